@@ -1,0 +1,408 @@
+"""Input validation shared by every public geomlib function and every lab entry point.
+
+One rule: bad input raises :class:`MeshError` (a ``ValueError``) whose message names the
+problem *and the place* (which row, which face, which edge), prefixed with the name of the
+function that was called, so a student reading it knows what to fix.
+
+Examples
+--------
+>>> import numpy as np
+>>> from geomlib.validate import check_mesh
+>>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0.0]])
+>>> check_mesh(V, [[0, 1, 3]], where="loop_subdivide")
+Traceback (most recent call last):
+...
+geomlib.validate.MeshError: loop_subdivide: F: face 0 uses vertex 3, but V has only 3 vertices (valid indices 0..2)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+
+__all__ = [
+    "MeshError",
+    "as_vertices",
+    "as_faces",
+    "as_array",
+    "as_polygons",
+    "as_image",
+    "check_mesh",
+    "check_polygon_mesh",
+    "check_manifold",
+    "check_int",
+    "check_float",
+    "check_choice",
+]
+
+
+class MeshError(ValueError):
+    """Invalid mesh, array, image or parameter. The message names the problem and the place."""
+
+
+def _prefix(where: str | None) -> str:
+    return f"{where}: " if where else ""
+
+
+def _fmt_row(row: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.6g}" if isinstance(x, float | np.floating) else str(x) for x in row) + ")"
+
+
+def as_array(
+    x,
+    name: str,
+    *,
+    shape: Sequence[int | None] | None = None,
+    dtype: type | np.dtype = np.float64,
+    finite: bool = True,
+    where: str | None = None,
+) -> np.ndarray:
+    """Convert ``x`` to a contiguous array of ``dtype`` and check its shape and values.
+
+    Parameters
+    ----------
+    x : array_like
+    name : str
+        Name used in error messages (e.g. ``"UV"``).
+    shape : sequence of int or None, optional
+        Expected shape; ``None`` entries match any size. ``None`` skips the check.
+    dtype : numpy dtype
+        Target dtype. Integer targets reject non-integral floats.
+    finite : bool
+        For float targets, reject NaN and inf (naming the first bad row).
+    where : str, optional
+        Name of the calling function, prepended to messages.
+    """
+    p = _prefix(where)
+    if x is None:
+        raise MeshError(f"{p}{name} is missing (got None)")
+    try:
+        a = np.asarray(x)
+    except Exception as e:  # ragged lists and the like
+        raise MeshError(f"{p}{name} could not be read as an array ({e})") from None
+    if a.dtype == object:
+        raise MeshError(f"{p}{name} is ragged or holds non-numbers (dtype object); expected a numeric array")
+    if shape is not None:
+        exp = "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
+        if a.ndim != len(shape) or any(s is not None and s != d for s, d in zip(shape, a.shape, strict=False)):
+            raise MeshError(f"{p}{name} has shape {a.shape}, expected {exp}")
+    target = np.dtype(dtype)
+    if target.kind in "iu":
+        if a.dtype.kind == "b" or a.dtype.kind not in "iuf":
+            raise MeshError(f"{p}{name} has dtype {a.dtype}, expected integers")
+        if a.dtype.kind == "f":
+            if a.size and not np.all(np.isfinite(a)):
+                raise MeshError(f"{p}{name} holds NaN or inf, expected integers")
+            if a.size and not np.all(a == np.round(a)):
+                bad = np.argwhere(a != np.round(a))[0]
+                raise MeshError(f"{p}{name} holds a non-integer value {a[tuple(bad)]} at {tuple(int(i) for i in bad)}")
+        a = np.ascontiguousarray(a, dtype=target)
+    else:
+        if a.dtype.kind not in "biuf":
+            raise MeshError(f"{p}{name} has dtype {a.dtype}, expected numbers")
+        a = np.ascontiguousarray(a, dtype=target)
+        if finite and a.size and not np.all(np.isfinite(a)):
+            bad = ~np.isfinite(a)
+            if a.ndim >= 2:
+                r = int(np.flatnonzero(bad.reshape(a.shape[0], -1).any(axis=1))[0])
+                raise MeshError(f"{p}{name}: row {r} has a non-finite value {_fmt_row(a[r].ravel())}")
+            i = tuple(int(k) for k in np.argwhere(bad)[0])
+            raise MeshError(f"{p}{name}: entry {i} is {a[i]}, expected a finite number")
+    return a
+
+
+def as_vertices(V, *, name: str = "V", dim: int = 3, where: str | None = None) -> np.ndarray:
+    """Vertex positions as float64 ``(n, dim)``, finite."""
+    return as_array(V, name, shape=(None, dim), dtype=np.float64, where=where)
+
+
+def as_faces(
+    F,
+    n_vertices: int,
+    *,
+    name: str = "F",
+    k: int | None = 3,
+    allow_degenerate: bool = False,
+    allow_duplicate: bool = False,
+    where: str | None = None,
+) -> np.ndarray:
+    """Face indices as int64 ``(m, k)``, every index in ``0..n_vertices-1``.
+
+    Degenerate faces (a repeated vertex) and duplicate faces (the same vertex set twice) are
+    rejected unless allowed.
+    """
+    p = _prefix(where)
+    F = as_array(F, name, shape=(None, k) if k else (None, None), dtype=np.int64, where=where)
+    if F.shape[0] == 0:
+        return F
+    if F.min() < 0:
+        f = int(np.flatnonzero((F < 0).any(axis=1))[0])
+        raise MeshError(f"{p}{name}: face {f} {_fmt_row(F[f])} has a negative index")
+    if F.max() >= n_vertices:
+        f = int(np.flatnonzero((F >= n_vertices).any(axis=1))[0])
+        bad = int(F[f][F[f] >= n_vertices][0])
+        raise MeshError(
+            f"{p}{name}: face {f} uses vertex {bad}, but V has only {n_vertices} vertices "
+            f"(valid indices 0..{n_vertices - 1})"
+        )
+    S = np.sort(F, axis=1)
+    if not allow_degenerate:
+        rep = (S[:, 1:] == S[:, :-1]).any(axis=1)
+        if rep.any():
+            f = int(np.flatnonzero(rep)[0])
+            raise MeshError(f"{p}{name}: face {f} {_fmt_row(F[f])} is degenerate (repeats a vertex)")
+    if not allow_duplicate:
+        _, first, counts = np.unique(S, axis=0, return_index=True, return_counts=True)
+        if (counts > 1).any():
+            key = S[first[np.flatnonzero(counts > 1)[0]]]
+            dup = np.flatnonzero((S == key).all(axis=1))
+            raise MeshError(
+                f"{p}{name}: faces {int(dup[0])} and {int(dup[1])} are duplicates "
+                f"(both use vertices {_fmt_row(key)})"
+            )
+    return F
+
+
+def check_manifold(F: np.ndarray, n_vertices: int, *, name: str = "F", where: str | None = None) -> None:
+    """Raise unless the triangle or polygon mesh is edge- and vertex-manifold and consistently oriented.
+
+    ``F`` is an ``(m, k)`` int array or a ``(indices, offsets)`` ragged pair (see :func:`as_polygons`).
+    """
+    from geomlib import topology
+
+    p = _prefix(where)
+    idx, off = topology.to_ragged(F)
+    he = topology.halfedges(idx, off)  # (h, 2) directed edges, face of each in he_face
+    he_face = np.repeat(np.arange(len(off) - 1), np.diff(off))
+    und = np.sort(he, axis=1)
+    keys, inv, counts = topology.unique_rows(und, return_inverse=True, return_counts=True)
+    if (counts > 2).any():
+        e = int(np.flatnonzero(counts > 2)[0])
+        faces = sorted(set(he_face[inv == e].tolist()))
+        raise MeshError(
+            f"{p}{name}: edge ({keys[e][0]}, {keys[e][1]}) is shared by {counts[e]} faces {tuple(faces)}; "
+            f"this needs an edge-manifold mesh (each edge in at most 2 faces)"
+        )
+    # Same directed edge twice = neighbouring faces with opposite orientation.
+    dkeys, dcounts = topology.unique_rows(he, return_counts=True)
+    if (dcounts > 1).any():
+        d = dkeys[np.flatnonzero(dcounts > 1)[0]]
+        faces = he_face[(he == d).all(axis=1)]
+        raise MeshError(
+            f"{p}{name}: faces {int(faces[0])} and {int(faces[1])} both traverse edge ({d[0]}, {d[1]}) "
+            f"in the same direction; the mesh is not consistently oriented"
+        )
+    fans = topology.vertex_fan_counts(idx, off, n_vertices)
+    if (fans > 1).any():
+        v = int(np.flatnonzero(fans > 1)[0])
+        raise MeshError(
+            f"{p}{name}: vertex {v} is non-manifold (its faces form {int(fans[v])} separate fans); "
+            f"this needs a vertex-manifold mesh"
+        )
+
+
+def check_mesh(
+    V,
+    F,
+    *,
+    where: str | None = None,
+    manifold: bool = False,
+    closed: bool = False,
+    allow_degenerate: bool = False,
+    allow_duplicate: bool = False,
+    min_faces: int = 1,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Validate a triangle mesh and return it as ``(V float64 (n, 3), F int64 (m, 3))``.
+
+    Parameters
+    ----------
+    V, F : array_like
+        Vertex positions and triangle indices.
+    where : str, optional
+        Name of the calling function, used as message prefix.
+    manifold : bool
+        Also require an edge- and vertex-manifold, consistently oriented mesh.
+    closed : bool
+        Also require no boundary edges.
+    allow_degenerate, allow_duplicate : bool
+        Accept faces that repeat a vertex / that repeat another face.
+    min_faces : int
+        Fewest faces accepted.
+    """
+    p = _prefix(where)
+    V = as_vertices(V, where=where)
+    if F is not None and not isinstance(F, np.ndarray):
+        try:
+            shape_ok = np.asarray(F).ndim == 2
+        except Exception:
+            shape_ok = False
+        if not shape_ok:
+            raise MeshError(f"{p}F must be an (m, 3) integer array of triangles; got a ragged or polygonal list")
+    if F is not None and np.asarray(F).ndim == 2 and np.asarray(F).shape[1] != 3:
+        raise MeshError(
+            f"{p}F has shape {np.asarray(F).shape}: this function needs triangles (m, 3); "
+            f"triangulate polygon faces first"
+        )
+    F = as_faces(F, len(V), where=where, allow_degenerate=allow_degenerate, allow_duplicate=allow_duplicate)
+    if len(F) < min_faces:
+        raise MeshError(f"{p}F has {len(F)} faces, expected at least {min_faces}")
+    if manifold:
+        check_manifold(F, len(V), where=where)
+    if closed:
+        from geomlib import topology
+
+        b = topology.boundary_edges(F)
+        if len(b):
+            raise MeshError(f"{p}mesh has {len(b)} boundary edges (e.g. {tuple(int(i) for i in b[0])}); expected a closed mesh")
+    return V, F
+
+
+def as_polygons(faces, n_vertices: int, *, name: str = "faces", where: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Polygon faces as a ragged ``(indices, offsets)`` pair of int64 arrays.
+
+    ``faces`` is an int ``(m, k)`` array or a list of index sequences of any lengths >= 3.
+    Face ``f`` is ``indices[offsets[f]:offsets[f + 1]]``.
+    """
+    p = _prefix(where)
+    if faces is None:
+        raise MeshError(f"{p}{name} is missing (got None)")
+    if isinstance(faces, np.ndarray) and faces.dtype != object:
+        arr = as_array(faces, name, shape=(None, None), dtype=np.int64, where=where)
+        lens = np.full(len(arr), arr.shape[1], dtype=np.int64)
+        idx = arr.ravel()
+    else:
+        if not isinstance(faces, Iterable):
+            raise MeshError(f"{p}{name} must be an (m, k) array or a list of polygons")
+        polys = []
+        for i, f in enumerate(faces):
+            try:
+                a = np.asarray(f)
+            except Exception:
+                raise MeshError(f"{p}{name}: face {i} is not a sequence of indices") from None
+            if a.ndim != 1 or a.dtype.kind not in "iu":
+                if a.ndim == 1 and a.dtype.kind == "f" and np.all(a == np.round(a)):
+                    a = a.astype(np.int64)
+                else:
+                    raise MeshError(f"{p}{name}: face {i} is not a flat sequence of integer indices")
+            polys.append(a.astype(np.int64))
+        lens = np.array([len(a) for a in polys], dtype=np.int64)
+        idx = np.concatenate(polys) if polys else np.zeros(0, np.int64)
+    if len(lens) and lens.min() < 3:
+        f = int(np.flatnonzero(lens < 3)[0])
+        raise MeshError(f"{p}{name}: face {f} has {lens[f]} vertices, a polygon needs at least 3")
+    off = np.concatenate([[0], np.cumsum(lens)]).astype(np.int64)
+    if idx.size:
+        face_of = np.repeat(np.arange(len(lens)), lens)
+        if idx.min() < 0:
+            f = int(face_of[np.flatnonzero(idx < 0)[0]])
+            raise MeshError(f"{p}{name}: face {f} has a negative index")
+        if idx.max() >= n_vertices:
+            j = int(np.flatnonzero(idx >= n_vertices)[0])
+            raise MeshError(
+                f"{p}{name}: face {int(face_of[j])} uses vertex {int(idx[j])}, but V has only {n_vertices} "
+                f"vertices (valid indices 0..{n_vertices - 1})"
+            )
+        # A polygon that repeats a vertex is degenerate.
+        order = np.lexsort((idx, face_of))
+        s_idx, s_face = idx[order], face_of[order]
+        rep = (s_idx[1:] == s_idx[:-1]) & (s_face[1:] == s_face[:-1])
+        if rep.any():
+            f = int(s_face[1:][rep][0])
+            raise MeshError(f"{p}{name}: face {f} {_fmt_row(idx[off[f]:off[f + 1]])} is degenerate (repeats a vertex)")
+    return idx, off
+
+
+def check_polygon_mesh(
+    V, faces, *, where: str | None = None, manifold: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Validate a polygon mesh; return ``(V, indices, offsets)`` (see :func:`as_polygons`)."""
+    V = as_vertices(V, where=where)
+    idx, off = as_polygons(faces, len(V), where=where)
+    if len(off) < 2:
+        raise MeshError(f"{_prefix(where)}faces is empty, expected at least one polygon")
+    if manifold:
+        check_manifold((idx, off), len(V), name="faces", where=where)
+    return V, idx, off
+
+
+def check_int(value, name: str, *, minimum: int | None = None, maximum: int | None = None, where: str | None = None) -> int:
+    """An integer parameter (bools and non-integral floats rejected)."""
+    p = _prefix(where)
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise MeshError(f"{p}{name} must be an integer, got {value!r} ({type(value).__name__})")
+    value = int(value)
+    if minimum is not None and value < minimum:
+        raise MeshError(f"{p}{name} must be >= {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise MeshError(f"{p}{name} must be <= {maximum}, got {value}")
+    return value
+
+
+def check_float(
+    value, name: str, *, minimum: float | None = None, maximum: float | None = None, where: str | None = None
+) -> float:
+    """A finite real parameter within optional bounds."""
+    p = _prefix(where)
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise MeshError(f"{p}{name} must be a number, got {value!r} ({type(value).__name__})")
+    value = float(value)
+    if not np.isfinite(value):
+        raise MeshError(f"{p}{name} must be finite, got {value}")
+    if minimum is not None and value < minimum:
+        raise MeshError(f"{p}{name} must be >= {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise MeshError(f"{p}{name} must be <= {maximum}, got {value}")
+    return value
+
+
+def check_choice(value, name: str, choices: Sequence[str], *, where: str | None = None) -> str:
+    """One of a fixed set of string options."""
+    if not isinstance(value, str) or value not in choices:
+        raise MeshError(f"{_prefix(where)}{name} must be one of {', '.join(map(repr, choices))}; got {value!r}")
+    return value
+
+
+def as_image(
+    img,
+    name: str = "image",
+    *,
+    channels: int | Sequence[int] | None = None,
+    size: tuple[int, int] | None = None,
+    square: bool = False,
+    dtype: type | np.dtype | None = None,
+    where: str | None = None,
+) -> np.ndarray:
+    """Check an image array ``(h, w)`` or ``(h, w, c)``.
+
+    Parameters
+    ----------
+    channels : int or sequence of int, optional
+        Allowed channel counts; a 2-D array counts as 1 channel.
+    size : (h, w), optional
+        Required height and width.
+    square : bool
+        Require ``h == w``.
+    dtype : dtype, optional
+        Convert to this dtype (float targets must be finite).
+    """
+    p = _prefix(where)
+    if img is None:
+        raise MeshError(f"{p}{name} is missing (got None)")
+    a = np.asarray(img)
+    if a.ndim not in (2, 3) or a.dtype == object:
+        raise MeshError(f"{p}{name} has shape {a.shape}; expected an image (h, w) or (h, w, c)")
+    c = 1 if a.ndim == 2 else a.shape[2]
+    if channels is not None:
+        allowed = (channels,) if isinstance(channels, int) else tuple(channels)
+        if c not in allowed:
+            raise MeshError(f"{p}{name} has {c} channel(s) (shape {a.shape}); expected {' or '.join(map(str, allowed))}")
+    if a.shape[0] == 0 or a.shape[1] == 0:
+        raise MeshError(f"{p}{name} is empty (shape {a.shape})")
+    if size is not None and tuple(a.shape[:2]) != tuple(size):
+        raise MeshError(f"{p}{name} is {a.shape[0]}x{a.shape[1]} pixels; expected {size[0]}x{size[1]}")
+    if square and a.shape[0] != a.shape[1]:
+        raise MeshError(f"{p}{name} is {a.shape[0]}x{a.shape[1]} pixels; expected a square image")
+    if dtype is not None:
+        a = as_array(a, name, dtype=dtype, where=where)
+    return a
