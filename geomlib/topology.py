@@ -138,7 +138,9 @@ def boundary_loops(faces) -> list[np.ndarray]:
         return []
     starts, counts = np.unique(B[:, 0], return_counts=True)
     if (counts > 1).any():
-        raise MeshError(f"boundary vertex {int(starts[np.argmax(counts)])} has {counts.max()} outgoing boundary edges (non-manifold boundary)")
+        raise MeshError(
+            f"boundary vertex {int(starts[np.argmax(counts)])} has {counts.max()} outgoing boundary edges (non-manifold boundary)"
+        )
     nxt = dict(zip(B[:, 0].tolist(), B[:, 1].tolist(), strict=True))
     seen: set[int] = set()
     loops = []

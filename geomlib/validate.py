@@ -158,8 +158,7 @@ def as_faces(
             key = S[first[np.flatnonzero(counts > 1)[0]]]
             dup = np.flatnonzero((S == key).all(axis=1))
             raise MeshError(
-                f"{p}{name}: faces {int(dup[0])} and {int(dup[1])} are duplicates "
-                f"(both use vertices {_fmt_row(key)})"
+                f"{p}{name}: faces {int(dup[0])} and {int(dup[1])} are duplicates (both use vertices {_fmt_row(key)})"
             )
     return F
 
@@ -254,11 +253,15 @@ def check_mesh(
 
         b = topology.boundary_edges(F)
         if len(b):
-            raise MeshError(f"{p}mesh has {len(b)} boundary edges (e.g. {tuple(int(i) for i in b[0])}); expected a closed mesh")
+            raise MeshError(
+                f"{p}mesh has {len(b)} boundary edges (e.g. {tuple(int(i) for i in b[0])}); expected a closed mesh"
+            )
     return V, F
 
 
-def as_polygons(faces, n_vertices: int, *, name: str = "faces", where: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+def as_polygons(
+    faces, n_vertices: int, *, name: str = "faces", where: str | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Polygon faces as a ragged ``(indices, offsets)`` pair of int64 arrays.
 
     ``faces`` is an int ``(m, k)`` array or a list of index sequences of any lengths >= 3.
@@ -309,7 +312,9 @@ def as_polygons(faces, n_vertices: int, *, name: str = "faces", where: str | Non
         rep = (s_idx[1:] == s_idx[:-1]) & (s_face[1:] == s_face[:-1])
         if rep.any():
             f = int(s_face[1:][rep][0])
-            raise MeshError(f"{p}{name}: face {f} {_fmt_row(idx[off[f]:off[f + 1]])} is degenerate (repeats a vertex)")
+            raise MeshError(
+                f"{p}{name}: face {f} {_fmt_row(idx[off[f] : off[f + 1]])} is degenerate (repeats a vertex)"
+            )
     return idx, off
 
 
@@ -326,7 +331,9 @@ def check_polygon_mesh(
     return V, idx, off
 
 
-def check_int(value, name: str, *, minimum: int | None = None, maximum: int | None = None, where: str | None = None) -> int:
+def check_int(
+    value, name: str, *, minimum: int | None = None, maximum: int | None = None, where: str | None = None
+) -> int:
     """An integer parameter (bools and non-integral floats rejected)."""
     p = _prefix(where)
     if isinstance(value, bool) or not isinstance(value, int | np.integer):
@@ -396,7 +403,9 @@ def as_image(
     if channels is not None:
         allowed = (channels,) if isinstance(channels, int) else tuple(channels)
         if c not in allowed:
-            raise MeshError(f"{p}{name} has {c} channel(s) (shape {a.shape}); expected {' or '.join(map(str, allowed))}")
+            raise MeshError(
+                f"{p}{name} has {c} channel(s) (shape {a.shape}); expected {' or '.join(map(str, allowed))}"
+            )
     if a.shape[0] == 0 or a.shape[1] == 0:
         raise MeshError(f"{p}{name} is empty (shape {a.shape})")
     if size is not None and tuple(a.shape[:2]) != tuple(size):

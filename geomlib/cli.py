@@ -1,0 +1,195 @@
+"""The ``geomlib`` command.
+
+Students:      geomlib grade --impl labs --lab subdivision
+Instructors:   geomlib figures | refs build | refs check | stubs build | stubs check | release OUT
+Anyone:        geomlib info mesh.obj | geomlib render mesh.obj -o mesh.png
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+EPILOG = """\
+examples:
+  geomlib figures --out build/figures          regenerate every figure + index.html (instructors)
+  geomlib grade --impl labs --lab subdivision  grade your work in labs/ (students)
+  geomlib grade --impl path/to/submission --results results.json
+  geomlib refs build --lab subdivision         store reference outputs from solutions/
+  geomlib stubs build                          regenerate labs/ from solutions/
+  geomlib release dist/                        student bundle + Gradescope autograder zip
+  geomlib info mesh.obj                        counts, face kinds, manifoldness, genus, bbox
+  geomlib render mesh.off -o mesh.png --wireframe
+"""
+
+
+def _cmd_figures(a) -> int:
+    from geomlib import figures
+
+    out = Path(a.out)
+    figs = figures.build_all(out, labs=a.lab, quick=a.quick, progress=True)
+    print(f"{len(figs)} figures; open {out / 'index.html'}")
+    return 0
+
+
+def _cmd_info(a) -> int:
+    from geomlib import info
+
+    print(info.describe(a.file))
+    return 0
+
+
+def _cmd_render(a) -> int:
+    import numpy as np
+
+    from geomlib import io, plot, render, topology
+
+    V, faces = io.read_mesh(a.file)
+    if isinstance(faces, np.ndarray) and faces.shape[1] == 3:
+        img = render.render(
+            V, faces, wireframe=a.wireframe, shadows=a.shadows, size=(a.width, a.height), camera=a.camera
+        )
+    else:
+        img = render.render_polygons(
+            V, faces, wireframe=a.wireframe, shadows=a.shadows, size=(a.width, a.height), camera=a.camera
+        )
+    del topology
+    plot.save_png(a.output, img)
+    print(f"wrote {a.output}")
+    return 0
+
+
+def _cmd_refs(a) -> int:
+    from geomlib.grading import refs
+
+    labs = [a.lab] if a.lab else None
+    if a.action == "build":
+        t = time.time()
+        files = refs.build(labs)
+        print(f"wrote {len(files)} reference files in {time.time() - t:.1f} s")
+        return 0
+    problems = refs.check(labs)
+    for p in problems:
+        print(f"FAIL {p.lab}/{p.case}: {p.message}")
+    print("references OK" if not problems else f"{len(problems)} reference problem(s)")
+    return 1 if problems else 0
+
+
+def _cmd_stubs(a) -> int:
+    from geomlib.grading import stubs
+
+    labs = [a.lab] if a.lab else None
+    if a.action == "build":
+        files = stubs.build(labs)
+        print(f"{len(files)} stub files up to date in labs/")
+        return 0
+    problems = stubs.check(labs)
+    for p in problems:
+        print(f"STALE {p}")
+    print("labs/ is up to date" if not problems else "labs/ is stale: run `geomlib stubs build`")
+    return 1 if problems else 0
+
+
+def _cmd_grade(a) -> int:
+    from geomlib.grading.grade import grade
+
+    data = grade(a.impl, [a.lab] if a.lab else None, results=a.results, feedback_dir=a.feedback, verbose=a.verbose)
+    failed = [t for t in data["tests"] if t["status"] == "failed"]
+    if failed:
+        print("\nWhat to fix:")
+        for t in failed:
+            print(f"  ✗ {t['name']}\n      {t['output']}")
+    print()
+    print(data["output"])
+    if a.results:
+        print(f"\nwrote {a.results}")
+    return 0
+
+
+def _cmd_release(a) -> int:
+    from geomlib.grading import release
+
+    out = release.release(Path(a.out))
+    for k, v in out.items():
+        print(f"{k}: {v}")
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="geomlib",
+        description="Geometry-processing course framework: figures, grading, references, stubs, release, mesh tools.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    f = sub.add_parser("figures", help="render every lab's figures (and the dataset gallery) with an index page")
+    f.add_argument("--lab", action="append", help="only this lab (repeatable); 'gallery' for the datasets")
+    f.add_argument("--out", default="build/figures", help="output folder (default: build/figures)")
+    f.add_argument("--quick", action="store_true", help="smaller, faster figures (for tests)")
+    f.set_defaults(func=_cmd_figures)
+
+    i = sub.add_parser(
+        "info", help="describe a mesh file: counts, face kinds, manifoldness, boundary loops, genus, bbox"
+    )
+    i.add_argument("file")
+    i.set_defaults(func=_cmd_info)
+
+    r = sub.add_parser("render", help="render an OBJ/OFF/PLY mesh to a PNG")
+    r.add_argument("file")
+    r.add_argument("-o", "--output", required=True, help="PNG to write")
+    r.add_argument("--wireframe", action="store_true", help="overlay the edges")
+    r.add_argument("--shadows", action="store_true", help="cast shadows onto a ground plane")
+    r.add_argument("--camera", default="three_quarter", choices=["front", "three_quarter", "top", "side"])
+    r.add_argument("--width", type=int, default=800)
+    r.add_argument("--height", type=int, default=600)
+    r.set_defaults(func=_cmd_render)
+
+    rf = sub.add_parser("refs", help="reference outputs: build from solutions/, or check they are reproduced")
+    rf.add_argument("action", choices=["build", "check"])
+    rf.add_argument("--lab")
+    rf.set_defaults(func=_cmd_refs)
+
+    st = sub.add_parser("stubs", help="regenerate labs/ from solutions/, or check labs/ is up to date")
+    st.add_argument("action", choices=["build", "check"])
+    st.add_argument("--lab")
+    st.set_defaults(func=_cmd_stubs)
+
+    g = sub.add_parser("grade", help="run the graded tests on an implementation; print scores, write results.json")
+    g.add_argument(
+        "--impl",
+        default=None,
+        help="'solutions', 'labs' (your work) or a submission folder (default: solutions if present, else labs)",
+    )
+    g.add_argument("--lab", help="only this lab")
+    g.add_argument("--results", help="write Gradescope results.json here")
+    g.add_argument("--feedback", default="feedback", help="folder for feedback pictures (default: feedback/)")
+    g.add_argument("-v", "--verbose", action="store_true")
+    g.set_defaults(func=_cmd_grade)
+
+    rl = sub.add_parser("release", help="write the student bundle and the Gradescope autograder zip")
+    rl.add_argument("out", help="output folder")
+    rl.set_defaults(func=_cmd_release)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    a = parser.parse_args(argv)
+    if not getattr(a, "func", None):
+        parser.print_help()
+        return 0
+    from geomlib.validate import MeshError
+
+    try:
+        return a.func(a)
+    except (MeshError, FileNotFoundError) as e:
+        print(f"geomlib {a.command}: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,54 @@
+"""The main job: regenerate every figure from the reference solutions, with an index page.
+
+``geomlib figures`` renders the gallery of built-in datasets and, for every lab that has a
+``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, quick)``; then writes
+``index.html`` and ``index.md`` showing every figure with its caption.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import time
+from pathlib import Path
+
+from geomlib.grading.impl import course_root
+
+__all__ = ["lab_figure_modules", "build_all"]
+
+
+def lab_figure_modules() -> list[str]:
+    """Labs whose reference solution has a ``figures.py``, in course order."""
+    order = ["subdivision", "simplification", "maps", "denoise", "shadows", "vdm"]
+    sol = course_root() / "solutions"
+    names = [p.parent.name for p in sol.glob("*/figures.py")] if sol.is_dir() else []
+    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
+
+
+def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, progress: bool = True) -> list:
+    """Render the gallery and every lab's figures into ``out``; return the list of ``Figure``."""
+    from geomlib import gallery, plot
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    wanted = labs or ["gallery", *lab_figure_modules()]
+    root = str(course_root())
+    if root not in sys.path:
+        sys.path.insert(0, root)
+    figures = []
+    for i, name in enumerate(wanted, 1):
+        t = time.time()
+        if progress:
+            print(f"[{i}/{len(wanted)}] {name} ...", flush=True)
+        if name == "gallery":
+            figs = gallery.build_gallery(out / "gallery", quick=quick)
+        else:
+            if not (course_root() / "solutions" / name / "figures.py").is_file():
+                raise FileNotFoundError(f"no figures for lab {name!r} (expected solutions/{name}/figures.py)")
+            mod = importlib.import_module(f"solutions.{name}.figures")
+            figs = mod.make_figures(out / name, quick=quick)
+        figures.extend(figs)
+        if progress:
+            print(f"      {len(figs)} figure(s) in {time.time() - t:.1f} s", flush=True)
+    plot.write_index(figures, out)
+    return figures

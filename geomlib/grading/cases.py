@@ -1,0 +1,246 @@
+"""Graded cases declared once, and the helpers graded tests are written with.
+
+See ``docs/adding-a-lab.md`` for how a lab uses them.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import json
+import re
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from geomlib.grading import impl as _impl
+from geomlib.grading import tolerances as tol
+from geomlib.grading.checks import Context, compare_arrays
+from geomlib.grading.errors import BadReturn, Mismatch, StudentError
+
+__all__ = [
+    "Case",
+    "graded",
+    "reference_tests",
+    "run_case",
+    "expect_close",
+    "expect_raises",
+    "load_cases",
+    "reference_path",
+    "load_reference",
+    "inputs_digest",
+]
+
+VISIBILITIES = ("visible", "after_due_date", "hidden", "after_published")
+
+
+@dataclass
+class Case:
+    """One graded call with a stored reference output.
+
+    Attributes
+    ----------
+    id : str
+        Unique within the lab; names the reference file.
+    function : str
+        Lab function, called as ``function(**inputs(), **params)``.
+    inputs : callable
+        Returns a dict of arguments (deterministic: seeded, built from ``geomlib.datasets``).
+    params : dict
+        JSON-able extra keyword arguments (recorded in the manifest).
+    outputs : tuple of str
+        Names of the returned values (one name: the function returns a single value).
+    check : callable
+        A comparison from :mod:`geomlib.grading.checks`.
+    part : str
+        Grading part this case counts towards.
+    points : float
+    visibility : str
+        ``visible``, ``after_due_date`` or ``hidden`` (Gradescope's meanings).
+    hint : str, optional
+        Appended to the failure message.
+    timeout : float, optional
+        Seconds allowed for the call (default :data:`~geomlib.grading.tolerances.TIME_LIMIT_S`).
+    """
+
+    id: str
+    function: str
+    inputs: Callable[[], dict]
+    check: Callable
+    part: str
+    points: float = 1.0
+    params: dict = field(default_factory=dict)
+    outputs: tuple = ("result",)
+    visibility: str = "visible"
+    hint: str | None = None
+    timeout: float | None = None
+
+    def __post_init__(self):
+        if self.visibility not in VISIBILITIES:
+            raise ValueError(f"case {self.id}: visibility must be one of {VISIBILITIES}")
+        if isinstance(self.outputs, str):
+            self.outputs = (self.outputs,)
+        if not re.fullmatch(r"[A-Za-z0-9_.\-]+", self.id):
+            raise ValueError(f"case id {self.id!r}: use letters, digits, '-', '_' and '.' only")
+
+    @property
+    def hidden(self) -> bool:
+        return self.visibility == "hidden"
+
+    @property
+    def label(self) -> str:
+        return f'{self.function} on "{self.id}"'
+
+    def name_outputs(self, result, label: str | None = None) -> dict:
+        """Map a returned value to ``{output name: value}``, failing clearly on the wrong arity."""
+        label = label or self.label
+        if len(self.outputs) == 1:
+            return {self.outputs[0]: result}
+        names = ", ".join(self.outputs)
+        if not isinstance(result, tuple | list):
+            raise BadReturn(
+                f"{label}: should return {len(self.outputs)} values ({names}), got a single {type(result).__name__}"
+            )
+        if len(result) != len(self.outputs):
+            raise BadReturn(f"{label}: should return {len(self.outputs)} values ({names}), got {len(result)}")
+        return dict(zip(self.outputs, result, strict=True))
+
+
+def graded(
+    points: float, part: str, visibility: str = "visible", *, timeout: float | None = None, memory_mb: int | None = None
+):
+    """Mark a test as graded: its points, its part and its Gradescope visibility."""
+    if visibility not in VISIBILITIES:
+        raise ValueError(f"visibility must be one of {VISIBILITIES}")
+    return pytest.mark.graded(points=points, part=part, visibility=visibility, timeout=timeout, memory_mb=memory_mb)
+
+
+def reference_path(lab: str, case: Case) -> Path:
+    sub = "hidden" if case.hidden else ""
+    return _impl.reference_dir() / lab / sub / f"{case.id}.npz"
+
+
+def load_reference(lab: str, case: Case) -> dict:
+    """The stored expected outputs of ``case`` (written by ``geomlib refs build``)."""
+    path = reference_path(lab, case)
+    if not path.is_file():
+        raise Mismatch(
+            f"reference output {path.relative_to(_impl.course_root())} is missing: run `geomlib refs build --lab {lab}`"
+        )
+    with np.load(path, allow_pickle=False) as z:
+        return {name: z[name] for name in z.files}
+
+
+def inputs_digest(inputs: dict, params: dict) -> str:
+    """A stable hash of a case's inputs, so `refs check` can tell changed inputs from changed outputs."""
+    h = hashlib.sha256()
+    for key in sorted(inputs):
+        h.update(key.encode())
+        v = inputs[key]
+        if (
+            isinstance(v, np.ndarray)
+            or isinstance(v, list | tuple)
+            and v
+            and isinstance(v[0], np.ndarray | list | tuple)
+        ):
+            try:
+                a = np.ascontiguousarray(np.asarray(v))
+                if a.dtype != object:
+                    h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
+                    continue
+            except ValueError:
+                pass
+            for item in v:
+                a = np.ascontiguousarray(np.asarray(item))
+                h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
+        else:
+            h.update(repr(v).encode())
+    h.update(json.dumps(params, sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def run_case(lab, case: Case, *, feedback_dir: Path | None = None) -> None:
+    """Call the case's function on the lab under test and compare with the stored reference."""
+    kwargs = {**case.inputs(), **case.params}
+    result = lab.call(case.function, **kwargs)
+    got = case.name_outputs(result)
+    expected = load_reference(lab.name, case)  # loaded only after the student's call has returned
+    ctx = Context(label=case.label, lab=lab.name, case_id=case.id, hint=case.hint, feedback_dir=feedback_dir)
+    case.check(expected, got, ctx)
+
+
+def reference_tests(cases: list[Case]):
+    """One graded, parametrised pytest test per case. Assign it to a ``test_*`` name in a test module."""
+    ids = [c.id for c in cases]
+    if len(set(ids)) != len(ids):
+        raise ValueError(f"duplicate case ids: {sorted({i for i in ids if ids.count(i) > 1})}")
+    params = [pytest.param(c, id=c.id, marks=graded(c.points, c.part, c.visibility, timeout=c.timeout)) for c in cases]
+
+    @pytest.mark.parametrize("case", params)
+    def test_reference(lab, case, feedback_dir):
+        run_case(lab, case, feedback_dir=feedback_dir)
+
+    test_reference.__doc__ = "reference output"
+    return test_reference
+
+
+def expect_close(
+    label: str,
+    got,
+    expected,
+    *,
+    atol: float = tol.EXACT,
+    rtol: float = 0.0,
+    name: str = "output",
+    hint: str | None = None,
+) -> None:
+    """Fail with a student-readable message unless ``got`` matches ``expected`` (same shape, within tolerance)."""
+    ctx = Context(label=label, hint=hint)
+    e = np.asarray(expected, dtype=np.float64)
+    try:
+        g = np.asarray(got, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise BadReturn(f"{label}: {name} is not a numeric array (got {type(got).__name__})") from None
+    compare_arrays(name, np.atleast_1d(e), np.atleast_1d(g), ctx, atol=atol, rtol=rtol)
+
+
+def expect_raises(
+    call: Callable[[], object], exception: str = "ValueError", *, match: str | None = None, label: str = "the call"
+) -> StudentError:
+    """Fail unless ``call()`` raises ``exception`` (by class name, bases included) whose message matches ``match``.
+
+    ``NotImplementedYet`` passes through, so a stub scores zero here too.
+    """
+    try:
+        call()
+    except StudentError as e:
+        if exception not in e.exc_mro:
+            raise Mismatch(f"{label} should raise {exception}, but raised {e.exc_type}: {e.exc_message}") from None
+        if match and not re.search(match, e.exc_message, flags=re.IGNORECASE):
+            raise Mismatch(
+                f"{label} raised {e.exc_type} as expected, but its message {e.exc_message!r} does not say what is wrong "
+                f"(expected it to mention {match!r})"
+            ) from None
+        return e
+    raise Mismatch(f"{label} should raise {exception} for this input, but it returned normally")
+
+
+def load_cases(lab: str, *, hidden: bool = True) -> list[Case]:
+    """All cases a lab declares (``tests/graded/<lab>/cases.py`` and, if present and wanted, ``cases_hidden.py``)."""
+    tests = str(_impl.tests_dir())
+    if tests not in sys.path:
+        sys.path.insert(0, tests)
+    cases: list[Case] = []
+    folder = _impl.tests_dir() / "graded" / lab
+    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True)):
+        if is_hidden and not hidden:
+            continue
+        if not (folder / f"{mod_name}.py").is_file():
+            continue
+        mod = importlib.import_module(f"graded.{lab}.{mod_name}")
+        cases.extend(mod.CASES)
+    return cases

@@ -1,0 +1,181 @@
+"""pytest plugin for graded tests: ``--impl``, the ``lab`` fixture, clean failure messages, scores.
+
+Loaded by ``tests/conftest.py``. A graded test lives in ``tests/graded/<lab>/`` and carries a
+``graded`` marker (points, part, visibility). The plugin
+
+- hands each test the lab under test as a sandboxed :class:`~geomlib.grading.sandbox.LabProxy`;
+- replaces the traceback of an expected failure (:class:`~geomlib.grading.errors.GradingFailure`)
+  by its one- or two-sentence message;
+- records every graded outcome, prints a per-lab, per-part score table, and leaves the records in
+  :data:`RECORDS` for ``geomlib grade`` to turn into ``results.json``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading import impl as _impl
+from geomlib.grading.errors import GradingFailure, NotImplementedYet
+from geomlib.grading.sandbox import LabProxy
+
+
+@dataclass
+class Record:
+    """The outcome of one graded test."""
+
+    nodeid: str
+    lab: str
+    part: str
+    name: str
+    points: float
+    visibility: str
+    passed: bool
+    message: str
+    duration: float
+    not_implemented: bool = False
+    error: bool = False
+
+    @property
+    def score(self) -> float:
+        return self.points if self.passed else 0.0
+
+
+#: Records of the most recent run in this process (read by ``geomlib grade``).
+RECORDS: list[Record] = []
+
+
+def pytest_addoption(parser):
+    g = parser.getgroup("geomlib grading")
+    g.addoption(
+        "--impl",
+        default=None,
+        help="implementation to grade: 'solutions', 'labs' or a path to a submission (default: solutions if present)",
+    )
+    g.addoption(
+        "--feedback-dir", default="feedback", help="where failing checks write feedback pictures (default: feedback/)"
+    )
+    g.addoption(
+        "--time-limit",
+        type=float,
+        default=float(os.environ["GEOMLIB_TIME_LIMIT"]) if os.environ.get("GEOMLIB_TIME_LIMIT") else None,
+        help="seconds allowed per call into the implementation (default: each test's own, else 30; env GEOMLIB_TIME_LIMIT)",
+    )
+
+
+def pytest_configure(config):
+    RECORDS.clear()
+    config.addinivalue_line("markers", "graded(points, part, visibility, timeout, memory_mb): a graded test")
+
+
+def _lab_of(path: Path) -> str | None:
+    parts = Path(path).parts
+    if "graded" in parts:
+        i = parts.index("graded")
+        if i + 1 < len(parts) - 1:
+            return parts[i + 1]
+    return None
+
+
+@pytest.fixture
+def feedback_dir(request) -> Path | None:
+    d = request.config.getoption("--feedback-dir")
+    return Path(d) if d else None
+
+
+@pytest.fixture
+def lab(request) -> LabProxy:
+    """The lab under test (from the test's folder ``tests/graded/<lab>/``), run in sandboxed workers."""
+    name = _lab_of(request.path)
+    if name is None:
+        raise RuntimeError("the `lab` fixture is for tests under tests/graded/<lab>/")
+    root = _impl.resolve_impl(request.config.getoption("--impl"))
+    marker = request.node.get_closest_marker("graded")
+    timeout = request.config.getoption("--time-limit") or (marker.kwargs.get("timeout") if marker else None)
+    memory = marker.kwargs.get("memory_mb") if marker else None
+    return LabProxy(name, root / name, timeout=timeout, memory_mb=memory)
+
+
+def _display_name(item) -> str:
+    fn = getattr(item, "function", None)
+    doc = (fn.__doc__ or "").strip().splitlines()[0] if fn is not None and fn.__doc__ else ""
+    base = doc or item.originalname.removeprefix("test_").replace("_", " ")
+    callspec = getattr(item, "callspec", None)
+    if callspec is not None and "case" in callspec.params:
+        return callspec.params["case"].label
+    if callspec is not None:
+        return f"{base} [{callspec.id}]"
+    return base
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    rep = outcome.get_result()
+    marker = item.get_closest_marker("graded")
+    exc = call.excinfo.value if call.excinfo is not None else None
+    if isinstance(exc, GradingFailure) and rep.failed:
+        rep.longrepr = str(exc)
+    if marker is None:
+        return
+    done = rep.when == "call" or (rep.when == "setup" and not rep.passed)
+    if not done:
+        return
+    if rep.skipped:
+        passed, message = (
+            False,
+            "skipped: " + (str(rep.longrepr[-1]) if isinstance(rep.longrepr, tuple) else str(rep.longrepr)),
+        )
+    elif rep.passed:
+        passed, message = True, ""
+    elif isinstance(exc, GradingFailure):
+        passed, message = False, str(exc)
+    else:
+        # An assertion in a graded test or an error in the grader: show the short reason, not a traceback.
+        passed = False
+        message = f"{type(exc).__name__}: {exc}" if exc is not None else str(rep.longrepr)[-800:]
+    RECORDS.append(
+        Record(
+            nodeid=item.nodeid,
+            lab=_lab_of(item.path) or "?",
+            part=marker.kwargs.get("part", "other"),
+            name=_display_name(item),
+            points=float(marker.kwargs.get("points", 0)),
+            visibility=marker.kwargs.get("visibility", "visible"),
+            passed=passed,
+            message=message,
+            duration=getattr(rep, "duration", 0.0),
+            not_implemented=isinstance(exc, NotImplementedYet),
+            error=exc is not None and not isinstance(exc, GradingFailure | AssertionError),
+        )
+    )
+
+
+def score_table(records: list[Record]) -> str:
+    """A per-lab, per-part score table."""
+    from collections import OrderedDict
+
+    parts: OrderedDict = OrderedDict()
+    for r in records:
+        key = (r.lab, r.part)
+        s, m, n, ok = parts.get(key, (0.0, 0.0, 0, 0))
+        parts[key] = (s + r.score, m + r.points, n + 1, ok + r.passed)
+    lines = [f"{'lab':<16}{'part':<34}{'tests':>9}{'score':>14}"]
+    lines.append("-" * len(lines[0]))
+    total = maxtotal = 0.0
+    for (lab, part), (s, m, n, ok) in parts.items():
+        lines.append(f"{lab:<16}{part[:33]:<34}{f'{ok}/{n}':>9}{f'{s:g} / {m:g}':>14}")
+        total += s
+        maxtotal += m
+    lines.append("-" * len(lines[0]))
+    lines.append(f"{'total':<59}{f'{total:g} / {maxtotal:g}':>14}")
+    return "\n".join(lines)
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    if RECORDS:
+        terminalreporter.write_sep("=", "graded score")
+        terminalreporter.write_line(score_table(RECORDS))

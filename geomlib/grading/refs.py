@@ -1,0 +1,168 @@
+"""Reference outputs: built from the solutions by ``geomlib refs build``, verified by ``geomlib refs check``.
+
+Layout::
+
+    tests/reference/<lab>/<case>.npz            public cases (named arrays)
+    tests/reference/<lab>/manifest.json          parameters, input digests, versions, checksums
+    tests/reference/<lab>/hidden/<case>.npz     hidden cases (never shipped to students)
+    tests/reference/<lab>/hidden/manifest.json
+
+Never edit these files by hand: change the solution or the case, then rebuild.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import platform
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from geomlib.grading import impl as _impl
+from geomlib.grading.cases import Case, inputs_digest, load_cases, reference_path
+from geomlib.grading.checks import Context
+from geomlib.grading.errors import GradingFailure
+
+__all__ = ["build", "check", "RefProblem"]
+
+
+@dataclass
+class RefProblem:
+    lab: str
+    case: str
+    message: str
+
+
+def _versions() -> dict:
+    import scipy
+
+    out = {"python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__}
+    try:
+        import igl
+
+        out["libigl"] = getattr(igl, "__version__", "?")
+    except ImportError:
+        pass
+    return out
+
+
+def _to_arrays(case: Case, result) -> dict[str, np.ndarray]:
+    named = case.name_outputs(result)
+    out = {}
+    for k, v in named.items():
+        if hasattr(v, "toarray"):  # sparse matrix outputs are stored dense only if small
+            v = v.toarray()
+        a = np.asarray(v)
+        if a.dtype == object:
+            raise TypeError(f"case {case.id}: output {k} is not a numeric array")
+        out[k] = a
+    return out
+
+
+def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    return buf.getvalue()
+
+
+def _run_solution(lab: str, case: Case) -> tuple[dict, str]:
+    mod = _impl.load_lab(lab, "solutions")
+    fn = getattr(mod, case.function)
+    inputs = case.inputs()
+    digest = inputs_digest(inputs, case.params)
+    return _to_arrays(case, fn(**inputs, **case.params)), digest
+
+
+def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
+    """Run the solutions on every declared case and store the outputs; returns the files written."""
+    labs = labs or _impl.lab_names()
+    written = []
+    for lab in labs:
+        cases = load_cases(lab)
+        if not cases:
+            continue
+        manifests: dict[bool, dict] = {False: {}, True: {}}
+        for case in cases:
+            arrays, digest = _run_solution(lab, case)
+            path = reference_path(lab, case)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(_npz_bytes(arrays))
+            written.append(path)
+            manifests[case.hidden][case.id] = {
+                "function": case.function,
+                "params": case.params,
+                "part": case.part,
+                "points": case.points,
+                "visibility": case.visibility,
+                "inputs_sha256": digest,
+                "outputs": {
+                    k: {
+                        "shape": list(a.shape),
+                        "dtype": str(a.dtype),
+                        "sha256": hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest(),
+                    }
+                    for k, a in arrays.items()
+                },
+            }
+            log(
+                f"  {lab}/{'hidden/' if case.hidden else ''}{case.id}.npz  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}"
+            )
+        for hidden, entries in manifests.items():
+            folder = _impl.reference_dir() / lab / ("hidden" if hidden else "")
+            if not entries:
+                continue
+            # Drop stale reference files of cases that no longer exist.
+            for old in folder.glob("*.npz"):
+                if old.stem not in entries:
+                    old.unlink()
+            manifest = {
+                "generated_by": f"geomlib refs build --lab {lab}",
+                "note": "generated from solutions/; do not edit by hand",
+                "versions": _versions(),
+                "cases": entries,
+            }
+            (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+    return written
+
+
+def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
+    """Re-run the solutions and compare with the stored references using each case's own check."""
+    labs = labs or _impl.lab_names()
+    problems: list[RefProblem] = []
+    for lab in labs:
+        cases = load_cases(lab)
+        for case in cases:
+            path = reference_path(lab, case)
+            if not path.is_file():
+                problems.append(RefProblem(lab, case.id, f"missing {path.name}: run `geomlib refs build --lab {lab}`"))
+                continue
+            manifest_path = path.parent / "manifest.json"
+            manifest = json.loads(manifest_path.read_text()) if manifest_path.is_file() else {"cases": {}}
+            entry = manifest["cases"].get(case.id)
+            arrays, digest = _run_solution(lab, case)
+            if entry is None:
+                problems.append(RefProblem(lab, case.id, "not in the manifest: rebuild the references"))
+            elif entry["inputs_sha256"] != digest or entry["params"] != case.params:
+                problems.append(
+                    RefProblem(lab, case.id, "the case's inputs or parameters changed since the references were built")
+                )
+                continue
+            with np.load(path, allow_pickle=False) as z:
+                stored = {k: z[k] for k in z.files}
+            ctx = Context(label=f"{lab}/{case.id}", lab=lab, case_id=case.id)
+            try:
+                case.check(stored, arrays, ctx)
+            except GradingFailure as e:
+                problems.append(RefProblem(lab, case.id, f"the solution no longer reproduces the reference: {e}"))
+        # Reference files for which no case exists any more.
+        known = {(c.hidden, c.id) for c in cases}
+        for hidden in (False, True):
+            folder = _impl.reference_dir() / lab / ("hidden" if hidden else "")
+            for f in folder.glob("*.npz"):
+                if (hidden, f.stem) not in known:
+                    problems.append(RefProblem(lab, f.stem, f"stale reference file {f.name} has no case"))
+        log(f"  {lab}: {len(cases)} cases checked")
+    return problems

@@ -1,0 +1,166 @@
+"""Generate the student stubs ``labs/<lab>/`` from the reference solutions ``solutions/<lab>/``.
+
+In a solution file, each student part sits between two marker comments::
+
+    # BEGIN SOLUTION: Task 2 (even vertices): v' = (1 - n u) v + u * sum(neighbours)
+    ...reference code...
+    # END SOLUTION
+
+The stub gets, at the block's indentation, ``raise NotImplementedError("Task 2 (even vertices): ...")``.
+Optional prompt lines, commented out in the solution, are uncommented in the stub::
+
+    # BEGIN PROMPT
+    # odd = ...  # (e, 3) positions of the edge points
+    # END PROMPT
+
+Everything else (imports, docstrings, validation, given helpers) is copied unchanged.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from geomlib.grading import impl as _impl
+
+__all__ = ["make_stub", "build", "check", "solution_lines", "StubError"]
+
+_BEGIN = re.compile(r"^(?P<indent>\s*)# BEGIN SOLUTION(?::\s*(?P<task>.*?))?\s*$")
+_END = re.compile(r"^\s*# END SOLUTION\s*$")
+_PBEGIN = re.compile(r"^\s*# BEGIN PROMPT\s*$")
+_PEND = re.compile(r"^\s*# END PROMPT\s*$")
+
+
+class StubError(ValueError):
+    """Unbalanced or misplaced solution/prompt markers (the message names file and line)."""
+
+
+@dataclass
+class _Block:
+    start: int
+    end: int
+    indent: str
+    task: str
+
+
+def _scan(text: str, name: str) -> tuple[list[_Block], list[tuple[int, int]]]:
+    lines = text.splitlines()
+    blocks, prompts = [], []
+    open_block = open_prompt = None
+    for i, line in enumerate(lines, start=1):
+        m = _BEGIN.match(line)
+        if m:
+            if open_block or open_prompt:
+                raise StubError(f"{name}, line {i}: BEGIN SOLUTION inside another block")
+            open_block = _Block(i, -1, m.group("indent"), m.group("task") or "")
+        elif _END.match(line):
+            if not open_block:
+                raise StubError(f"{name}, line {i}: END SOLUTION without BEGIN SOLUTION")
+            open_block.end = i
+            blocks.append(open_block)
+            open_block = None
+        elif _PBEGIN.match(line):
+            if open_block or open_prompt:
+                raise StubError(f"{name}, line {i}: BEGIN PROMPT inside another block")
+            open_prompt = i
+        elif _PEND.match(line):
+            if not open_prompt:
+                raise StubError(f"{name}, line {i}: END PROMPT without BEGIN PROMPT")
+            prompts.append((open_prompt, i))
+            open_prompt = None
+    if open_block:
+        raise StubError(f"{name}, line {open_block.start}: BEGIN SOLUTION is never closed")
+    if open_prompt:
+        raise StubError(f"{name}, line {open_prompt}: BEGIN PROMPT is never closed")
+    return blocks, prompts
+
+
+def make_stub(text: str, name: str = "<solution>") -> str:
+    """The stub version of one solution file's text."""
+    blocks, prompts = _scan(text, name)
+    lines = text.splitlines()
+    out: list[str] = []
+    starts = {b.start: b for b in blocks}
+    in_prompt = {i for s, e in prompts for i in range(s, e + 1)}
+    i = 1
+    while i <= len(lines):
+        if i in starts:
+            b = starts[i]
+            task = b.task or "this part of the lab"
+            out.append(f"{b.indent}raise NotImplementedError({task!r})")
+            i = b.end + 1
+            continue
+        line = lines[i - 1]
+        if i in in_prompt:
+            if _PBEGIN.match(line) or _PEND.match(line):
+                i += 1
+                continue
+            out.append(re.sub(r"^(\s*)# ?", r"\1", line, count=1))
+        else:
+            out.append(line)
+        i += 1
+    return "\n".join(out) + ("\n" if text.endswith("\n") else "")
+
+
+def solution_lines(text: str, name: str = "<solution>") -> list[str]:
+    """The stripped lines inside solution blocks (what must never reach students)."""
+    blocks, _ = _scan(text, name)
+    lines = text.splitlines()
+    return [lines[k - 1].strip() for b in blocks for k in range(b.start + 1, b.end) if lines[k - 1].strip()]
+
+
+def _pairs(labs: list[str] | None):
+    root = _impl.course_root()
+    sol_root, lab_root = root / "solutions", root / "labs"
+    names = labs or sorted(p.name for p in sol_root.iterdir() if (p / "__init__.py").is_file())
+    for lab in names:
+        src = sol_root / lab
+        if not src.is_dir():
+            raise StubError(f"no solution folder {src}")
+        for f in sorted(src.rglob("*.py")):
+            if "__pycache__" in f.parts:
+                continue
+            yield lab, f, lab_root / lab / f.relative_to(src)
+
+
+def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
+    """Regenerate the ``.py`` files of ``labs/<lab>/`` from ``solutions/<lab>/``; returns files written.
+
+    Stub ``.py`` files with no solution counterpart are removed; other files in ``labs/`` (the
+    handout README, data) are left alone.
+    """
+    written = []
+    expected: dict[str, set[Path]] = {}
+    for lab, src, dst in _pairs(labs):
+        stub = make_stub(src.read_text(), str(src.relative_to(_impl.course_root())))
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        if not dst.is_file() or dst.read_text() != stub:
+            dst.write_text(stub)
+            log(f"  wrote {dst.relative_to(_impl.course_root())}")
+        written.append(dst)
+        expected.setdefault(lab, set()).add(dst)
+    for lab, files in expected.items():
+        for f in (_impl.course_root() / "labs" / lab).rglob("*.py"):
+            if f not in files and "__pycache__" not in f.parts:
+                f.unlink()
+                log(f"  removed {f.relative_to(_impl.course_root())} (no solution counterpart)")
+    return written
+
+
+def check(labs: list[str] | None = None) -> list[str]:
+    """Problems that make ``labs/`` stale: missing, differing or extra stub files."""
+    problems = []
+    seen: dict[str, set[Path]] = {}
+    for lab, src, dst in _pairs(labs):
+        seen.setdefault(lab, set()).add(dst)
+        rel = dst.relative_to(_impl.course_root())
+        if not dst.is_file():
+            problems.append(f"{rel} is missing")
+        elif dst.read_text() != make_stub(src.read_text(), str(src)):
+            problems.append(f"{rel} differs from the stub generated from {src.relative_to(_impl.course_root())}")
+    for lab, files in seen.items():
+        for f in (_impl.course_root() / "labs" / lab).rglob("*.py"):
+            if f not in files and "__pycache__" not in f.parts:
+                problems.append(f"{f.relative_to(_impl.course_root())} has no solution counterpart")
+    return problems

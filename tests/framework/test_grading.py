@@ -1,0 +1,170 @@
+"""The grading framework end to end on the sample course: scores, messages, hostile submissions."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import tempfile
+import textwrap
+from pathlib import Path
+
+from geomlib.grading.results import validate_results
+
+from .course import grade, run_geomlib
+
+GOOD_OPS = (Path(__file__).parent / "sample_course" / "solutions" / "sample" / "ops.py").read_text()
+
+
+def _by_name(results: dict) -> dict[str, dict]:
+    return {t["name"]: t for t in results["tests"]}
+
+
+def test_solutions_score_full_marks_and_results_follow_the_schema(sample_course):
+    r = grade(sample_course, "solutions")
+    validate_results(r)
+    assert r["score"] == sum(t["max_score"] for t in r["tests"]) == 7  # 6 public + 1 hidden point
+    assert all(t["status"] == "passed" for t in r["tests"])
+    vis = {t["name"]: t["visibility"] for t in r["tests"]}
+    assert vis['sample › scaling › scale_about_centroid on "tet-scale-half"'] == "hidden"
+    assert "total" in r["output"] and "scaling" in r["output"]
+
+
+def test_stubs_score_zero_without_a_single_error(sample_course):
+    r = grade(sample_course, "labs")
+    validate_results(r)
+    assert r["score"] == 0
+    pointed = [t for t in r["tests"] if t["max_score"] > 0]
+    assert pointed and all(t["status"] == "failed" for t in pointed)
+    for t in pointed:
+        assert "not implemented yet" in t["output"], t
+        assert "Traceback" not in t["output"]
+    assert "Task 1 (scaling)" in _by_name(r)['sample › scaling › scale_about_centroid on "tet-scale"']["output"]
+
+
+def _submission(tmp_path: Path, ops_source: str, extra_files: dict[str, str] | None = None) -> Path:
+    # A world-readable folder, so the sandbox may drop privileges to `nobody` and still read it.
+    tmp_path = Path(tempfile.mkdtemp(prefix="geomlib-sub-"))
+    tmp_path.chmod(0o755)
+    sub = tmp_path / "submission" / "sample"
+    sub.mkdir(parents=True)
+    (sub / "__init__.py").write_text("from .ops import *\n")
+    (sub / "ops.py").write_text(textwrap.dedent(ops_source))
+    for name, text in (extra_files or {}).items():
+        (sub / name).write_text(textwrap.dedent(text))
+    return tmp_path / "submission"
+
+
+def test_wrong_values_get_a_message_naming_the_row_values_and_count(sample_course, tmp_path):
+    wrong = GOOD_OPS.replace("return c + s * (V - c)", "return s * V  # forgot the centroid")
+    r = grade(sample_course, str(_submission(tmp_path, wrong)))
+    t = _by_name(r)['sample › scaling › scale_about_centroid on "tet-scale"']
+    assert t["status"] == "failed" and t["score"] == 0
+    assert t["output"].startswith('scale_about_centroid on "tet-scale": V[0] expected (')
+    assert "got (0, 0, 0)" in t["output"] and "of 4 rows off by more than" in t["output"]
+    assert "scale about the centroid, not the origin" in t["output"]  # the case's hint
+    # Partial credit: the midpoints part is untouched.
+    assert _by_name(r)['sample › midpoints › edge_midpoints on "tet-mid"']["status"] == "passed"
+
+
+def test_student_exception_shows_their_own_file_and_line(sample_course, tmp_path):
+    broken = GOOD_OPS.replace("M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])", "M = 0.5 * (V[E[:, 0]] + V[E[:, 1] + 100])")
+    r = grade(sample_course, str(_submission(tmp_path, broken)))
+    t = _by_name(r)['sample › midpoints › edge_midpoints on "tet-mid"']
+    assert "edge_midpoints raised IndexError at sample/ops.py, line" in t["output"]
+    assert "V[E[:, 1] + 100]" in t["output"]
+    assert "geomlib/grading" not in t["output"]
+
+
+def test_a_crash_costs_only_the_affected_tests(sample_course, tmp_path):
+    src = GOOD_OPS.replace("    c = V.mean(axis=0)\n", "    import ctypes; ctypes.string_at(0)\n")
+    r = grade(sample_course, str(_submission(tmp_path, src)))
+    validate_results(r)
+    by = _by_name(r)
+    assert "segmentation fault" in by['sample › scaling › scale_about_centroid on "tet-scale"']["output"]
+    assert by['sample › midpoints › edge_midpoints on "tet-mid"']["status"] == "passed"
+    assert r["score"] == 3  # the midpoints part (2 + 1) still scores
+
+
+def test_syntax_error_in_one_file_costs_only_its_functions(sample_course, tmp_path):
+    ops = GOOD_OPS.replace("def edge_midpoints(V, F):", "def edge_midpoints(V, F:")  # syntax error
+    # scale_about_centroid moved to its own, valid file.
+    start = GOOD_OPS.index("def scale_about_centroid")
+    end = GOOD_OPS.index("def edge_midpoints")
+    scale_src = GOOD_OPS[:end]
+    ops = ops[:start] + ops[end:]
+    sub = _submission(tmp_path, ops, {"scale.py": scale_src})
+    r = grade(sample_course, str(sub))
+    by = _by_name(r)
+    assert by['sample › scaling › scale_about_centroid on "tet-scale"']["status"] == "passed"
+    t = by['sample › midpoints › edge_midpoints on "tet-mid"']
+    assert t["status"] == "failed" and "ops.py line" in t["output"] and "syntax" in t["output"].lower()
+
+
+def test_missing_function_and_missing_lab(sample_course, tmp_path):
+    ops = GOOD_OPS.replace("def edge_midpoints(V, F):", "def edge_midpoint(V, F):")
+    r = grade(sample_course, str(_submission(tmp_path, ops)))
+    t = _by_name(r)['sample › midpoints › edge_midpoints on "tet-mid"']
+    assert "could not find a function named 'edge_midpoints'" in t["output"]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    r = grade(sample_course, str(empty))
+    assert r["score"] == 0 and all("missing from the submission" in t["output"] for t in r["tests"] if t["max_score"])
+
+
+def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_course, tmp_path):
+    results = sample_course / "results" / "submission.json"
+    hidden = next((sample_course / "tests" / "reference" / "sample" / "hidden").glob("*.npz"))
+    src = GOOD_OPS.replace(
+        "    c = V.mean(axis=0)\n",
+        f"""    import json, numpy as np
+    try:
+        open({str(results)!r}, "w").write(json.dumps({{"score": 999, "tests": []}}))
+    except OSError:
+        pass
+    try:
+        np.load({str(hidden)!r})
+        raise RuntimeError("LEAK: read a hidden reference")
+    except PermissionError:
+        pass
+    c = V.mean(axis=0)
+""",
+    )
+    hidden.parent.chmod(0o700)
+    try:
+        r = grade(sample_course, str(_submission(tmp_path, src)), env={"GEOMLIB_SANDBOX_USER": "nobody"})
+    finally:
+        hidden.parent.chmod(0o755)
+    assert r["score"] == 7
+    assert json.loads(results.read_text())["score"] == 7
+
+
+def test_plain_pytest_shows_the_message_not_a_traceback(sample_course, tmp_path):
+    import subprocess
+    import sys
+
+    wrong = GOOD_OPS.replace("return c + s * (V - c)", "return s * V")
+    sub = _submission(tmp_path, wrong)
+    p = subprocess.run(
+        [sys.executable, "-m", "pytest", "tests/graded/sample", f"--impl={sub}", "-p", "no:cacheprovider", "-q"],
+        cwd=sample_course,
+        capture_output=True,
+        text=True,
+        env={**__import__("os").environ, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"},
+    )
+    out = p.stdout
+    assert p.returncode == 1
+    assert 'scale_about_centroid on "tet-scale": V[0] expected' in out
+    assert "sandbox.py" not in out and "Traceback" not in out
+    assert "graded score" in out
+
+
+def test_refs_check_detects_a_changed_solution(sample_course, tmp_path):
+    copy = tmp_path / "course"
+    shutil.copytree(sample_course, copy)
+    assert run_geomlib(copy, "refs", "check").returncode == 0
+    ops = copy / "solutions" / "sample" / "ops.py"
+    ops.write_text(
+        ops.read_text().replace("M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])", "M = 0.5 * (V[E[:, 0]] + V[E[:, 1]]) + 1e-3")
+    )
+    p = run_geomlib(copy, "refs", "check", check=False)
+    assert p.returncode == 1 and "tet-mid" in p.stdout and "no longer reproduces" in p.stdout

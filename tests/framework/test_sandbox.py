@@ -1,0 +1,161 @@
+"""The sandbox on planted hostile submissions: each behaviour costs one call, with a clear message."""
+
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from geomlib.grading import wire
+from geomlib.grading.errors import (
+    BadReturn,
+    GradingFailure,
+    NotImplementedYet,
+    StudentCrash,
+    StudentError,
+    StudentTimeout,
+)
+from geomlib.grading.sandbox import LabProxy
+
+PLANTED = """
+import ctypes, os, sys, time
+import numpy as np
+
+def good(x):
+    return x * 2, {"a": np.arange(3)}, [1.5, None, "s"], np.float64(2.5)
+
+def infinite_loop():
+    while True:
+        pass
+
+def segfault():
+    ctypes.string_at(0)
+
+def calls_sys_exit():
+    sys.exit(3)
+
+def calls_os_exit():
+    os._exit(0)
+
+def huge_allocation():
+    return np.ones(6 * 10**8)  # 4.8 GB, over the 1 GiB limit used here
+
+def prints_garbage():
+    print("garbage" * 1000)
+    sys.stderr.write("more garbage")
+    return 7
+
+def stub():
+    raise NotImplementedError("Task 1 (odd vertices): 3/8 (a + b) + 1/8 (c + d)")
+
+def index_error(i):
+    values = [1, 2]
+    return values[i]
+
+def returns_object():
+    return object()
+
+class Exploit:
+    def __reduce__(self):
+        return (os.system, ("touch /tmp/geomlib-pwned",))
+
+def returns_exploit():
+    return Exploit()
+
+def returns_sparse():
+    import scipy.sparse as sp
+    return sp.eye(3, format="csr") * 2.0
+
+def deep_recursion(n=0):
+    return deep_recursion(n + 1)
+
+def mutates_global_state():
+    np.set_printoptions(precision=1)
+    sys.modules["numpy"].pi = 3
+    return 1
+"""
+
+
+@pytest.fixture(scope="module")
+def planted(tmp_path_factory) -> LabProxy:
+    d = tmp_path_factory.mktemp("planted") / "bad"
+    d.mkdir()
+    (d / "__init__.py").write_text("from .ops import *\nfrom .broken import *\n")
+    (d / "ops.py").write_text(textwrap.dedent(PLANTED))
+    (d / "broken.py").write_text("def broken(:\n    pass\n")
+    return LabProxy("bad", d, timeout=3, memory_mb=1024)
+
+
+def test_good_call_round_trips_values(planted):
+    x, d, lst, f = planted.good(np.arange(4.0))
+    np.testing.assert_array_equal(x, np.arange(4.0) * 2)
+    np.testing.assert_array_equal(d["a"], np.arange(3))
+    assert lst == [1.5, None, "s"] and f == 2.5
+
+
+def test_sparse_results_come_back_as_sparse(planted):
+    S = planted.returns_sparse()
+    np.testing.assert_array_equal(S.toarray(), 2 * np.eye(3))
+
+
+@pytest.mark.parametrize(
+    "function, error, words",
+    [
+        ("infinite_loop", StudentTimeout, "did not finish within 3 s"),
+        ("segfault", StudentCrash, "segmentation fault"),
+        ("calls_sys_exit", StudentCrash, "called sys.exit(3)"),
+        ("calls_os_exit", StudentCrash, "without returning a result"),
+        ("huge_allocation", StudentCrash, "ran out of memory (limit 1024 MiB)"),
+        ("stub", NotImplementedYet, "stub: not implemented yet (Task 1 (odd vertices)"),
+        ("returns_object", BadReturn, "returned an object of type builtins.object"),
+        ("returns_exploit", BadReturn, "which the grader cannot read"),
+        ("deep_recursion", StudentError, "RecursionError"),
+        ("broken", StudentError, "broken.py line 1: invalid syntax"),
+        ("no_such_function", StudentError, "could not find a function named 'no_such_function'"),
+    ],
+)
+def test_hostile_behaviour_costs_one_call_with_a_clear_message(planted, function, error, words):
+    with pytest.raises(error) as e:
+        getattr(planted, function)()
+    assert words in str(e.value)
+    assert not Path("/tmp/geomlib-pwned").exists()
+
+
+def test_student_exception_names_their_file_line_and_code(planted):
+    with pytest.raises(StudentError) as e:
+        planted.index_error(5)
+    msg = str(e.value)
+    assert msg.startswith("index_error raised IndexError at bad/ops.py, line ")
+    assert "`return values[i]`" in msg and "list index out of range" in msg
+    assert e.value.exc_mro[:2] == ["IndexError", "LookupError"]
+
+
+def test_printing_does_not_disturb_the_result_or_the_grader(planted, capfd):
+    assert planted.prints_garbage() == 7
+    out, err = capfd.readouterr()
+    assert "garbage" not in out and "garbage" not in err
+
+
+def test_a_call_cannot_change_the_graders_state(planted):
+    assert planted.mutates_global_state() == 1
+    assert np.pi != 3
+    assert np.get_printoptions()["precision"] == 8
+
+
+def test_the_lab_keeps_working_after_every_failure(planted):
+    for f in ("segfault", "calls_os_exit", "infinite_loop"):
+        with pytest.raises(GradingFailure):
+            getattr(planted, f)()
+        assert planted.good(1)[0] == 2
+
+
+def test_wire_refuses_what_it_cannot_represent_safely():
+    with pytest.raises(wire.WireError, match="dtype object"):
+        wire.encode(np.array([object()]))
+    with pytest.raises(wire.WireError, match="non-string keys"):
+        wire.encode({1: 2})
+    data = wire.encode((np.inf, -np.nan if False else 1, {"k": np.zeros((2, 2), np.float32)}))
+    a, b, c = wire.decode(data)
+    assert a == np.inf and b == 1 and c["k"].dtype == np.float32

@@ -1,0 +1,1 @@
+"""Graded tests: one folder per lab, run against any implementation (--impl)."""
