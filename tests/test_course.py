@@ -1,0 +1,82 @@
+"""Course-wide invariants: stubs are fresh, references reproduce, stubs score zero, lint is clean."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading import impl, stubs
+from geomlib.grading.results import validate_results
+
+ROOT = Path(__file__).resolve().parents[1]
+LABS = (
+    [p.name for p in sorted((ROOT / "solutions").iterdir()) if (p / "__init__.py").is_file()]
+    if (ROOT / "solutions").is_dir()
+    else []
+)
+
+
+def _cli(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+    env = {**os.environ, "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
+    env.pop("GEOMLIB_ROOT", None)
+    return subprocess.run(
+        [sys.executable, "-m", "geomlib.cli", *args], cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout
+    )
+
+
+def test_labs_are_generated_from_solutions():
+    problems = stubs.check()
+    assert not problems, "labs/ is stale, run `geomlib stubs build`:\n" + "\n".join(problems)
+
+
+@pytest.mark.slow
+def test_solutions_reproduce_the_stored_references():
+    p = _cli("refs", "check")
+    assert p.returncode == 0, p.stdout[-4000:] + p.stderr[-2000:]
+
+
+@pytest.mark.slow
+def test_stubs_score_zero_without_a_single_error(tmp_path):
+    results = tmp_path / "results.json"
+    p = _cli("grade", "--impl", "labs", "--results", str(results), "--feedback", str(tmp_path / "fb"))
+    assert p.returncode == 0, p.stderr[-3000:]
+    r = json.loads(results.read_text())
+    validate_results(r)
+    assert r["score"] == 0, [t["name"] for t in r["tests"] if t["score"]]
+    pointed = [t for t in r["tests"] if t["max_score"] > 0]
+    assert pointed
+    bad = [t for t in pointed if "not implemented yet" not in t["output"]]
+    assert not bad, "stub tests that fail for another reason than 'not implemented yet':\n" + "\n".join(
+        f"{t['name']}: {t['output'][:300]}" for t in bad
+    )
+
+
+def test_every_lab_is_complete():
+    for lab in LABS:
+        for rel in (
+            f"labs/{lab}/__init__.py",
+            f"labs/{lab}/README.md",
+            f"solutions/{lab}/figures.py",
+            f"tests/graded/{lab}/__init__.py",
+            f"tests/graded/{lab}/cases.py",
+            f"tests/solutions/test_{lab}.py",
+            f"notebooks/{lab}.ipynb",
+            f"bench/{lab}.py",
+        ):
+            assert (ROOT / rel).is_file(), f"lab {lab!r} lacks {rel}"
+
+
+def test_reference_data_is_small():
+    total = sum(p.stat().st_size for p in impl.reference_dir().rglob("*") if p.is_file())
+    assert total <= 25 * 2**20, f"tests/reference holds {total / 2**20:.1f} MiB (limit 25 MiB)"
+
+
+def test_ruff_lint_and_format():
+    for args in (["check", "."], ["format", "--check", "."]):
+        p = subprocess.run([sys.executable, "-m", "ruff", *args], cwd=ROOT, capture_output=True, text=True)
+        assert p.returncode == 0, f"ruff {' '.join(args)}:\n{p.stdout[-3000:]}{p.stderr[-1000:]}"
