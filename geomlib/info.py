@@ -14,7 +14,7 @@ def summary(V: np.ndarray, faces) -> dict:
     idx, off = topology.to_ragged(faces)
     sizes = np.diff(off)
     kinds = {int(k): int(c) for k, c in zip(*np.unique(sizes, return_counts=True), strict=True)}
-    used = np.unique(idx)
+    used = topology.unique_ints(idx)
     edge_manifold = topology.is_edge_manifold((idx, off))
     fans = topology.vertex_fan_counts(idx, off, len(V))
     vertex_manifold = bool((fans[used] == 1).all())

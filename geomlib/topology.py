@@ -19,6 +19,7 @@ __all__ = [
     "to_ragged",
     "face_sizes",
     "halfedges",
+    "unique_ints",
     "unique_rows",
     "unique_edges",
     "edge_faces",
@@ -68,18 +69,39 @@ def halfedges(faces, offsets: np.ndarray | None = None) -> np.ndarray:
     return np.stack([idx, idx[nxt]], axis=1)
 
 
+def unique_ints(keys: np.ndarray, return_inverse: bool = False, return_counts: bool = False):
+    """Sorted unique values of an int array, by one argsort.
+
+    ``np.unique`` on int64 without ``return_*`` takes a hash-based path in NumPy 2.3+ that measured
+    ~70x slower than sorting here (0.8 s vs 0.012 s for 260k keys), so topology uses this instead.
+    """
+    keys = np.asarray(keys).ravel()
+    order = np.argsort(keys, kind="stable")
+    sk = keys[order]
+    start = np.r_[True, sk[1:] != sk[:-1]] if len(sk) else np.zeros(0, bool)
+    u = sk[start]
+    if not (return_inverse or return_counts):
+        return u
+    out = [u]
+    if return_inverse:
+        inv = np.empty(len(keys), dtype=np.int64)
+        inv[order] = np.cumsum(start) - 1
+        out.append(inv)
+    if return_counts:
+        out.append(np.diff(np.r_[np.flatnonzero(start), len(sk)]))
+    return tuple(out)
+
+
 def unique_rows(E: np.ndarray, return_inverse: bool = False, return_counts: bool = False):
     """``np.unique(E, axis=0)`` for non-negative int pairs ``(k, 2)``, via int64 keys (much faster)."""
     E = np.asarray(E, dtype=np.int64)
     n = int(E.max()) + 1 if E.size else 1
     keys = E[:, 0] * n + E[:, 1]
-    out = np.unique(keys, return_inverse=return_inverse, return_counts=return_counts)
+    out = unique_ints(keys, return_inverse=return_inverse, return_counts=return_counts)
     if not (return_inverse or return_counts):
         return np.stack([out // n, out % n], axis=1)
     u = out[0]
-    res = [np.stack([u // n, u % n], axis=1)]
-    res += [np.asarray(o).ravel() for o in out[1:]]
-    return tuple(res)
+    return (np.stack([u // n, u % n], axis=1), *out[1:])
 
 
 def unique_edges(faces) -> np.ndarray:
@@ -136,7 +158,7 @@ def boundary_loops(faces) -> list[np.ndarray]:
     B = boundary_edges(faces)
     if len(B) == 0:
         return []
-    starts, counts = np.unique(B[:, 0], return_counts=True)
+    starts, counts = unique_ints(B[:, 0], return_counts=True)
     if (counts > 1).any():
         raise MeshError(
             f"boundary vertex {int(starts[np.argmax(counts)])} has {counts.max()} outgoing boundary edges (non-manifold boundary)"
@@ -185,40 +207,38 @@ def vertex_fan_counts(faces, offsets: np.ndarray | None = None, n_vertices: int 
     """
     idx, off = (faces, offsets) if offsets is not None else to_ragged(faces)
     n = int(n_vertices if n_vertices is not None else (idx.max() + 1 if len(idx) else 0))
-    lens = np.diff(off)
-    m = len(lens)
-    # Corner c = (vertex v, face f). Two corners at the same vertex are linked when their faces
-    # share an edge through v. Count components of that corner graph per vertex.
-    corner_face = np.repeat(np.arange(m), lens)
-    pos = np.arange(len(idx)) - np.repeat(off[:-1], lens)
-    L = np.repeat(lens, lens)
-    nxt = np.repeat(off[:-1], lens) + (pos + 1) % L
-    prv = np.repeat(off[:-1], lens) + (pos - 1) % L
-    # Directed edge (v -> w) in face f is seen from corner v (outgoing) and corner w (incoming).
-    v_out, w_out = idx, idx[nxt]
-    # Key each undirected edge incident to v by (v, other endpoint); corners sharing a key are linked.
-    keys_v = np.r_[idx, idx]
-    keys_o = np.r_[idx[nxt], idx[prv]]
-    corners = np.r_[np.arange(len(idx)), np.arange(len(idx))]
-    order = np.lexsort((keys_o, keys_v))
-    kv, ko, cc = keys_v[order], keys_o[order], corners[order]
-    same = (kv[1:] == kv[:-1]) & (ko[1:] == ko[:-1])
-    a, b = cc[:-1][same], cc[1:][same]
     N = len(idx)
-    G = sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(N, N))
-    _, labels = connected_components(G, directed=False)
-    del v_out, w_out, corner_face
-    fans = np.zeros(n, dtype=np.int64)
-    if N:
-        pairs = unique_rows(np.stack([idx, labels], axis=1))
-        np.add.at(fans, pairs[:, 0], 1)
-    return fans
+    if N == 0:
+        return np.zeros(n, dtype=np.int64)
+    lens = np.diff(off)
+    base = np.repeat(off[:-1], lens)
+    pos = np.arange(N) - base
+    nxt = base + (pos + 1) % np.repeat(lens, lens)
+    # Half-edge h runs from corner h (vertex a) to corner nxt[h] (vertex b). Two faces sharing the
+    # undirected edge {a, b} link their corners at a and their corners at b: corners of one vertex
+    # that end up connected form one fan.
+    a, b = idx, idx[nxt]
+    key = np.minimum(a, b) * n + np.maximum(a, b)
+    order = np.argsort(key, kind="stable")
+    k = key[order]
+    same = np.flatnonzero(k[1:] == k[:-1])
+    h1, h2 = order[same], order[same + 1]
+    lo1 = np.where(a[h1] < b[h1], h1, nxt[h1])  # corner at the smaller endpoint, in each face
+    hi1 = np.where(a[h1] < b[h1], nxt[h1], h1)
+    lo2 = np.where(a[h2] < b[h2], h2, nxt[h2])
+    hi2 = np.where(a[h2] < b[h2], nxt[h2], h2)
+    rows, cols = np.r_[lo1, hi1], np.r_[lo2, hi2]
+    G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(N, N))
+    ncomp, labels = connected_components(G, directed=False)
+    first = np.full(ncomp, -1, dtype=np.int64)
+    first[labels[::-1]] = np.arange(N)[::-1]  # one corner per component
+    return np.bincount(idx[first], minlength=n).astype(np.int64)
 
 
 def euler_characteristic(faces, n_vertices: int | None = None) -> int:
     """*Polygons*: χ = V − E + F, counting only vertices that some face uses (unless ``n_vertices``)."""
     idx, off = to_ragged(faces)
-    nv = int(n_vertices) if n_vertices is not None else len(np.unique(idx))
+    nv = int(n_vertices) if n_vertices is not None else len(unique_ints(idx))
     return nv - len(unique_edges((idx, off))) + (len(off) - 1)
 
 

@@ -153,12 +153,14 @@ def as_faces(
             f = int(np.flatnonzero(rep)[0])
             raise MeshError(f"{p}{name}: face {f} {_fmt_row(F[f])} is degenerate (repeats a vertex)")
     if not allow_duplicate:
-        _, first, counts = np.unique(S, axis=0, return_index=True, return_counts=True)
-        if (counts > 1).any():
-            key = S[first[np.flatnonzero(counts > 1)[0]]]
-            dup = np.flatnonzero((S == key).all(axis=1))
+        order = np.lexsort(S.T[::-1])
+        Ss = S[order]
+        dup = np.flatnonzero((Ss[1:] == Ss[:-1]).all(axis=1))
+        if len(dup):
+            pair = np.sort(order[[dup[0], dup[0] + 1]])
             raise MeshError(
-                f"{p}{name}: faces {int(dup[0])} and {int(dup[1])} are duplicates (both use vertices {_fmt_row(key)})"
+                f"{p}{name}: faces {int(pair[0])} and {int(pair[1])} are duplicates "
+                f"(both use vertices {_fmt_row(S[pair[0]])})"
             )
     return F
 
