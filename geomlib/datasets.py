@@ -21,7 +21,7 @@ from typing import NamedTuple
 import numpy as np
 
 from geomlib import topology
-from geomlib.validate import MeshError, as_array, as_vertices, check_choice, check_float, check_int
+from geomlib.validate import MeshError, as_array, as_vertices, check_choice, check_float, check_int, check_mesh
 
 __all__ = [
     "icosphere",
@@ -587,15 +587,21 @@ def uv_grid(n: int = 16, size: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.
 _PYVISTA_MESHES = ("airplane", "ant", "nut")
 
 
-def pyvista_mesh(name: str) -> tuple[np.ndarray, np.ndarray]:
+def pyvista_mesh(name: str, manifold: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """A triangle mesh from the PLY files inside the pyvista package (no download).
 
     The file is read with ``pyvista.read``, triangulated, and vertices with identical positions
     are welded; faces that become degenerate or duplicate are dropped, and so are unused vertices.
+    The airplane is not manifold as shipped (a stray triangle on a wing edge makes an edge with
+    three faces, and six vertices are pinch points where separate parts touch):
+    ``manifold=True`` drops components of fewer than three faces and gives each fan of faces
+    around a pinch vertex its own copy of the vertex (see :func:`split_nonmanifold_vertices`).
 
     Parameters
     ----------
     name : {"airplane", "ant", "nut"}
+    manifold : bool
+        Repair as described above (a no-op for the ant and the nut, which are manifold).
 
     Returns
     -------
@@ -622,7 +628,51 @@ def pyvista_mesh(name: str) -> tuple[np.ndarray, np.ndarray]:
     used = np.flatnonzero(np.bincount(F.ravel(), minlength=len(V)))
     remap = np.full(len(V), -1, np.int64)
     remap[used] = np.arange(len(used))
-    return np.ascontiguousarray(V[used]), remap[F]
+    V, F = np.ascontiguousarray(V[used]), remap[F]
+    if manifold:
+        _, comp = topology.connected_components_faces(F)
+        F = F[np.bincount(comp)[comp] >= 3]
+        V, F = split_nonmanifold_vertices(V, F)
+    return V, F
+
+
+def split_nonmanifold_vertices(V, F) -> tuple[np.ndarray, np.ndarray]:
+    """Give every fan of faces around a vertex its own copy of that vertex.
+
+    A consistently oriented, edge-manifold triangle mesh whose vertices are pinch points (several
+    fans meeting at one vertex) becomes vertex-manifold; positions are unchanged, so the surface
+    is the same. Unreferenced vertices are dropped.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+    F : (m, 3) int
+
+    Returns
+    -------
+    V2 : (n2, 3) float64
+        ``n2 >= n`` (one row per fan).
+    F2 : (m, 3) int64
+        The same faces, re-indexed.
+    """
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
+    V, F = check_mesh(V, F, where="split_nonmanifold_vertices")
+    h, n = F.size, len(V)
+    nxt = (np.arange(h).reshape(-1, 3)[:, [1, 2, 0]]).ravel()
+    a, b = F.ravel(), F.ravel()[nxt]
+    key = a * n + b
+    order = np.argsort(key)
+    pos = np.minimum(np.searchsorted(key[order], b * n + a), h - 1)
+    twin = np.where(key[order][pos] == b * n + a, order[pos], -1)
+    j = np.flatnonzero(twin >= 0)
+    # Corner j and the corner of the same vertex across its outgoing edge lie in the same fan.
+    G = sp.coo_matrix((np.ones(len(j)), (j, nxt[twin[j]])), shape=(h, h))
+    k, label = connected_components(G, directed=False)
+    owner = np.empty(k, np.int64)
+    owner[label] = a
+    return V[owner], label.reshape(-1, 3).astype(np.int64)
 
 
 # --------------------------------------------------------------------------------------------

@@ -165,36 +165,65 @@ def as_faces(
     return F
 
 
-def check_manifold(F: np.ndarray, n_vertices: int, *, name: str = "F", where: str | None = None) -> None:
+def check_manifold(F, n_vertices: int, *, name: str = "F", where: str | None = None) -> None:
     """Raise unless the triangle or polygon mesh is edge- and vertex-manifold and consistently oriented.
 
     ``F`` is an ``(m, k)`` int array or a ``(indices, offsets)`` ragged pair (see :func:`as_polygons`).
+
+    Notes
+    -----
+    One argsort of the undirected half-edge keys ``min * n + max`` answers all three questions:
+    group sizes (edges in more than two faces), directions within a group (orientation), and the
+    corner links across interior edges whose connected components are the fans around each vertex.
     """
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
     from geomlib import topology
 
     p = _prefix(where)
     idx, off = topology.to_ragged(F)
-    he = topology.halfedges(idx, off)  # (h, 2) directed edges, face of each in he_face
-    he_face = np.repeat(np.arange(len(off) - 1), np.diff(off))
-    und = np.sort(he, axis=1)
-    keys, inv, counts = topology.unique_rows(und, return_inverse=True, return_counts=True)
+    h, n = len(idx), int(n_vertices)
+    if h == 0:
+        return
+    lens = np.diff(off)
+    he_face = np.repeat(np.arange(len(lens)), lens)
+    base = np.repeat(off[:-1], lens)
+    nxt = base + (np.arange(h) - base + 1) % lens[he_face]
+    b = idx[nxt]
+    keys = np.minimum(idx, b) * n + np.maximum(idx, b)
+    order = np.argsort(keys, kind="stable")
+    sk = keys[order]
+    new = np.r_[True, sk[1:] != sk[:-1]]
+    first = np.flatnonzero(new)
+    counts = np.diff(np.r_[first, h])
     if (counts > 2).any():
-        e = int(np.flatnonzero(counts > 2)[0])
-        faces = sorted(set(he_face[inv == e].tolist()))
+        i = int(np.flatnonzero(counts > 2)[0])
+        hs = order[first[i] : first[i] + counts[i]]
+        faces = tuple(sorted(set(he_face[hs].tolist())))
+        u, v = int(sk[first[i]] // n), int(sk[first[i]] % n)
         raise MeshError(
-            f"{p}{name}: edge ({keys[e][0]}, {keys[e][1]}) is shared by {counts[e]} faces {tuple(faces)}; "
+            f"{p}{name}: edge ({u}, {v}) is shared by {counts[i]} faces {faces}; "
             f"this needs an edge-manifold mesh (each edge in at most 2 faces)"
         )
-    # Same directed edge twice = neighbouring faces with opposite orientation.
-    dkeys, dcounts = topology.unique_rows(he, return_counts=True)
-    if (dcounts > 1).any():
-        d = dkeys[np.flatnonzero(dcounts > 1)[0]]
-        faces = he_face[(he == d).all(axis=1)]
+    pair = first[counts == 2]
+    h0, h1 = order[pair], order[pair + 1]
+    same_dir = idx[h0] == idx[h1]
+    if same_dir.any():
+        j = int(np.flatnonzero(same_dir)[0])
+        f0, f1 = sorted((int(he_face[h0[j]]), int(he_face[h1[j]])))
         raise MeshError(
-            f"{p}{name}: faces {int(faces[0])} and {int(faces[1])} both traverse edge ({d[0]}, {d[1]}) "
-            f"in the same direction; the mesh is not consistently oriented"
+            f"{p}{name}: faces {f0} and {f1} both traverse edge ({idx[h0[j]]}, {b[h0[j]]}) in the same direction; "
+            f"the mesh is not consistently oriented (or the two faces are duplicates)"
         )
-    fans = topology.vertex_fan_counts(idx, off, n_vertices)
+    # Across an interior edge a->b (face f, half-edge h0) / b->a (face g, h1): the corners at a are
+    # h0 and nxt[h1], the corners at b are nxt[h0] and h1. Linked corners belong to one fan.
+    rows, cols = np.r_[h0, nxt[h0]], np.r_[nxt[h1], h1]
+    G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(h, h))
+    ncomp, labels = connected_components(G, directed=False)
+    owner = np.empty(ncomp, dtype=np.int64)
+    owner[labels] = idx
+    fans = np.bincount(owner, minlength=n)
     if (fans > 1).any():
         v = int(np.flatnonzero(fans > 1)[0])
         raise MeshError(

@@ -1,0 +1,258 @@
+"""Figures of the subdivision lab, rendered with the lab's own functions.
+
+``make_figures(out_dir)`` writes the PNGs and returns :class:`geomlib.plot.Figure` records. The
+file is copied into ``labs/subdivision/`` with the stubs, so there it renders *your* results:
+run ``make_figures`` once your functions work and compare with ``docs/figures/subdivision/``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geomlib import datasets, topology
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
+from geomlib.render import camera_pose, render, render_polygons
+
+LAB = "subdivision"
+CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the difference vanishes
+
+
+def _ss(quick: bool) -> int:
+    """Supersampling factor: anti-aliased figures, faster quick ones."""
+    return 1 if quick else 2
+
+
+def _functions(lab):
+    """``(loop_subdivide, catmull_clark)`` of the given lab module, or of this package."""
+    if lab is not None:
+        return lab.loop_subdivide, lab.catmull_clark
+    from .catmullclark import catmull_clark
+    from .loop import loop_subdivide
+
+    return loop_subdivide, catmull_clark
+
+
+def airplane() -> tuple[np.ndarray, np.ndarray]:
+    """The pyvista airplane made manifold (stray triangle dropped, 6 pinch vertices split)."""
+    return datasets.pyvista_mesh("airplane", manifold=True)
+
+
+def _extraordinary(faces, n: int) -> np.ndarray:
+    """Vertices of valence != 4 (interior vertices only; boundary ones are not counted)."""
+    val = topology.valence(faces, n)
+    bnd = np.zeros(n, bool)
+    bnd[topology.boundary_edges(faces).ravel()] = True
+    return np.flatnonzero((val != 4) & ~bnd)
+
+
+def _levels(subdivide, V, F, levels: int, **kw) -> list[tuple[np.ndarray, np.ndarray]]:
+    out = [(np.asarray(V, float), F)]
+    for _ in range(levels):  # one level at a time, so every level can be drawn
+        V, F = subdivide(V, F, 1, **kw)
+        out.append((np.asarray(V), np.asarray(F)))
+    return out
+
+
+def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, _ = _functions(lab)
+    size = (240, 200) if quick else (330, 270)
+    L = 2 if quick else 3
+    row1 = _levels(loop_subdivide, *datasets.icosphere(0), L, weights="warren")
+    row2 = _levels(loop_subdivide, *airplane(), L, weights="warren")
+    images, captions = [], []
+    for name, row in (("icosahedron", row1), ("airplane", row2)):
+        pose = camera_pose(row[0][0], "three_quarter", size=size, zoom=1.05)  # one camera per row
+        for k, (V, F) in enumerate(row):
+            dense = len(F) > 1500
+            images.append(
+                render(
+                    V,
+                    F,
+                    camera=pose,
+                    size=size,
+                    supersample=_ss(quick),
+                    wireframe=True,
+                    wire_opacity=0.25 if dense else 0.9,
+                    smooth=k > 0,
+                )
+            )
+            captions.append(f"{name}, level {k}: {len(F):,} faces")
+    img = panels(images, captions, ncols=L + 1, title=f"Loop subdivision, Warren weights (levels 0-{L})")
+    path = save_png(out / "loop_levels.png", img)
+    return Figure(
+        path,
+        "Loop subdivision of the icosahedron (top) and of the open airplane mesh (bottom): every level splits each "
+        "triangle into four and moves all vertices by fixed weights. The icosahedron shrinks toward a smooth limit "
+        "surface inside its control mesh; the airplane's boundary edges follow the cubic B-spline curve rule.",
+        LAB,
+    )
+
+
+def fig_weights(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, _ = _functions(lab)
+    size = (260, 220) if quick else (360, 300)
+    V, F = datasets.pyvista_mesh("ant")
+    L = 1 if quick else 2
+    Vw, Fw = loop_subdivide(V, F, L, "warren")
+    Vl, _ = loop_subdivide(V, F, L, "loop")
+    diag = float(np.linalg.norm(V.max(0) - V.min(0)))
+    d = np.linalg.norm(np.asarray(Vw) - np.asarray(Vl), axis=1) / diag
+    hi = float(d.max())
+    pose = camera_pose(V, "three_quarter", size=size)
+    imgs = [
+        render(Vw, Fw, camera=pose, size=size, supersample=_ss(quick)),
+        render(Vl, Fw, camera=pose, size=size, supersample=_ss(quick)),
+        render(Vw, Fw, camera=pose, size=size, supersample=_ss(quick), colors=heat_colors(d, 0.0, hi, cmap=CMAP)),
+        colorbar(0.0, hi, CMAP, label="|warren - loop| / diag", height=size[1] - 20),
+    ]
+    caps = [
+        f'weights="warren", {L} levels',
+        f'weights="loop", {L} levels',
+        "distance between the two",
+        "",
+    ]
+    img = panels(imgs, caps, ncols=4, title="Warren's weights vs Loop's beta on the pyvista ant")
+    path = save_png(out / "warren_vs_loop.png", img)
+    return Figure(
+        path,
+        "The same mesh subdivided with Warren's simplified weights (u = 3/(8n), as in igl.loop) and with Loop's "
+        f"original beta(n) (as in trimesh and VTK). The rules agree at valence 3 and 6 only; the largest difference "
+        f"here is {hi:.1e} of the bounding-box diagonal, at vertices of unusual valence.",
+        LAB,
+    )
+
+
+def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
+    _, catmull_clark = _functions(lab)
+    size = (240, 200) if quick else (330, 270)
+    L = 2 if quick else 3
+    images, captions = [], []
+    for name, (V0, faces0) in (("cube", datasets.quad_cube()), ("polygon cage", datasets.polygon_cage())):
+        pose = camera_pose(V0, "three_quarter", size=size, zoom=1.05)
+        V, faces = V0, faces0
+        for k in range(L + 1):
+            if k:
+                V, faces = catmull_clark(V, faces, 1)
+            ext = _extraordinary(faces, len(V))
+            images.append(
+                render_polygons(
+                    V, faces, camera=pose, size=size, supersample=_ss(quick), wireframe=True, wire_opacity=0.8 if k < 3 else 0.35,
+                    highlight_points=ext, point_radius=4.0, smooth=k > 0, crease_deg=None,
+                )
+            )  # fmt: skip
+            captions.append(f"{name}, level {k}: {len(faces):,} faces, {len(ext)} extraordinary")
+    img = panels(images, captions, ncols=L + 1, title="Catmull-Clark subdivision (red: extraordinary vertices)")
+    path = save_png(out / "catmull_clark_levels.png", img)
+    return Figure(
+        path,
+        "Catmull-Clark subdivision of a cube and of a cage of pentagon, quads and triangles. After one level every "
+        "face is a quad; the extraordinary vertices (valence != 4, red) are the old corners of valence 3 or 5 and "
+        "the face points of non-quad faces, and their number stays the same at every later level.",
+        LAB,
+    )
+
+
+def fig_boundary(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, catmull_clark = _functions(lab)
+    import trimesh
+
+    size = (260, 220) if quick else (340, 280)
+    V, F = datasets.height_field(n=5, seed=3, amplitude=0.25)
+    L = 2
+    V2, F2 = loop_subdivide(V, F, L, "loop")
+    Vt, Ft = trimesh.remesh.subdivide_loop(V, F, iterations=L)
+    # same vertex order in both (old vertices first, then edges): match by position to be safe
+    from scipy.spatial import cKDTree
+
+    d = cKDTree(np.asarray(V2)).query(np.asarray(Vt))[0]
+    pose = camera_pose(V, "three_quarter", size=size)
+    imgs = [
+        render(V, F, camera=pose, size=size, supersample=_ss(quick), wireframe=True, smooth=False),
+        render(V2, F2, camera=pose, size=size, supersample=_ss(quick), wireframe=True, wire_opacity=0.4),
+        render(
+            Vt,
+            Ft,
+            camera=pose,
+            size=size,
+            supersample=_ss(quick),
+            colors=heat_colors(d, 0.0, max(float(d.max()), 1e-12), cmap=CMAP),
+        ),
+        colorbar(0.0, float(d.max()), CMAP, label="distance to ours", height=size[1] - 20),
+    ]
+    caps = [
+        "open height field (control mesh)",
+        f"loop_subdivide, {L} levels (same as igl.loop and VTK)",
+        f"trimesh.subdivide_loop, {L} levels",
+        "",
+    ]
+    img = panels(imgs, caps, ncols=4, title="Boundary rules: midpoints and 1/8, 3/4, 1/8 along the boundary")
+    path = save_png(out / "boundary.png", img)
+    return Figure(
+        path,
+        "An open grid subdivided twice with Loop's weights. The boundary is refined as a cubic B-spline curve of "
+        "its own (odd = edge midpoint, even = 1/8, 3/4, 1/8 along the boundary), as in igl.loop and VTK. trimesh "
+        "gives 1/8 to every neighbour that lies on the boundary, so boundary vertices joined to another boundary "
+        "vertex by an interior edge get weights summing to 9/8 and move off (dark red).",
+        LAB,
+    )
+
+
+def fig_convergence(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, catmull_clark = _functions(lab)
+    L = 4 if quick else 6
+    curves, labels = [], []
+    for name, fn, (V, F) in (
+        ("Loop, icosahedron", lambda V, F: loop_subdivide(V, F, 1, "loop"), datasets.icosphere(0)),
+        ("Catmull-Clark, cube", lambda V, F: catmull_clark(V, F, 1), datasets.quad_cube()),
+        ("Catmull-Clark, cage", lambda V, F: catmull_clark(V, F, 1), datasets.polygon_cage()),
+    ):
+        moves = []
+        for _ in range(L):
+            V1, F1 = fn(V, F)
+            V1 = np.asarray(V1)
+            moves.append(float(np.abs(V1[: len(V)] - V).max()))  # how far the old vertices moved
+            V, F = V1, F1
+        curves.append(np.array(moves))
+        labels.append(name)
+    xs = [np.arange(1, L + 1)] * len(curves)
+    img = line_plot(
+        xs, curves, labels, xlabel="level", ylabel="largest move of an old vertex", logy=True,
+        title="Subdivision converges: moves shrink geometrically", size=(560, 380),
+    )  # fmt: skip
+    path = save_png(out / "convergence.png", img)
+    return Figure(
+        path,
+        "How far the old vertices move at each level (log scale). The moves shrink by a roughly constant factor "
+        "per level (about 1/4 on regular regions), so the meshes converge to a limit surface; the limit position "
+        "of every vertex is a fixed weighted average of its neighbourhood.",
+        LAB,
+    )
+
+
+def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
+    """Render the lab's figures into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Folder for the PNG files (created if missing).
+    lab : module, optional
+        A lab module providing ``loop_subdivide`` and ``catmull_clark`` (default: this package).
+    quick : bool
+        Fewer levels and smaller images (for notebooks and smoke tests).
+
+    Returns
+    -------
+    list of Figure
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return [
+        fig_loop_levels(out, lab, quick),
+        fig_weights(out, lab, quick),
+        fig_catmull_clark(out, lab, quick),
+        fig_boundary(out, lab, quick),
+        fig_convergence(out, lab, quick),
+    ]

@@ -1,0 +1,163 @@
+"""Meshes and comparisons shared by the graded subdivision tests (public: shipped with the lab).
+
+Everything here is independent of any implementation of the lab: inputs come from
+``geomlib.datasets`` (deterministic), and expected values come from hand calculations, simple
+formulas written out below, or the stored references.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets
+from geomlib.grading import tolerances as tol
+from geomlib.grading.checks import format_vec
+
+# --------------------------------------------------------------------------------------------
+# tiny meshes (by hand)
+
+#: One triangle: every vertex and edge is on the boundary.
+TRIANGLE_V = np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]])
+TRIANGLE_F = np.array([[0, 1, 2]])
+
+#: A unit square split along the diagonal 0-2: one interior edge, four boundary edges.
+SQUARE_V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]])
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+#: Corner tetrahedron, outward oriented: every vertex has valence 3, every edge is interior.
+TET_V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+TET_F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+
+#: Regular tetrahedron centred at the origin (vertex sum 0): nice closed forms for Catmull-Clark.
+REG_TET_V = np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+REG_TET_F = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])
+
+#: Octahedron: vertex 2k and 2k+1 are +-e_k (antipodes); every vertex has valence 4.
+OCTA_V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+OCTA_F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+
+#: One quad (all boundary).
+QUAD_V = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 2.0, 0.0], [0.0, 2.0, 0.0]])
+QUAD_F = np.array([[0, 1, 2, 3]])
+
+
+# --------------------------------------------------------------------------------------------
+# realistic inputs
+
+
+def airplane() -> tuple[np.ndarray, np.ndarray]:
+    """The pyvista airplane made manifold (stray triangle dropped, 6 pinch vertices split)."""
+    return datasets.pyvista_mesh("airplane", manifold=True)
+
+
+def quad_grid(nx: int = 6, ny: int = 5, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """An open (nx x ny)-cell quad patch with random heights, facing +z."""
+    x, y = np.meshgrid(np.arange(nx + 1, dtype=float), np.arange(ny + 1, dtype=float), indexing="ij")
+    z = 0.3 * np.random.default_rng(seed).normal(size=x.shape)
+    V = np.stack([x, y, z], -1).reshape(-1, 3) / max(nx, ny)
+    vid = np.arange((nx + 1) * (ny + 1)).reshape(nx + 1, ny + 1)
+    Q = np.stack([vid[:-1, :-1], vid[1:, :-1], vid[1:, 1:], vid[:-1, 1:]], -1).reshape(-1, 4)
+    return V, Q
+
+
+def centroids(V, faces) -> np.ndarray:
+    """Face centroids, written plainly (so edge/vertex-point tests do not depend on Task 6)."""
+    V = np.asarray(V, float)
+    return np.array([V[list(f)].mean(axis=0) for f in faces])
+
+
+def as_dense(S, name: str = "S") -> np.ndarray:
+    """A returned matrix (scipy.sparse or dense array) as a dense float array."""
+    if hasattr(S, "toarray"):
+        S = S.toarray()
+    A = np.asarray(S)
+    if A.dtype == object or A.ndim != 2:
+        from geomlib.grading.errors import BadReturn
+
+        raise BadReturn(f"{name} should be a 2-D matrix (scipy.sparse or ndarray), got {type(S).__name__}")
+    return A.astype(np.float64)
+
+
+# --------------------------------------------------------------------------------------------
+# comparisons with student-readable messages
+
+
+def _row_text(row: np.ndarray) -> str:
+    nz = np.flatnonzero(np.abs(row) > 1e-15)
+    if len(nz) == 0:
+        return "{} (an empty row)"
+    return "{" + ", ".join(f"{int(c)}: {row[c]:.6g}" for c in nz) + "}"
+
+
+def matrix_mismatch(name: str, expected, got, *, atol: float = tol.EXACT, what_row: str = "row") -> str | None:
+    """None if the matrices agree, else a message naming the first wrong row and its weights."""
+    E = as_dense(expected, name)
+    G = as_dense(got, name)
+    if G.shape != E.shape:
+        return f"{name} has shape {G.shape}, expected {E.shape}"
+    bad = (np.abs(G - E) > atol).any(axis=1)
+    if not bad.any():
+        return None
+    r = int(np.flatnonzero(bad)[0])
+    msg = (
+        f"{name} {what_row} {r}: expected weights {_row_text(E[r])} (column = old vertex), got {_row_text(G[r])}; "
+        f"{int(bad.sum())} of {len(E)} rows differ"
+    )
+    sums = G.sum(axis=1)
+    if np.abs(sums - 1).max() > 1e-9:
+        k = int(np.argmax(np.abs(sums - 1)))
+        msg += f" (row {k} sums to {sums[k]:.6g}; subdivision weights of a row always sum to 1)"
+    return msg
+
+
+def matrix_check(name: str, *, atol: float = tol.EXACT, what_row: str = "row"):
+    """A ``checks.Custom`` comparison for a matrix output stored dense in the reference."""
+    from geomlib.grading import checks
+
+    return checks.Custom(lambda e, g, ctx: matrix_mismatch(name, e[name], g.get(name), atol=atol, what_row=what_row))
+
+
+def canonical_faces(F) -> set:
+    """Faces as a set of oriented cycles, each rotated to start at its smallest index."""
+    F = np.asarray(F, dtype=np.int64)
+    s = np.argmin(F, axis=1)
+    k = F.shape[1]
+    R = np.take_along_axis(F, (s[:, None] + np.arange(k)) % k, axis=1)
+    return {tuple(r) for r in R.tolist()}
+
+
+def faces_mismatch(name: str, expected, got) -> str | None:
+    """None if the two face arrays hold the same oriented faces (any order, any rotation)."""
+    E = np.asarray(expected)
+    try:
+        G = np.asarray(got)
+    except Exception:
+        G = np.zeros((0,))
+    if G.dtype == object or G.ndim != 2 or G.shape[1] != E.shape[1]:
+        return f"{name} should be an integer array of shape (m, {E.shape[1]}), got shape {getattr(G, 'shape', None)}"
+    if len(G) != len(E):
+        return f"{name} has {len(G)} faces, expected {len(E)}"
+    if G.dtype.kind not in "iu":
+        if not np.all(G == np.round(G)):
+            return f"{name} holds non-integer values"
+        G = G.astype(np.int64)
+    ce, cg = canonical_faces(E), canonical_faces(G)
+    if ce == cg:
+        return None
+    missing = sorted(ce - cg)
+    flipped = sum(1 for f in missing if canonical_faces([f[::-1]]) <= cg)
+    extra = sorted(cg - ce)
+    msg = f"{len(missing)} of {len(E)} expected faces are missing, e.g. {format_vec(np.array(missing[0]))}"
+    if extra:
+        msg += f"; unexpected faces include {format_vec(np.array(extra[0]))}"
+    if flipped:
+        msg += f"; {flipped} appear with reversed orientation (keep each child in the corner order of its parent)"
+    if len(cg) < len(G):
+        msg += f"; {len(G) - len(cg)} faces are repeated"
+    return msg
+
+
+def faces_check(name: str):
+    from geomlib.grading import checks
+
+    return checks.Custom(lambda e, g, ctx: faces_mismatch(name, e[name], g.get(name)))

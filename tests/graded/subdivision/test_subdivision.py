@@ -1,0 +1,419 @@
+"""Graded tests of the subdivision lab.
+
+Two kinds: ``test_references`` compares with stored reference outputs on realistic meshes (see
+``cases.py``); the tests below use tiny meshes whose answers are worked out by hand in the
+docstrings and comments, identities that any correct implementation satisfies, and bad input.
+Expected values never come from running a solution at test time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets, topology
+from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading.errors import Mismatch
+
+from .cases import CASES
+from .support import (
+    OCTA_F,
+    OCTA_V,
+    QUAD_F,
+    QUAD_V,
+    REG_TET_F,
+    REG_TET_V,
+    SQUARE_F,
+    SQUARE_V,
+    TET_F,
+    TET_V,
+    TRIANGLE_F,
+    TRIANGLE_V,
+    as_dense,
+    centroids,
+    faces_mismatch,
+    matrix_mismatch,
+)
+
+test_references = reference_tests(CASES)
+
+
+def expect_matrix(label: str, got, expected, name: str = "S") -> None:
+    msg = matrix_mismatch(name, np.asarray(expected, float), got)
+    if msg:
+        raise Mismatch(f"{label}: {msg}")
+
+
+def expect_faces(label: str, got, expected, name: str = "F") -> None:
+    msg = faces_mismatch(name, np.asarray(expected), got)
+    if msg:
+        raise Mismatch(f"{label}: {msg}")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 1: odd vertices
+
+
+@graded(points=2, part="odd vertices")
+def test_tetrahedron_odd_rows(lab):
+    """tetrahedron: every edge (a, b) gets 3/8, 3/8 on its ends and 1/8, 1/8 on the two other vertices"""
+    S = lab.loop_odd_matrix(TET_V, TET_F)
+    # Edges in sorted order (0,1), (0,2), (0,3), (1,2), (1,3), (2,3); in a tetrahedron the two
+    # vertices opposite an edge are simply the two vertices not on it.
+    E = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    expected = np.full((6, 4), 1 / 8)
+    for i, (a, b) in enumerate(E):
+        expected[i, [a, b]] = 3 / 8
+    expect_matrix("loop_odd_matrix on the tetrahedron", S, expected, "S_odd")
+
+
+@graded(points=1, part="odd vertices")
+def test_octahedron_odd_positions(lab):
+    """octahedron: the new vertex on edge (+x, +y) is 3/8 (x + y) + 1/8 (z + (-z)) = (3/8, 3/8, 0)"""
+    S = as_dense(lab.loop_odd_matrix(OCTA_V, OCTA_F), "S_odd")
+    E = topology.unique_edges(OCTA_F)
+    # Every edge joins two unit vectors on different axes; its opposite vertices are the two
+    # antipodes on the third axis, which cancel: odd = 3/8 (a + b).
+    expected = 3 / 8 * (OCTA_V[E[:, 0]] + OCTA_V[E[:, 1]])
+    expect_close("loop_odd_matrix(octahedron) @ V", S @ OCTA_V, expected, atol=1e-12, name="odd vertices")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 2: even vertices
+
+
+@graded(points=1, part="even vertices")
+def test_weights_by_hand(lab):
+    """loop_weight: both rules give 3/16 at n = 3 and 1/16 at n = 6; at n = 4 Warren 3/32, Loop 31/256"""
+    # beta(4) = (5/8 - (3/8 + cos(pi/2)/4)^2) / 4 = (5/8 - 9/64) / 4 = 31/256
+    expect_close("loop_weight([3, 4, 6], 'warren')", lab.loop_weight([3, 4, 6], "warren"), [3 / 16, 3 / 32, 1 / 16])
+    expect_close("loop_weight([3, 4, 6], 'loop')", lab.loop_weight([3, 4, 6], "loop"), [3 / 16, 31 / 256, 1 / 16])
+
+
+@graded(points=2, part="even vertices")
+def test_octahedron_even_rows(lab):
+    """octahedron, valence 4: row v = (1 - 4u) on v and u on its 4 neighbours (every vertex but its antipode)"""
+    for weights, u in (("warren", 3 / 32), ("loop", 31 / 256)):
+        expected = np.full((6, 6), u)
+        np.fill_diagonal(expected, 1 - 4 * u)
+        for k in range(3):
+            expected[2 * k, 2 * k + 1] = expected[2 * k + 1, 2 * k] = 0.0  # antipodes are not neighbours
+        S = lab.loop_even_matrix(OCTA_V, OCTA_F, weights)
+        expect_matrix(f"loop_even_matrix(octahedron, weights={weights!r})", S, expected, "S_even")
+
+
+@graded(points=1, part="even vertices")
+def test_tetrahedron_even_rows(lab):
+    """tetrahedron, valence 3: both rules give u = 3/16, so each row is 7/16 on v and 3/16 on the others"""
+    expected = np.full((4, 4), 3 / 16)
+    np.fill_diagonal(expected, 7 / 16)
+    for weights in ("warren", "loop"):
+        expect_matrix(
+            f"loop_even_matrix(tetrahedron, {weights!r})",
+            lab.loop_even_matrix(TET_V, TET_F, weights),
+            expected,
+            "S_even",
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# Task 3: connectivity
+
+
+@graded(points=2, part="connectivity")
+def test_one_triangle_faces(lab):
+    """one triangle (0, 1, 2): edges (0,1), (0,2), (1,2) become vertices 3, 4, 5 -> four oriented triangles"""
+    F = lab.loop_faces(TRIANGLE_F)
+    # m01 = 3, m20 = 4, m12 = 5: corners (0, m01, m20), (1, m12, m01), (2, m20, m12) and the middle one.
+    expect_faces("loop_faces on one triangle", F, [[0, 3, 4], [1, 5, 3], [2, 4, 5], [3, 5, 4]])
+
+
+@graded(points=1, part="connectivity")
+def test_closed_mesh_stays_closed(lab):
+    """icosphere: 4x the faces, every edge in exactly two faces with opposite directions, chi unchanged"""
+    V, F = datasets.icosphere(1)
+    F1 = np.asarray(lab.loop_faces(F))
+    if F1.shape != (4 * len(F), 3):
+        raise Mismatch(f"loop_faces(icosphere(1)) has shape {F1.shape}, expected {(4 * len(F), 3)}")
+    he = np.stack([F1, np.roll(F1, -1, axis=1)], -1).reshape(-1, 2)
+    if len(np.unique(he, axis=0)) != len(he) or not topology.is_closed(F1):
+        raise Mismatch("loop_faces(icosphere(1)): the refined mesh is not closed and consistently oriented")
+    chi0, chi1 = topology.euler_characteristic(F), topology.euler_characteristic(F1)
+    if chi0 != chi1:
+        raise Mismatch(f"loop_faces(icosphere(1)): Euler characteristic changed from {chi0} to {chi1}")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 4: boundary rules
+
+
+@graded(points=1, part="boundary rules")
+def test_one_triangle_boundary_rows(lab):
+    """one triangle: odd rows are midpoints, even rows 3/4 on the vertex and 1/8 on each other corner"""
+    expect_matrix(
+        "loop_odd_matrix on one triangle",
+        lab.loop_odd_matrix(TRIANGLE_V, TRIANGLE_F),
+        [[0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]],  # edges (0,1), (0,2), (1,2)
+        "S_odd",
+    )
+    expected = np.full((3, 3), 1 / 8)
+    np.fill_diagonal(expected, 3 / 4)
+    expect_matrix(
+        "loop_even_matrix on one triangle", lab.loop_even_matrix(TRIANGLE_V, TRIANGLE_F, "loop"), expected, "S_even"
+    )
+
+
+@graded(points=2, part="boundary rules")
+def test_square_interior_edge_between_boundary_vertices(lab):
+    """square split along 0-2: the interior edge keeps the 3/8-1/8 rule; vertex 0 ignores its interior neighbour 2"""
+    # Edges (0,1), (0,2), (0,3), (1,2), (2,3). Only (0,2) is interior (opposite vertices 1 and 3).
+    odd = [[0.5, 0.5, 0, 0], [3 / 8, 1 / 8, 3 / 8, 1 / 8], [0.5, 0, 0, 0.5], [0, 0.5, 0.5, 0], [0, 0, 0.5, 0.5]]
+    expect_matrix("loop_odd_matrix on the split square", lab.loop_odd_matrix(SQUARE_V, SQUARE_F), odd, "S_odd")
+    # Every vertex is on the boundary: 3/4 on itself, 1/8 on its two boundary neighbours only.
+    # Vertex 0's boundary neighbours are 1 and 3; vertex 2 is a neighbour too, but across the interior edge.
+    even = [[3 / 4, 1 / 8, 0, 1 / 8], [1 / 8, 3 / 4, 1 / 8, 0], [0, 1 / 8, 3 / 4, 1 / 8], [1 / 8, 0, 1 / 8, 3 / 4]]
+    for weights in ("warren", "loop"):
+        S = lab.loop_even_matrix(SQUARE_V, SQUARE_F, weights)
+        expect_matrix(f"loop_even_matrix on the split square ({weights!r})", S, even, "S_even")
+
+
+@graded(points=1, part="boundary rules")
+def test_one_quad_boundary_points(lab):
+    """one quad: Catmull-Clark edge points are the midpoints, vertex points 3/4 P + 1/8 (two neighbours)"""
+    fp = centroids(QUAD_V, QUAD_F)
+    EP = lab.cc_edge_points(QUAD_V, QUAD_F, fp)
+    # edges (0,1), (0,3), (1,2), (2,3)
+    expect_close(
+        "cc_edge_points on one quad", EP, [[1, 0, 0], [0, 1, 0], [2, 1, 0], [1, 2, 0]], atol=1e-12, name="edge points"
+    )
+    VP = lab.cc_vertex_points(QUAD_V, QUAD_F, fp)
+    # vertex 0 = (0,0): 1/8 ((2,0) + (0,2)) = (0.25, 0.25); the others by symmetry
+    expect_close(
+        "cc_vertex_points on one quad",
+        VP,
+        [[0.25, 0.25, 0], [1.75, 0.25, 0], [1.75, 1.75, 0], [0.25, 1.75, 0]],
+        atol=1e-12,
+        name="vertex points",
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Task 5: several levels
+
+
+@graded(points=1, part="several levels")
+def test_levels_zero_is_identity(lab):
+    """levels=0 returns the input mesh unchanged"""
+    V, F = datasets.icosphere(1)
+    V0, F0 = lab.loop_subdivide(V, F, 0)
+    expect_close("loop_subdivide(levels=0) vertices", V0, V, atol=0.0, name="V")
+    expect_close("loop_subdivide(levels=0) faces", F0, F, atol=0.0, name="F")
+
+
+@graded(points=2, part="several levels")
+def test_subdivision_matrix_identity(lab):
+    """return_matrix=True: S @ V equals the returned vertices, rows sum to 1, counts n + e per level"""
+    V, F = datasets.icosphere(1)
+    V2, F2, S = lab.loop_subdivide(V, F, 2, "loop", return_matrix=True)
+    n1 = len(V) + len(topology.unique_edges(F))  # 42 + 120
+    n2 = n1 + 3 * 4 * len(F) // 2  # e after one level = 3 * 4m / 2
+    V2 = np.asarray(V2)
+    if V2.shape != (n2, 3) or np.asarray(F2).shape != (16 * len(F), 3):
+        raise Mismatch(
+            f"loop_subdivide(icosphere(1), 2): got V {V2.shape}, F {np.asarray(F2).shape}; expected ({n2}, 3) and ({16 * len(F)}, 3)"
+        )
+    S = as_dense(S, "S")
+    if S.shape != (n2, len(V)):
+        raise Mismatch(f"loop_subdivide(..., return_matrix=True): S has shape {S.shape}, expected ({n2}, {len(V)})")
+    expect_close("S @ V (return_matrix=True)", S @ V, V2, atol=1e-10, name="S @ V")
+    expect_close("row sums of S", S.sum(axis=1), np.ones(n2), atol=1e-10, name="row sums")
+
+
+@graded(points=1, part="several levels")
+def test_planar_mesh_stays_planar(lab):
+    """a flat open grid stays in its plane through three levels (both weight rules)"""
+    V, F = datasets.grid_patch(4)
+    for weights in ("warren", "loop"):
+        V3, F3 = lab.loop_subdivide(V, F, 3, weights)
+        expect_close(
+            f"z of loop_subdivide(flat grid, 3, {weights!r})",
+            np.asarray(V3)[:, 2],
+            np.zeros(len(V3)),
+            atol=1e-12,
+            name="z",
+        )
+
+
+@graded(points=1, part="several levels")
+def test_old_vertices_keep_valence(lab):
+    """after one level: V' = V + E, chi unchanged, old vertices keep their valence, new ones have 6 (interior)"""
+    V, F = datasets.torus(n_major=8, n_minor=6)
+    V1, F1 = lab.loop_subdivide(V, F)
+    n, e = len(V), len(topology.unique_edges(F))
+    V1, F1 = np.asarray(V1), np.asarray(F1)
+    if len(V1) != n + e:
+        raise Mismatch(f"loop_subdivide(torus): {len(V1)} vertices, expected V + E = {n} + {e} = {n + e}")
+    val0 = np.sort(topology.valence(F, n))
+    val1 = np.sort(topology.valence(F1, len(V1)))
+    expected = np.sort(np.concatenate([val0, np.full(e, 6)]))
+    if not np.array_equal(val1, expected) or topology.euler_characteristic(F1) != topology.euler_characteristic(F):
+        raise Mismatch("loop_subdivide(torus): the valences or the Euler characteristic changed")
+
+
+# --------------------------------------------------------------------------------------------
+# Tasks 6-8: Catmull-Clark points
+
+
+@graded(points=2, part="catmull-clark points")
+def test_cube_by_hand(lab):
+    """unit cube [-1/2, 1/2]^3: face points = face centres, edge points at 3/8, corner vertex points at 5/18"""
+    V, Q = datasets.quad_cube()
+    FP = lab.cc_face_points(V, Q)
+    expect_close("cc_face_points(cube)", FP, centroids(V, Q), atol=1e-12, name="face points")
+    # Edge (0, 1) runs along x at y = z = -1/2 between the faces y = -1/2 and z = -1/2:
+    # ((-1/2,-1/2,-1/2) + (1/2,-1/2,-1/2) + (0,-1/2,0) + (0,0,-1/2)) / 4 = (0, -3/8, -3/8).
+    E = topology.unique_edges(Q)
+    EP = np.asarray(lab.cc_edge_points(V, Q, centroids(V, Q)))
+    i = int(np.flatnonzero((E == [0, 1]).all(axis=1))[0])
+    expect_close("cc_edge_points(cube), edge (0, 1)", EP[i], [0, -3 / 8, -3 / 8], atol=1e-12, name="edge point")
+    # Corner -1/2 (1,1,1), valence 3: Q = mean face centre = -1/6 (1,1,1), R = mean edge midpoint
+    # = -1/3 (1,1,1); (Q + 2R + 0 P) / 3 = -5/18 (1,1,1). All corners by symmetry: 5/9 of P.
+    VP = lab.cc_vertex_points(V, Q, centroids(V, Q))
+    expect_close("cc_vertex_points(cube)", VP, V * (5 / 9), atol=1e-12, name="vertex points")
+
+
+@graded(points=2, part="catmull-clark points")
+def test_regular_torus_is_bicubic_bspline(lab):
+    """on a quad torus (every vertex regular) one step equals tensor-product cubic B-spline refinement"""
+    nu, nv = 10, 6
+    V, Q = datasets.quad_torus(n_major=nu, n_minor=nv)
+    V = datasets.add_noise(V, 0.02, seed=1)
+    P = V.reshape(nv, nu, 3)  # vertex i + nu * j
+
+    def refine(P, axis):  # 1-D periodic rule: even (p- + 6p + p+)/8, odd (p + p+)/2
+        Pm, Pp = np.roll(P, 1, axis), np.roll(P, -1, axis)
+        out = np.stack([(Pm + 6 * P + Pp) / 8, (P + Pp) / 2], axis + 1)
+        shape = list(P.shape)
+        shape[axis] *= 2
+        return out.reshape(shape)
+
+    expected = refine(refine(P, 0), 1).reshape(-1, 3)
+    V1, Q1 = lab.catmull_clark(V, Q)
+    V1 = np.asarray(V1)
+    if V1.shape != expected.shape:
+        raise Mismatch(f"catmull_clark(quad torus): {len(V1)} vertices, expected {len(expected)}")
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(V1).query(expected)
+    if d.max() > 1e-10:
+        raise Mismatch(
+            f"catmull_clark(quad torus): {int((d > 1e-10).sum())} of {len(expected)} B-spline points have no matching "
+            f"vertex (worst off by {d.max():.3g}) — check the edge and vertex point rules on regular quads"
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# Task 9 and non-quad input
+
+
+@graded(points=2, part="non-quad input")
+def test_regular_tetrahedron_by_hand(lab):
+    """regular tetrahedron (vertex sum 0): face points -w/3, edge points (a + b)/3, vertex points 7/27 P"""
+    V, F = REG_TET_V, REG_TET_F
+    # The face without vertex w has centroid (sum - w)/3 = -w/3. Edge (a, b) lies in the faces
+    # without c and without d: (a + b - c/3 - d/3) / 4 = (a + b)(1 + 1/3)/4 = (a + b)/3.
+    # Vertex P, valence 3: Q = mean of -w/3 over the other three = P/9, R = mean of (P + w)/2 = P/3,
+    # (Q + 2R + 0 P)/3 = 7P/27.
+    V1, Q1 = lab.catmull_clark(V, F)
+    E = topology.unique_edges(F)
+    expected = np.concatenate([7 * V / 27, (V[E[:, 0]] + V[E[:, 1]]) / 3, -V[[3, 2, 1, 0]] / 3])
+    from scipy.spatial import cKDTree
+
+    V1 = np.asarray(V1)
+    if V1.shape != expected.shape:
+        raise Mismatch(f"catmull_clark(tetrahedron): {len(V1)} vertices, expected V + E + F = 4 + 6 + 4 = 14")
+    d, j = cKDTree(V1).query(expected)
+    if d.max() > 1e-12:
+        i = int(np.argmax(d))
+        raise Mismatch(
+            f"catmull_clark(tetrahedron): expected a vertex at {np.round(expected[i], 6).tolist()}, nearest is {np.round(V1[j[i]], 6).tolist()}"
+        )
+    Q1 = np.asarray(Q1)
+    if Q1.shape != (12, 4):
+        raise Mismatch(f"catmull_clark(tetrahedron): quads have shape {Q1.shape}, expected (12, 4): one per corner")
+
+
+@graded(points=1, part="non-quad input")
+def test_cage_counts_and_extraordinary_vertices(lab):
+    """mixed cage: V' = V + E + F, one quad per corner, old valences kept, extraordinary count constant"""
+    V, faces = datasets.polygon_cage()
+    n, e, m = len(V), len(topology.unique_edges(faces)), len(faces)
+    corners = sum(len(f) for f in faces)
+    V1, Q1 = (np.asarray(a) for a in lab.catmull_clark(V, faces, 1))
+    if V1.shape != (n + e + m, 3) or Q1.shape != (corners, 4):
+        raise Mismatch(
+            f"catmull_clark(cage): got V {V1.shape}, Q {Q1.shape}; expected ({n + e + m}, 3), ({corners}, 4)"
+        )
+    if not np.array_equal(topology.valence(Q1, len(V1))[:n], topology.valence(faces, n)):
+        raise Mismatch("catmull_clark(cage): the old vertices (first n rows) must keep their valence")
+    V2, Q2 = (np.asarray(a) for a in lab.catmull_clark(V, faces, 2))
+    x1 = int((topology.valence(Q1, len(V1)) != 4).sum())
+    x2 = int((topology.valence(Q2, len(V2)) != 4).sum())
+    # extraordinary after one step: old vertices of valence != 4 plus face points of non-quads
+    x_expected = int((topology.valence(faces, n) != 4).sum()) + sum(len(f) != 4 for f in faces)
+    if not (x1 == x2 == x_expected):
+        raise Mismatch(
+            f"catmull_clark(cage): {x1} extraordinary vertices after level 1 and {x2} after level 2; expected {x_expected} both times"
+        )
+    if not topology.is_closed(Q1):
+        raise Mismatch("catmull_clark(cage): the refined mesh should still be closed")
+
+
+# --------------------------------------------------------------------------------------------
+# bad input (validation is given code: these make sure it stays in place; no points)
+
+
+@graded(points=0, part="bad input")
+def test_rejects_quads_for_loop(lab):
+    """Loop subdivision rejects quads with a message about triangles"""
+    V, Q = datasets.quad_cube()
+    expect_raises(lambda: lab.loop_subdivide(V, Q), "MeshError", match="triangles", label="loop_subdivide(quads)")
+
+
+@graded(points=0, part="bad input")
+def test_rejects_non_manifold(lab):
+    """an edge shared by three triangles is rejected, naming the edge"""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
+    expect_raises(
+        lambda: lab.loop_odd_matrix(V, F), "MeshError", match=r"edge \(0, 1\).*3 faces", label="loop_odd_matrix"
+    )
+    expect_raises(lambda: lab.catmull_clark(V, F), "MeshError", match=r"edge \(0, 1\)", label="catmull_clark")
+
+
+@graded(points=0, part="bad input")
+def test_rejects_bad_levels(lab):
+    """levels must be an integer >= 0"""
+    V, F = datasets.icosphere(0)
+    expect_raises(lambda: lab.loop_subdivide(V, F, -1), "MeshError", match=">= 0", label="loop_subdivide(levels=-1)")
+    expect_raises(
+        lambda: lab.loop_subdivide(V, F, 1.5), "MeshError", match="integer", label="loop_subdivide(levels=1.5)"
+    )
+    expect_raises(lambda: lab.catmull_clark(V, F, "2"), "MeshError", match="integer", label="catmull_clark(levels='2')")
+
+
+@graded(points=0, part="bad input")
+def test_rejects_unknown_weights_and_nan(lab):
+    """unknown weight rule and NaN coordinates are rejected with a message naming them"""
+    V, F = datasets.icosphere(0)
+    expect_raises(
+        lambda: lab.loop_subdivide(V, F, 1, "butterfly"),
+        "MeshError",
+        match="weights",
+        label="loop_subdivide(weights='butterfly')",
+    )
+    Vn = V.copy()
+    Vn[3, 0] = np.nan
+    expect_raises(lambda: lab.loop_subdivide(Vn, F), "MeshError", match="row 3", label="loop_subdivide(V with NaN)")
+    expect_raises(
+        lambda: lab.catmull_clark(V, [[0, 1, 2], [2, 3]]), "MeshError", match="face 1", label="catmull_clark(2-gon)"
+    )
