@@ -44,18 +44,20 @@ def _cmd_info(a) -> int:
 def _cmd_render(a) -> int:
     import numpy as np
 
-    from geomlib import io, plot, render, topology
+    from geomlib import io, plot, render
 
     V, faces = io.read_mesh(a.file)
-    if isinstance(faces, np.ndarray) and faces.shape[1] == 3:
-        img = render.render(
-            V, faces, wireframe=a.wireframe, shadows=a.shadows, size=(a.width, a.height), camera=a.camera
-        )
-    else:
-        img = render.render_polygons(
-            V, faces, wireframe=a.wireframe, shadows=a.shadows, size=(a.width, a.height), camera=a.camera
-        )
-    del topology
+    draw = render.render if isinstance(faces, np.ndarray) and faces.shape[1] == 3 else render.render_polygons
+    img = draw(
+        V,
+        faces,
+        wireframe=a.wireframe,
+        shadows=a.shadows,
+        floor=a.shadows,
+        size=(a.width, a.height),
+        camera=a.camera,
+        up_axis=a.up,
+    )
     plot.save_png(a.output, img)
     print(f"wrote {a.output}")
     return 0
@@ -144,6 +146,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--wireframe", action="store_true", help="overlay the edges")
     r.add_argument("--shadows", action="store_true", help="cast shadows onto a ground plane")
     r.add_argument("--camera", default="three_quarter", choices=["front", "three_quarter", "top", "side"])
+    r.add_argument(
+        "--up", default="y", choices=["y", "z"], help="the mesh's up axis (default y, usual for OBJ/OFF/PLY files)"
+    )
     r.add_argument("--width", type=int, default=800)
     r.add_argument("--height", type=int, default=600)
     r.set_defaults(func=_cmd_render)

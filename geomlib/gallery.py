@@ -51,14 +51,6 @@ def extraordinary_vertices(faces, n_vertices: int) -> np.ndarray:
     return np.flatnonzero(used & ~boundary & (val != regular)).astype(np.int64)
 
 
-def _wire_opacity(V: np.ndarray, edges: np.ndarray, size: tuple[int, int]) -> float:
-    """Fade the wireframe when edges are short on screen, so dense meshes stay readable."""
-    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
-    typical = float(np.median(np.linalg.norm(V[edges[:, 0]] - V[edges[:, 1]], axis=1))) if len(edges) else diag
-    px = typical / diag * 0.8 * min(size)  # the object spans roughly 80% of the short image side
-    return float(np.clip(px / 7.0, 0.35, 1.0))
-
-
 def _thumbnail(img: np.ndarray, width: int) -> np.ndarray:
     from PIL import Image
 
@@ -113,7 +105,6 @@ def build_gallery(out_dir, quick: bool = False, *, names: list[str] | None = Non
             marked = special if 0 < len(special) <= MAX_MARKED else None
             opts = dict(
                 wireframe=True,
-                wire_opacity=_wire_opacity(V, E, size),
                 highlight_points=marked,
                 camera="three_quarter",
                 up_axis="z",  # every built-in dataset is z-up

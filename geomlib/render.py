@@ -633,7 +633,8 @@ def _draw(
     roughness = check_float(roughness, "roughness", minimum=0.0, maximum=1.0, where=where)
     metallic = check_float(metallic, "metallic", minimum=0.0, maximum=1.0, where=where)
     edge_width = check_float(edge_width, "edge_width", minimum=0.0, maximum=50.0, where=where)
-    wire_opacity = check_float(wire_opacity, "wire_opacity", minimum=0.0, maximum=1.0, where=where)
+    if wire_opacity is not None:
+        wire_opacity = check_float(wire_opacity, "wire_opacity", minimum=0.0, maximum=1.0, where=where)
     point_radius = check_float(point_radius, "point_radius", minimum=0.0, maximum=100.0, where=where)
     if crease_deg is not None:
         crease_deg = check_float(crease_deg, "crease_deg", minimum=0.0, maximum=180.0, where=where)
@@ -849,6 +850,8 @@ def _draw(
     col, depth = r.render(scene, flags=flags)
     col = np.asarray(col[:, :, :3])
 
+    if wire_opacity is None:
+        wire_opacity = auto_wire_opacity(V, edges, (w, h), zoom=zoom) if edges is not None else 0.0
     if (edges is not None and edge_width > 0 and wire_opacity > 0) or (
         highlight_points is not None and point_radius > 0
     ):
@@ -905,8 +908,10 @@ _OPTIONS_DOC = """
         Colour of the wireframe.
     edge_width : float
         Wireframe line width in output pixels.
-    wire_opacity : float
-        Opacity of the wireframe, in [0, 1] (lower it for dense meshes).
+    wire_opacity : float, optional
+        Opacity of the wireframe, in [0, 1]. Default: :func:`auto_wire_opacity`, which fades the
+        wireframe as edges get short on screen and drops it below about one pixel, so a dense
+        mesh is not painted solid black.
     highlight_points : (k,) int array_like, optional
         Vertex indices to mark with dots (e.g. extraordinary vertices); hidden ones are not drawn.
     point_color : RGB in [0, 1]
@@ -962,6 +967,17 @@ _OPTIONS_DOC = """
 """
 
 
+def auto_wire_opacity(V: np.ndarray, edges: np.ndarray, size: tuple[int, int], zoom: float = 1.0) -> float:
+    """Wireframe opacity for a mesh drawn at ``size``: 1 when a typical edge spans >= 7 pixels, fading
+    to 0 at about one pixel (the object is assumed to span ~80% of the shorter image side)."""
+    if edges is None or len(edges) == 0:
+        return 1.0
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0))) or 1.0
+    typical = float(np.median(np.linalg.norm(V[edges[:, 0]] - V[edges[:, 1]], axis=1)))
+    px = typical / diag * 0.8 * min(size) * zoom
+    return float(np.clip((px - 1.0) / 6.0, 0.0, 1.0))
+
+
 def render(
     V,
     F,
@@ -977,7 +993,7 @@ def render(
     wireframe: bool = False,
     wire_color=DEFAULT_WIRE_COLOR,
     edge_width: float = 1.0,
-    wire_opacity: float = 1.0,
+    wire_opacity: float | None = None,
     highlight_points=None,
     point_color=(0.90, 0.12, 0.10),
     point_radius: float = 3.5,

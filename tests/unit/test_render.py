@@ -226,3 +226,16 @@ def test_crease_normals_split_sharp_edges_only():
     V, F = uv_sphere(24, 48)
     tri_n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
     assert R._crease_normals(F, tri_n, R._vertex_normals(len(V), F, tri_n), 60.0) is None
+
+
+def test_auto_wire_opacity_fades_with_screen_edge_length():
+    from geomlib import datasets, topology
+    from geomlib.render import auto_wire_opacity
+
+    V, F = datasets.icosphere(0)
+    assert auto_wire_opacity(V, topology.unique_edges(F), (640, 480)) == 1.0  # long edges: full wireframe
+    V, F = datasets.icosphere(7)  # 327,680 faces: edges ~0.5 px at 320x240
+    assert auto_wire_opacity(V, topology.unique_edges(F), (320, 240)) == 0.0
+    V, F = datasets.icosphere(4)
+    mid = auto_wire_opacity(V, topology.unique_edges(F), (320, 240))
+    assert 0.0 < mid < 1.0
