@@ -1,0 +1,254 @@
+"""Figures of the lab "maps", rendered with the lab's own functions.
+
+The imports are relative, so the same file copied next to a student's implementation
+(``labs/maps/figures.py``) renders the student's results. Shaded images come from the lab's NumPy
+fragment shader (:func:`shade` over :func:`rasterize_mesh`); the displacement figure uses
+:func:`geomlib.render.render` (pyrender). Only built-in data is used.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geomlib import camera, datasets
+from geomlib.plot import Figure, panels, save_png
+from geomlib.textures import triangle_atlas
+
+from .bake import bake_normal_map
+from .displacement import displace, welded_vertex_normals
+from .encoding import encode_normal_map
+from .heightmap import height_to_normal_map
+from .shading import rasterize_mesh, shade
+from .tangents import tangent_frames
+
+__all__ = ["make_figures", "bump_tiles", "smooth_noise"]
+
+LAB = "maps"
+ALBEDO = (0.80, 0.66, 0.52)
+BACKGROUND = (1.0, 1.0, 1.0)
+# Two lighting set-ups (directions in which the light travels; z is up in every scene here).
+KEY_LIGHTS = [
+    {"direction": (0.6, 0.5, -0.8), "intensity": 0.95},
+    {"direction": (-0.7, 0.2, -0.4), "intensity": 0.25, "color": (0.85, 0.9, 1.0)},
+]
+GRAZING_LIGHTS = [{"direction": (-1.0, -0.15, -0.18), "intensity": 1.1, "color": (1.0, 0.93, 0.82)}]
+
+
+def bump_tiles(s: int, nu: int, nv: int, radius: float = 0.38) -> np.ndarray:
+    """A tileable height map of ``nu x nv`` round bumps (a cos^2 profile), values in [0, 1]."""
+    r, c = np.mgrid[0:s, 0:s]
+    u, v = (c + 0.5) / s, 1.0 - (r + 0.5) / s
+    fu, fv = (u * nu) % 1.0 - 0.5, (v * nv) % 1.0 - 0.5
+    d = np.hypot(fu, fv) / radius
+    return np.cos(0.5 * np.pi * np.minimum(d, 1.0)) ** 2
+
+
+def smooth_noise(s: int, seed: int = 0, waves: int = 14) -> np.ndarray:
+    """A smooth tileable random height map in [0, 1] (a sum of random low-frequency waves)."""
+    rng = np.random.default_rng(seed)
+    r, c = np.mgrid[0:s, 0:s] / s
+    H = np.zeros((s, s))
+    for _ in range(waves):
+        kx, ky = rng.integers(1, 7, size=2) * rng.choice([-1, 1], size=2)
+        H += rng.uniform(0.3, 1.0) * np.sin(2 * np.pi * (kx * c + ky * r) + rng.uniform(0, 2 * np.pi))
+    return (H - H.min()) / (H.max() - H.min())
+
+
+def _view(V: np.ndarray, direction, size: int, fov: float = 30.0, margin: float = 1.04):
+    """Eye and clip-from-world matrix of a camera looking at the bounding box of V from ``direction`` (z up)."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    c, r = (lo + hi) / 2, 0.5 * float(np.linalg.norm(hi - lo))
+    d = np.asarray(direction, float)
+    d /= np.linalg.norm(d)
+    dist = margin * r / np.sin(np.radians(fov) / 2)
+    eye = c + dist * d
+    M = camera.perspective(fov, 1.0, max(dist - 1.2 * r, 1e-3), dist + 1.2 * r) @ camera.look_at(eye, c, (0, 0, 1))
+    return eye, M
+
+
+def _shaded(V, F, eye, M, size, lights, *, N=None, UV=None, tangents=None, normal_map=None, wrap="clamp"):
+    g = rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
+    img = shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
+    return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)  # display gamma
+
+
+def _grey(H: np.ndarray) -> np.ndarray:
+    return (np.clip(H, 0, 1) * 255).round().astype(np.uint8)
+
+
+def _thumb(img: np.ndarray, size: int) -> np.ndarray:
+    """A map shown at ``size x size`` pixels next to the renders (Pillow's area-averaging resize)."""
+    from PIL import Image
+
+    return np.asarray(Image.fromarray(img).resize((size, size), Image.Resampling.BOX))
+
+
+def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
+    size, s = (160, 256) if quick else (300, 512)
+    nu, nv = 24, 8
+    H = bump_tiles(s, nu, nv)
+    R, r, lam = 1.0, 0.35, 0.05
+    # Tangent-space slope of the relief: the UV square spans 2 pi R around and 2 pi r across.
+    nmap = height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
+    V, F, UV = datasets.uv_torus(48, 24, R, r)
+    N = welded_vertex_normals(V, F)
+    T, _, _, w = tangent_frames(V, F, UV, N)
+    tg = np.column_stack([T, w])
+    dm, dn = (144, 48) if quick else (384, 128)
+    Vd0, Fd, UVd = datasets.uv_torus(dm, dn, R, r)
+    Vd, Nd = displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
+    eye, M = _view(Vd, (0.15, -1.0, 0.85), size, margin=0.8)
+    figs = []
+    for name, lights, label in (
+        ("mapped_vs_displaced", KEY_LIGHTS, "key and fill light"),
+        ("mapped_vs_displaced_grazing", GRAZING_LIGHTS, "one grazing light"),
+    ):
+        plain = _shaded(V, F, eye, M, size, lights, N=N)
+        mapped = _shaded(V, F, eye, M, size, lights, N=N, UV=UV, tangents=tg, normal_map=nmap, wrap="repeat")
+        real = _shaded(Vd, Fd, eye, M, size, lights, N=Nd)
+        imgs = [plain, mapped, real]
+        caps = [
+            f"plain: {len(F):,} faces, smooth normals",
+            f"normal-mapped: the same {len(F):,} faces, per-pixel normals from the {s}x{s} map",
+            f"displaced: {len(Fd):,} faces moved by lam * h along the normal",
+        ]
+        if name == "mapped_vs_displaced":
+            imgs = [_thumb(_grey(H), size), _thumb(encode_normal_map(nmap), size)] + imgs
+            caps = ["height map h (24 x 8 bumps)", "its tangent-space normal map (RGB = (n + 1) / 2)"] + caps
+        img = panels(imgs, caps, ncols=len(imgs), title=f"Normal mapping vs displacement, {label}")
+        path = save_png(out / f"{name}.png", img)
+        figs.append(
+            Figure(
+                path,
+                f"A torus shaded per pixel by the lab's Blinn-Phong shader ({label}). Normal mapping changes only the "
+                f"normals: lit, the bumps look like the displaced ones, but the silhouette and the outline of the "
+                f"inner ring stay smooth; displacement moves vertices and needs a {len(Fd) // len(F)}x denser mesh "
+                f"(this shader casts no shadows, so neither version shows bump shadows).",
+                LAB,
+            )
+        )
+    return figs
+
+
+def _fig_bias_scale(out: Path, quick: bool) -> Figure:
+    from geomlib.render import render
+
+    size, s = (160, 128) if quick else (300, 256)
+    # Fade to mid-grey towards v = 0 and v = 1: every pole of the UV sphere is a whole row of the map.
+    v = 1.0 - (np.arange(s) + 0.5) / s
+    fade = np.minimum(1.0, (np.sin(np.pi * v) / np.sin(0.2 * np.pi)) ** 2)  # flat (zero slope) at the poles
+    H = 0.5 + (smooth_noise(s, seed=3) - 0.5) * fade[:, None]
+    V, F, UV = datasets.uv_sphere(32, 64) if quick else datasets.uv_sphere(96, 192)
+    lam = 0.12
+    imgs, caps = [_thumb(_grey(H), size)], ["displacement map h in [0, 1] (black = 0), mid-grey at the poles"]
+    for bias, scale in ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0)):
+        Vd = displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
+        rad = np.linalg.norm(Vd, axis=1)
+        imgs.append(render(Vd, F, camera="three_quarter", up_axis="z", size=(size, size)))
+        caps.append(
+            f"(bias, scale) = ({bias:g}, {scale:g}): offsets lam * [{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
+        )
+    img = panels(imgs, caps, ncols=4, title="Displacement P' = P + lam (bias + scale h) n, lam = 0.12")
+    path = save_png(out / "bias_scale.png", img)
+    return Figure(
+        path,
+        "One displacement map applied to a UV sphere with three (bias, scale) pairs: (0, 1) only pushes outwards, "
+        "(-1, 2) maps mid-grey to no offset so the surface moves both ways, (-1, 5) exaggerates the peaks. "
+        "Seam copies are welded, so the sphere stays closed.",
+        LAB,
+    )
+
+
+def _rock(quick: bool):
+    """A detailed rock (built-in) and its decimated version with a one-chart-per-triangle atlas."""
+    import fast_simplification
+
+    Vh, Fh = datasets.rock_on_plinth(64 if quick else 160, seed=2)
+    target = 400 if quick else 1200
+    Vl, Fl = fast_simplification.simplify(Vh.astype(np.float32), Fh.astype(np.int32), target_count=target)
+    Vl, Fl = np.asarray(Vl, np.float64), np.asarray(Fl, np.int64)
+    # Decimated triangles vary a lot in size and shape: every chart gets half a cell (mode="fill").
+    Vs, Fs, UV, src = triangle_atlas(Vl, Fl, gutter=0.04, mode="fill")
+    N_lo = welded_vertex_normals(Vs, Fs)
+    return Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo
+
+
+def _fig_bake(out: Path, quick: bool) -> list[Figure]:
+    size, s = (160, 128) if quick else (300, 512)
+    Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo = _rock(quick)
+    nmap, mask = bake_normal_map(Vh, Fh, Vs, Fs, UV, s, N_lo=N_lo, padding=4, return_mask=True)
+    T, _, _, w = tangent_frames(Vs, Fs, UV, N_lo)
+    tg = np.column_stack([T, w])
+    Nh = welded_vertex_normals(Vh, Fh)
+    eye, M = _view(Vh, (0.9, -1.0, 0.9), size, margin=0.85)
+    enc = encode_normal_map(nmap)
+    figs = []
+    shots = {}
+    for key, lights in (("key", KEY_LIGHTS), ("grazing", GRAZING_LIGHTS)):
+        shots[key] = [
+            _shaded(Vs, Fs, eye, M, size, lights, N=N_lo),
+            _shaded(Vs, Fs, eye, M, size, lights, N=N_lo, UV=UV, tangents=tg, normal_map=enc),
+            _shaded(Vh, Fh, eye, M, size, lights, N=Nh),
+        ]
+    caps = [
+        f"decimated: {len(Fl):,} faces, smooth normals",
+        f"decimated + baked {s}x{s} normal map",
+        f"original: {len(Fh):,} faces",
+    ]
+    img = panels(
+        [_thumb(enc, size)] + shots["key"],
+        [
+            f"baked normal map, one chart per triangle ({100 * mask.mean():.0f}% of texels inside charts; flat areas are lilac)"
+        ]
+        + caps,
+        ncols=4,
+        title="Baking a normal map from a detailed rock onto its decimated version",
+    )
+    figs.append(
+        Figure(
+            save_png(out / "bake.png", img),
+            f"The built-in rock ({len(Fh):,} faces) decimated to {len(Fl):,} faces with fast-simplification; every "
+            f"triangle gets its own chart (triangle_atlas) and bake_normal_map casts from each texel along the low "
+            f"normal onto the detailed rock. Read back by the shader, the map restores the ridges and bumps the "
+            f"decimation removed.",
+            LAB,
+        )
+    )
+    img = panels(
+        shots["key"] + shots["grazing"],
+        [c + " — key + fill" for c in caps] + [c + " — grazing light" for c in caps],
+        ncols=3,
+        title="The baked rock under two lighting set-ups",
+    )
+    figs.append(
+        Figure(
+            save_png(out / "bake_lighting.png", img),
+            "The same three rocks lit from above-front (key and fill, top row) and by a single grazing light from the "
+            "side (bottom row). The baked normals respond to the light like the real geometry does; only the "
+            "silhouette (the rock's outline, the plinth's corners) gives the simplified mesh away.",
+            LAB,
+        )
+    )
+    return figs
+
+
+def make_figures(out_dir: Path, lab: str | None = None, quick: bool = False) -> list[Figure]:
+    """Render the lab's figures into ``out_dir`` and return them with captions.
+
+    Parameters
+    ----------
+    out_dir : Path
+        Folder for the PNG files (created).
+    lab : str, optional
+        Ignored (the figures command passes it for some labs).
+    quick : bool
+        Smaller images and meshes (for the notebook and tests).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    figs = _fig_mapped_vs_displaced(out, quick)
+    figs.append(_fig_bias_scale(out, quick))
+    figs.extend(_fig_bake(out, quick))
+    return figs

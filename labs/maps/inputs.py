@@ -1,0 +1,201 @@
+"""Given helpers: input checks shared by every function of the lab (not a task).
+
+Conventions of the whole lab (see ``geomlib.textures`` for the UV/image convention):
+
+* UV space is ``[0, 1]^2``, ``u`` right, ``v`` up; image row 0 is ``v = 1``.
+* Every map of this lab (normal map, height map, displacement map) is a SQUARE image of
+  ``s x s`` texels, so a texel has the same extent ``1 / s`` in ``u`` and ``v``.
+* Tangent-space normal maps hold unit vectors ``(x, y, z)``: ``x`` along the tangent ``T``
+  (direction of increasing ``u``), ``y`` along the bitangent ``B`` (increasing ``v``), ``z`` along
+  the surface normal ``N``; an undisturbed surface is ``(0, 0, 1)``.
+* Tangents follow glTF / pyrender: an ``(n, 4)`` array ``[T, w]`` with ``B = w (N x T)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float
+
+__all__ = [
+    "check_uv",
+    "as_unit_vectors",
+    "as_height_map",
+    "as_normal_map",
+    "as_encoded_map",
+    "as_tangents",
+    "check_lights",
+    "normalize_rows",
+    "fallback_perpendicular",
+]
+
+#: UV values this far outside [0, 1] still count as inside (round-off of exporters).
+UV_SLACK = 1e-9
+
+
+def normalize_rows(X: np.ndarray, fallback=None) -> np.ndarray:
+    """Unit vectors along the last axis; zero-length rows become ``fallback`` (or stay zero).
+
+    Never divides by zero, so no NaN.
+    """
+    X = np.asarray(X)
+    if X.dtype.kind != "f":
+        X = X.astype(np.float64)
+    n = np.sqrt(np.einsum("...i,...i->...", X, X))[..., None]
+    zero = n == 0
+    out = X / np.where(zero, 1.0, n)
+    if fallback is not None and zero.any():
+        out[zero[..., 0]] = np.asarray(fallback, dtype=X.dtype)
+    return out
+
+
+def fallback_perpendicular(N: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to each unit row of ``N`` (deterministic).
+
+    Uses the coordinate axis least aligned with ``N``: ``e - (N . e) N``, normalised.
+    """
+    axis = np.argmin(np.abs(N), axis=-1)
+    E = np.zeros_like(N)
+    np.put_along_axis(E, axis[..., None], 1.0, axis=-1)
+    T = E - np.sum(N * E, axis=-1, keepdims=True) * N
+    return normalize_rows(T, fallback=(1.0, 0.0, 0.0))
+
+
+def check_uv(UV, n: int, where: str, *, in_range: bool = False, name: str = "UV") -> np.ndarray:
+    """Texture coordinates ``(n, 2)`` float64, one row per vertex; optionally inside ``[0, 1]^2``."""
+    if UV is None:
+        raise MeshError(
+            f"{where}: {name} is missing; this function needs texture coordinates, one (u, v) row per vertex"
+        )
+    UV = as_array(UV, name, shape=(None, 2), where=where)
+    if len(UV) != n:
+        raise MeshError(f"{where}: {name} has {len(UV)} rows but V has {n}; expected one (u, v) per vertex")
+    if in_range:
+        bad = (UV < -UV_SLACK) | (UV > 1 + UV_SLACK)
+        if bad.any():
+            r = int(np.flatnonzero(bad.any(axis=1))[0])
+            raise MeshError(
+                f"{where}: {name} row {r} is ({UV[r, 0]:.6g}, {UV[r, 1]:.6g}), outside the texture square [0, 1]^2 "
+                f"({int(bad.any(axis=1).sum())} rows are out of range)"
+            )
+    return UV
+
+
+def as_unit_vectors(N, n: int, where: str, name: str = "N") -> np.ndarray:
+    """Per-vertex directions ``(n, 3)``, normalised; zero rows are an error."""
+    N = as_array(N, name, shape=(None, 3), where=where)
+    if len(N) != n:
+        raise MeshError(f"{where}: {name} has {len(N)} rows but V has {n}; expected one normal per vertex")
+    length = np.linalg.norm(N, axis=1)
+    if (length == 0).any():
+        raise MeshError(f"{where}: {name} row {int(np.flatnonzero(length == 0)[0])} is the zero vector")
+    return N / length[:, None]
+
+
+def _square(img: np.ndarray, name: str, where: str) -> None:
+    if img.shape[0] != img.shape[1]:
+        raise MeshError(
+            f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; maps in this lab are square (s x s texels)"
+        )
+
+
+def as_height_map(H, where: str, name: str = "height", *, unit_range: bool = False) -> np.ndarray:
+    """A square single-channel height map as float64 ``(s, s)``.
+
+    uint8 and uint16 images are scaled to ``[0, 1]`` (black = 0); float maps are used as they are
+    and, with ``unit_range``, must lie in ``[0, 1]``.
+    """
+    img = as_image(H, name, where=where)
+    if img.ndim == 3:
+        raise MeshError(
+            f"{where}: {name} has {img.shape[2]} channels (shape {img.shape}); expected a single-channel (grey) "
+            f"height map (s, s)"
+        )
+    _square(img, name, where)
+    if img.dtype == np.uint8:
+        return img.astype(np.float64) / 255.0
+    if img.dtype == np.uint16:
+        return img.astype(np.float64) / 65535.0
+    if img.dtype.kind not in "iuf":
+        raise MeshError(f"{where}: {name} has dtype {img.dtype}, expected floats, uint8 or uint16")
+    out = as_array(img, name, dtype=np.float64, where=where)
+    if unit_range and (out.min() < 0 or out.max() > 1):
+        raise MeshError(
+            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; a displacement map holds values in [0, 1] "
+            f"(use bias and scale to map them to offsets)"
+        )
+    return out
+
+
+def as_encoded_map(img, where: str, name: str = "img") -> np.ndarray:
+    """A square 8-bit RGB image ``(s, s, 3)`` uint8 (an encoded normal map)."""
+    a = as_image(img, name, where=where)
+    if a.ndim != 3 or a.shape[2] != 3:
+        c = 1 if a.ndim == 2 else a.shape[2]
+        raise MeshError(f"{where}: {name} has {c} channel(s) (shape {a.shape}); a normal map is an RGB image (s, s, 3)")
+    if a.dtype != np.uint8:
+        raise MeshError(f"{where}: {name} has dtype {a.dtype}; an encoded normal map is uint8 (0..255)")
+    _square(a, name, where)
+    return a
+
+
+def as_normal_map(img, where: str, name: str = "normal_map") -> np.ndarray:
+    """A square tangent-space normal map as float64 ``(s, s, 3)`` vectors (not yet normalised).
+
+    uint8 images are decoded with the affine part of the encoding, ``n = 2 rgb / 255 - 1``; float
+    images are taken as vectors. Normalise after interpolation, as a GPU does.
+    """
+    a = as_image(img, name, where=where)
+    if a.ndim != 3 or a.shape[2] != 3:
+        c = 1 if a.ndim == 2 else a.shape[2]
+        raise MeshError(f"{where}: {name} has {c} channel(s) (shape {a.shape}); a normal map is an RGB image (s, s, 3)")
+    _square(a, name, where)
+    if a.dtype == np.uint8:
+        return a.astype(np.float64) * (2.0 / 255.0) - 1.0
+    if a.dtype.kind != "f":
+        raise MeshError(f"{where}: {name} has dtype {a.dtype}; expected uint8 (encoded) or floats (unit vectors)")
+    return as_array(a, name, dtype=np.float64, where=where)
+
+
+def as_tangents(T, n: int, where: str, name: str = "tangents") -> np.ndarray:
+    """Per-vertex tangents ``(n, 4)`` ``[T, w]`` in glTF / pyrender convention (``w`` = +-1)."""
+    T = as_array(T, name, shape=(None, 4), where=where)
+    if len(T) != n:
+        raise MeshError(f"{where}: {name} has {len(T)} rows but V has {n}; expected one [T, w] row per vertex")
+    return T
+
+
+def check_lights(lights, where: str) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """Validate light dicts; return ``(kind, vector, rgb * intensity)`` per light.
+
+    Each light is a dict with ``"type"`` (``"directional"``, default, or ``"point"``),
+    ``"direction"`` (directional: the way the light TRAVELS, e.g. ``(0, 0, -1)`` shines down -z)
+    or ``"position"`` (point light, no fall-off), optional ``"color"`` (RGB in [0, 1], default
+    white) and ``"intensity"`` (>= 0, default 1).
+    """
+    if isinstance(lights, dict):
+        lights = [lights]
+    if not isinstance(lights, list | tuple) or len(lights) == 0:
+        raise MeshError(f"{where}: lights must be a non-empty list of light dicts, got {lights!r}")
+    out = []
+    for i, s in enumerate(lights):
+        if not isinstance(s, dict):
+            raise MeshError(f"{where}: lights[{i}] must be a dict, got {s!r}")
+        extra = sorted(set(s) - {"type", "direction", "position", "color", "intensity"})
+        if extra:
+            raise MeshError(f"{where}: lights[{i}] has unknown keys {extra}")
+        kind = check_choice(s.get("type", "directional"), f"lights[{i}]['type']", ("directional", "point"), where=where)
+        key = "direction" if kind == "directional" else "position"
+        if key not in s:
+            raise MeshError(f"{where}: lights[{i}] is a {kind} light and needs a '{key}'")
+        vec = as_array(s[key], f"lights[{i}]['{key}']", shape=(3,), where=where)
+        if kind == "directional":
+            if not np.any(vec):
+                raise MeshError(f"{where}: lights[{i}]['direction'] is the zero vector")
+            vec = vec / np.linalg.norm(vec)
+        color = as_array(s.get("color", (1.0, 1.0, 1.0)), f"lights[{i}]['color']", shape=(3,), where=where)
+        if color.min() < 0:
+            raise MeshError(f"{where}: lights[{i}]['color'] has a negative component")
+        inten = check_float(s.get("intensity", 1.0), f"lights[{i}]['intensity']", minimum=0.0, where=where)
+        out.append((kind, vec, color * inten))
+    return out

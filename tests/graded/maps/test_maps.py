@@ -1,0 +1,344 @@
+"""Graded tests of the lab "maps": stored references plus hand-checkable cases, identities and bad input.
+
+Expected values here are worked out by hand (comments) or are closed forms; none comes from the
+solution.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets
+from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading.checks import format_vec
+from geomlib.grading.errors import Mismatch
+
+from .cases import CASES, LIGHT, quad_gbuffer, texel_uv, unit_vectors, wave
+
+test_references = reference_tests(CASES)
+
+
+def unit(x):
+    x = np.asarray(x, float)
+    return x / np.linalg.norm(x, axis=-1, keepdims=True)
+
+
+def expect(condition: bool, message: str) -> None:
+    if not condition:
+        raise Mismatch(message)
+
+
+def expect_map_close(label: str, got, expected, atol: float, hint: str | None = None) -> None:
+    """Per-texel comparison of (h, w, c) maps; the message names the first texel that differs."""
+    e = np.asarray(expected, float)
+    g = np.asarray(got, float)
+    if g.shape != e.shape:
+        raise Mismatch(f"{label}: result has shape {g.shape}, expected {e.shape}")
+    per = np.abs(g - e).max(axis=-1)
+    bad = ~(per <= atol)  # NaN counts as bad
+    if bad.any():
+        r, c = (int(i) for i in np.argwhere(bad)[0])
+        raise Mismatch(
+            f"{label}: [{r}, {c}] expected {format_vec(e[r, c])}, got {format_vec(g[r, c])}; {int(bad.sum())} of "
+            f"{bad.size} texels differ by more than {atol:g}" + (f" — {hint}" if hint else "")
+        )
+
+
+# ------------------------------------------------------------------------------ tangent frames
+
+
+@graded(points=1, part="tangent frames")
+def test_one_triangle_by_hand(lab):
+    """one triangle: T along +u, B along +v, w = +1"""
+    # P1 - P0 = (2, 0, 0) with du = 1, P2 - P0 = (0, 1, 0) with dv = 1: dP/du = (2, 0, 0), dP/dv = (0, 1, 0).
+    V = np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0.0]])
+    T, B, N, w = lab.tangent_frames(V, [[0, 1, 2]], [[0, 0], [1, 0], [0, 1]])
+    expect_close("tangent_frames T on one triangle", T, np.tile([1.0, 0, 0], (3, 1)), atol=1e-12)
+    expect_close("tangent_frames B on one triangle", B, np.tile([0.0, 1, 0], (3, 1)), atol=1e-12)
+    expect_close("tangent_frames N on one triangle", N, np.tile([0.0, 0, 1], (3, 1)), atol=1e-12)
+    expect_close("tangent_frames w on one triangle", w, np.ones(3), atol=0, hint="w = sign((N x T) . B_sum)")
+
+
+@graded(points=1, part="tangent frames")
+def test_mirrored_uvs_flip_w(lab):
+    """mirrored UVs (u -> 1 - u) give w = -1 and T = -x, while B still points along +v"""
+    V, F, UV = datasets.uv_grid(3)
+    UVm = UV.copy()
+    UVm[:, 0] = 1.0 - UVm[:, 0]
+    T, B, N, w = lab.tangent_frames(V, F, UVm)
+    expect_close(
+        "tangent_frames w with mirrored UVs",
+        w,
+        -np.ones(len(V)),
+        atol=0,
+        hint="the UV triangles run clockwise: det < 0",
+    )
+    expect_close("tangent_frames T with mirrored UVs", T, np.tile([-1.0, 0, 0], (len(V), 1)), atol=1e-12)
+    expect_close(
+        "tangent_frames B with mirrored UVs", B, np.tile([0.0, 1, 0], (len(V), 1)), atol=1e-12, hint="B = w (N x T)"
+    )
+
+
+@graded(points=1, part="tangent frames")
+def test_frames_are_orthonormal_without_nan(lab):
+    """random and partly degenerate UVs: unit T, B, N, T . N = 0, B = w N x T, no NaN"""
+    V, F = datasets.icosphere(2)
+    UV = np.random.default_rng(0).random((len(V), 2))
+    UV[F[:6].ravel()] = 0.3
+    T, B, N, w = (np.asarray(a, float) for a in lab.tangent_frames(V, F, UV))
+    expect(
+        np.isfinite(T).all() and np.isfinite(B).all() and np.isfinite(N).all(),
+        "tangent_frames returned NaN or inf (degenerate UV triangles must be skipped)",
+    )
+    for name, X in (("T", T), ("B", B), ("N", N)):
+        expect_close(f"tangent_frames |{name}|", np.linalg.norm(X, axis=1), np.ones(len(V)), atol=1e-9)
+    expect_close(
+        "tangent_frames T . N", np.sum(T * N, axis=1), np.zeros(len(V)), atol=1e-9, hint="Gram-Schmidt: T - (N . T) N"
+    )
+    expect_close("tangent_frames B - w N x T", B - w[:, None] * np.cross(N, T), np.zeros_like(B), atol=1e-9)
+
+
+# ------------------------------------------------------------------------------ encode / decode
+
+
+@graded(points=1, part="encode/decode")
+def test_codes_by_hand(lab):
+    """(0, 0, 1) -> (128, 128, 255), (1, 0, 0) -> (255, 128, 128), (-1, 0, 0) -> (0, 128, 128)"""
+    # 255 (x + 1) / 2: -1 -> 0, 0 -> 127.5 -> 128, +1 -> 255.
+    n = np.array([[[0, 0, 1.0], [1, 0, 0]], [[-1, 0, 0], [0, -1, 0]]])
+    img = np.asarray(lab.encode_normal_map(n))
+    expect(img.dtype == np.uint8, f"encode_normal_map should return uint8, got {img.dtype}")
+    expect_map_close(
+        "encode_normal_map on axis directions",
+        img,
+        [[[128, 128, 255], [255, 128, 128]], [[0, 128, 128], [128, 0, 128]]],
+        atol=0,
+    )
+
+
+@graded(points=1, part="encode/decode")
+def test_decode_by_hand(lab):
+    """decode (255, 128, 128) = normalize(1, 1/255, 1/255)"""
+    got = lab.decode_normal_map(np.array([[[255, 128, 128]]], np.uint8))
+    expect_close(
+        "decode_normal_map((255, 128, 128))",
+        got,
+        unit([[[1.0, 1 / 255, 1 / 255]]]),
+        atol=1e-12,
+        hint="n = normalize(2 rgb / 255 - 1)",
+    )
+
+
+@graded(points=2, part="encode/decode")
+def test_round_trip_within_one_code(lab):
+    """decode(encode(n)) is within 1/255 of n in every component (random directions)"""
+    n = unit_vectors((96, 96), 4)
+    back = np.asarray(lab.decode_normal_map(lab.encode_normal_map(n)), float)
+    err = np.abs(back - n).max()
+    expect(
+        err <= 1.0 / 255.0,
+        f"decode(encode(n)) is off by up to {err * 255:.3f}/255 in a component, allowed 1/255 — plain rounding gets "
+        f"about 1.3/255 after renormalising: try the 8 floor/ceil codes around 255 (n + 1) / 2 and keep the one "
+        f"that decodes closest to n",
+    )
+
+
+# ------------------------------------------------------------------------------ height -> normals
+
+
+@graded(points=1, part="height to normals")
+def test_ramp_by_hand(lab):
+    """H = u (rising to the right), strength 0.5: n = normalize(-0.5, 0, 1) inside"""
+    u, v = texel_uv(8)
+    n = np.asarray(lab.height_to_normal_map(u, 0.5), float)
+    # dH/du = 1 exactly for a ramp: n = (-0.5, 0, 1) / sqrt(1.25).
+    expect_close("height_to_normal_map(H = u)[3, 3]", n[3, 3], unit([-0.5, 0.0, 1.0]), atol=1e-12)
+
+
+@graded(points=1, part="height to normals")
+def test_v_points_up(lab):
+    """H = v (higher towards row 0, the top of the image): the normal leans to -y"""
+    u, v = texel_uv(8)
+    n = np.asarray(lab.height_to_normal_map(v, 0.5), float)
+    expect_close(
+        "height_to_normal_map(H = v)[3, 3]",
+        n[3, 3],
+        unit([0.0, -0.5, 1.0]),
+        atol=1e-12,
+        hint="v grows upwards: dH/dv = (H[r - 1, c] - H[r + 1, c]) s / 2",
+    )
+
+
+@graded(points=1, part="height to normals")
+def test_matches_the_analytic_gradient(lab):
+    """a smooth wave h(u, v): normals within 1e-3 of the exact ones (central differences are second order)"""
+    s, k = 64, 0.1
+    u, v = texel_uv(s)
+    hu = np.pi * np.cos(2 * np.pi * u) * np.cos(2 * np.pi * v)
+    hv = -np.pi * np.sin(2 * np.pi * u) * np.sin(2 * np.pi * v)
+    exact = unit(np.stack([-k * hu, -k * hv, np.ones_like(u)], axis=-1))
+    expect_map_close(
+        "height_to_normal_map(wave) vs exact normals",
+        lab.height_to_normal_map(wave(s), k, "wrap"),
+        exact,
+        atol=1e-3,
+        hint="n = normalize(-k dH/du, -k dH/dv, 1); check the signs and that v grows towards row 0",
+    )
+
+
+# ------------------------------------------------------------------------------ shading
+
+
+@graded(points=1, part="shading")
+def test_lambert_by_hand(lab):
+    """light at 60 degrees, no ambient, no specular: colour = albedo * cos 60 = albedo / 2"""
+    g, eye = quad_gbuffer(8)
+    d = (np.sin(np.pi / 3), 0.0, -np.cos(np.pi / 3))
+    img = np.asarray(lab.shade(g, [{"direction": d}], eye, (0.8, 0.6, 0.4), ambient=0.0, specular=0.0), float)
+    expect_close(
+        "shade: Lambert term",
+        img[g.mask],
+        np.tile([0.4, 0.3, 0.2], (int(g.mask.sum()), 1)),
+        atol=1e-5,
+        hint="diffuse = albedo max(n . l, 0) with l = -direction",
+    )
+    expect_close("shade: background pixels", img[~g.mask], np.ones((int((~g.mask).sum()), 3)), atol=0)
+
+
+@graded(points=1, part="shading")
+def test_flat_normal_map_changes_nothing(lab):
+    """a normal map full of (0, 0, 1) gives the same image as no normal map"""
+    g, eye = quad_gbuffer(16)
+    plain = lab.shade(g, LIGHT, eye, (0.7, 0.7, 0.7))
+    flat = lab.shade(g, LIGHT, eye, (0.7, 0.7, 0.7), np.tile([0.0, 0.0, 1.0], (4, 4, 1)))
+    expect_map_close(
+        "shade with a flat normal map vs without", flat, plain, atol=1e-5, hint="tangent space (0, 0, 1) is N'"
+    )
+
+
+@graded(points=2, part="shading")
+def test_normal_mapped_quad_matches_the_closed_form(lab):
+    """wave relief z = 0.05 h: shading with the exact normals as a float map agrees with Lambert by hand"""
+    s, k = 32, 0.05
+    u, v = texel_uv(s)
+    hu = np.pi * np.cos(2 * np.pi * u) * np.cos(2 * np.pi * v)
+    hv = -np.pi * np.sin(2 * np.pi * u) * np.sin(2 * np.pi * v)
+    m = unit(np.stack([-k * hu, -k * hv, np.ones_like(u)], axis=-1))
+    g, eye = quad_gbuffer(s)  # one pixel per texel, at the texel centres
+    img = np.asarray(
+        lab.shade(g, [{"direction": (0, 0, -1)}], eye, (1.0, 1.0, 1.0), m, ambient=0.0, specular=0.0), float
+    )
+    # Light straight down: colour = n . (0, 0, 1) = m_z (T = x, B = y, N = z on this quad).
+    expect_map_close(
+        "shade: normal-mapped quad, light from above",
+        img[..., :1],
+        m[..., 2:],
+        atol=1e-5,
+        hint="n = normalize(m_x T' + m_y B' + m_z N')",
+    )
+
+
+# ------------------------------------------------------------------------------ displacement
+
+
+@graded(points=1, part="displacement")
+def test_constant_map_by_hand(lab):
+    """constant h = 0.75, (bias, scale) = (-1, 2), lam = 0.1, radial normals: radius 1 + 0.1 (-1 + 1.5) = 1.05"""
+    V, F, UV = datasets.uv_sphere(8, 16)
+    Vd = np.asarray(lab.displace(V, F, UV, V, np.full((4, 4), 0.75), lam=0.1, bias=-1.0, scale=2.0), float)
+    expect_close(
+        "displace: radius after a constant offset", np.linalg.norm(Vd, axis=1), np.full(len(V), 1.05), atol=1e-12
+    )
+
+
+@graded(points=1, part="displacement")
+def test_seam_copies_move_together(lab):
+    """UV sphere with a random map: vertices that share a position still share it after displacement"""
+    V, F, UV = datasets.uv_sphere(8, 16)
+    H = np.random.default_rng(1).random((16, 16))
+    Vd = np.asarray(lab.displace(V, F, UV, None, H, lam=0.2), float)
+    key = np.round(V, 9)
+    _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    gap = np.linalg.norm(Vd - Vd[first][inv.ravel()], axis=1).max()
+    expect(
+        gap < 1e-12,
+        f"displace: copies of a seam vertex end up {gap:.3g} apart (the seam cracks open); average their offsets and normals when weld_seams=True",
+    )
+
+
+# ------------------------------------------------------------------------------ baking
+
+
+@graded(points=2, part="baking")
+def test_baked_height_field_matches_exact_normals(lab):
+    """relief z = 0.05 h baked onto the flat square: within 1 degree of the exact normals"""
+    from .cases import bake_flat_inputs
+
+    args = bake_flat_inputs()
+    n = np.asarray(lab.bake_normal_map(**args, size=32), float)
+    s, k = 32, 0.05
+    u, v = texel_uv(s)
+    hu = np.pi * np.cos(2 * np.pi * u) * np.cos(2 * np.pi * v)
+    hv = -np.pi * np.sin(2 * np.pi * u) * np.sin(2 * np.pi * v)
+    exact = unit(np.stack([-k * hu, -k * hv, np.ones_like(u)], axis=-1))
+    ang = np.degrees(np.arccos(np.clip(np.sum(unit(n) * exact, axis=-1), -1, 1)))
+    expect(
+        ang.max() < 1.0,
+        f"bake_normal_map: baked normals are up to {ang.max():.2f} degrees off the exact ones (allowed 1)",
+    )
+
+
+# ------------------------------------------------------------------------------ bad input (given validation)
+
+
+@graded(points=0, part="bad input")
+def test_missing_uvs(lab):
+    """tangent_frames without UVs says UV is missing"""
+    V, F, _ = datasets.uv_grid(2)
+    expect_raises(
+        lambda: lab.tangent_frames(V, F, None), "MeshError", match="UV is missing", label="tangent_frames(UV=None)"
+    )
+
+
+@graded(points=0, part="bad input")
+def test_uv_out_of_range(lab):
+    """displace with UVs outside [0, 1] names the row"""
+    V, F, UV = datasets.uv_grid(2)
+    expect_raises(
+        lambda: lab.displace(V, F, UV + 2.0, None, np.zeros((4, 4))),
+        "MeshError",
+        match="outside the texture square",
+        label="displace(UV + 2)",
+    )
+
+
+@graded(points=0, part="bad input")
+def test_non_square_map(lab):
+    """a non-square height map is rejected"""
+    expect_raises(
+        lambda: lab.height_to_normal_map(np.zeros((8, 6))),
+        "MeshError",
+        match="square",
+        label="height_to_normal_map(8x6)",
+    )
+
+
+@graded(points=0, part="bad input")
+def test_wrong_image_modes(lab):
+    """decode needs uint8 RGB; shade needs an RGB normal map"""
+    expect_raises(
+        lambda: lab.decode_normal_map(np.zeros((4, 4, 4), np.uint8)),
+        "MeshError",
+        match="4 channel",
+        label="decode_normal_map(RGBA)",
+    )
+    expect_raises(
+        lambda: lab.decode_normal_map(np.zeros((4, 4, 3))), "MeshError", match="uint8", label="decode_normal_map(float)"
+    )
+    g, eye = quad_gbuffer(4)
+    expect_raises(
+        lambda: lab.shade(g, LIGHT, eye, (1, 1, 1), np.zeros((4, 4))),
+        "MeshError",
+        match="1 channel",
+        label="shade(grey normal map)",
+    )
