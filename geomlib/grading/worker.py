@@ -147,6 +147,9 @@ def run_call(conn, lab_dir: str, lab: str, function: str, args, kwargs, memory_m
         fd = os.open(out_path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         os.dup2(fd, 1)
         os.dup2(fd, 2)
+        # pytest's capture (and notebooks) replace sys.stdout with objects that bypass fd 1.
+        sys.stdout = open(1, "w", closefd=False, errors="replace")  # noqa: SIM115
+        sys.stderr = open(2, "w", closefd=False, errors="replace")  # noqa: SIM115
         _limit_resources(memory_mb, cpu_s)
         os.chdir(lab_path)
         _drop_privileges()

@@ -23,7 +23,9 @@ def sample_course() -> Path:
     root = base / "course"
     shutil.copytree(SAMPLE, root, ignore=shutil.ignore_patterns("__pycache__"))
     # The release ships the course's own geomlib: give the sample course a copy of ours.
-    shutil.copytree(Path(__file__).parents[2] / "geomlib", root / "geomlib", ignore=shutil.ignore_patterns("__pycache__", "READY"))
+    shutil.copytree(
+        Path(__file__).parents[2] / "geomlib", root / "geomlib", ignore=shutil.ignore_patterns("__pycache__", "READY")
+    )
     run_geomlib(root, "refs", "build")
     run_geomlib(root, "stubs", "build")
     yield root

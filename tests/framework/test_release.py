@@ -48,13 +48,20 @@ def test_student_bundle_grades_its_stubs_to_zero_without_errors(release):
     env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
     env.update(PYTHONPATH=str(student), GEOMLIB_NO_FEEDBACK_PICTURES="1")
     p = subprocess.run(
-        [sys.executable, "-m", "geomlib.cli", "grade", "--results", "r.json"], cwd=student, env=env, capture_output=True, text=True, timeout=300
+        [sys.executable, "-m", "geomlib.cli", "grade", "--results", "r.json"],
+        cwd=student,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert p.returncode == 0, p.stdout + p.stderr
     r = json.loads((student / "r.json").read_text())
     validate_results(r)
     assert r["score"] == 0 and r["tests"]
-    assert all(t["status"] == "failed" and "not implemented yet" in t["output"] for t in r["tests"] if t["max_score"] > 0)
+    assert all(
+        t["status"] == "failed" and "not implemented yet" in t["output"] for t in r["tests"] if t["max_score"] > 0
+    )
     assert "geomlib-sample" not in p.stdout  # it graded its own copy, not the instructors' course
 
 
