@@ -123,7 +123,7 @@ def torus_scene(size: int, s_map: int):
 def pyrender_frame(V, F, UV, N, tangents, nmap, view, size: int):
     from geomlib import render as grender
 
-    pyrender = grender._pyrender()
+    pyrender = grender.import_pyrender()
     mat = pyrender.MetallicRoughnessMaterial(
         baseColorFactor=[0.8, 0.7, 0.6, 1.0],
         metallicFactor=0.0,

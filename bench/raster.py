@@ -18,9 +18,9 @@ import trimesh
 
 from geomlib.camera import camera_presets, look_at, perspective
 from geomlib.raster import rasterize
-from geomlib.render import _pyrender  # headless platform + the project's one NumPy-2 shim for pyrender
+from geomlib.render import import_pyrender  # headless platform + the project's one NumPy-2 shim for pyrender
 
-pyrender = _pyrender()
+pyrender = import_pyrender()
 FOV = 40.0
 
 

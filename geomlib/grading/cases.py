@@ -136,29 +136,41 @@ def load_reference(lab: str, case: Case) -> dict:
 
 
 def inputs_digest(inputs: dict, params: dict) -> str:
-    """A stable hash of a case's inputs, so `refs check` can tell changed inputs from changed outputs."""
+    """A stable hash of a case's inputs, so `refs check` can tell changed inputs from changed outputs.
+
+    Arrays are hashed by dtype, shape and bytes; lists, tuples and dicts recursively; anything else
+    by ``repr`` (dataclasses of arrays included, field by field).
+    """
+    import dataclasses
+
     h = hashlib.sha256()
-    for key in sorted(inputs):
-        h.update(key.encode())
-        v = inputs[key]
-        if (
-            isinstance(v, np.ndarray)
-            or isinstance(v, list | tuple)
-            and v
-            and isinstance(v[0], np.ndarray | list | tuple)
-        ):
-            try:
-                a = np.ascontiguousarray(np.asarray(v))
-                if a.dtype != object:
-                    h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
-                    continue
-            except ValueError:
-                pass
+
+    def feed(v) -> None:
+        if isinstance(v, np.ndarray | np.generic):
+            a = np.ascontiguousarray(v)
+            if a.dtype == object:
+                for item in a.ravel():
+                    feed(item)
+                return
+            h.update(f"nd:{a.dtype}:{a.shape}:".encode() + a.tobytes())
+        elif isinstance(v, list | tuple):
+            h.update(f"seq{len(v)}(".encode())
             for item in v:
-                a = np.ascontiguousarray(np.asarray(item))
-                h.update(str(a.dtype).encode() + str(a.shape).encode() + a.tobytes())
+                feed(item)
+            h.update(b")")
+        elif isinstance(v, dict):
+            h.update(b"{")
+            for k in sorted(v, key=str):
+                h.update(repr(k).encode())
+                feed(v[k])
+            h.update(b"}")
+        elif dataclasses.is_dataclass(v) and not isinstance(v, type):
+            h.update(type(v).__name__.encode())
+            feed({f.name: getattr(v, f.name) for f in dataclasses.fields(v)})
         else:
             h.update(repr(v).encode())
+
+    feed(inputs)
     h.update(json.dumps(params, sort_keys=True, default=str).encode())
     return h.hexdigest()
 

@@ -389,7 +389,7 @@ def test_normal_mapped_quad_equals_displaced_grid_equals_analytic():
 def _pyrender_plane(enc, UV, tangents, eye, light_dir, size):
     from geomlib import render as grender
 
-    pyrender = grender._pyrender()  # chooses the headless platform and applies the project's one shim
+    pyrender = grender.import_pyrender()  # chooses the headless platform and applies the project's one shim
     V, F, _ = datasets.uv_grid(1)
     V = V - [0.5, 0.5, 0.0]
     mat = pyrender.MetallicRoughnessMaterial(

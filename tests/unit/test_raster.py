@@ -579,9 +579,9 @@ def test_matches_pyrender_pixel_for_pixel():
     # An independent rasterizer (Mesa through pyrender) with the same conventions: same covered pixels,
     # same depth up to its depth-buffer precision, also with the camera low over a floor that runs
     # behind it (near-plane clipping).
-    from geomlib.render import _pyrender
+    from geomlib.render import import_pyrender
 
-    pyrender = _pyrender()
+    pyrender = import_pyrender()
     import trimesh
 
     s = trimesh.creation.icosphere(subdivisions=2)

@@ -1,0 +1,115 @@
+"""Task 8: per-quad diagonals that follow sharp edges.
+
+Each grid cell becomes two triangles. With one global split (every cell cut along ``a-c``) a crease
+running along the other diagonal ``b-d`` is cut off in every cell it crosses, leaving a zig-zag.
+Per cell we therefore choose the split whose triangles stay closest to the surface, but only in
+cells that a sharp edge crosses (elsewhere the global default is kept, so smooth regions stay
+regular).
+
+Error of a split: the grid vertices' surface points ``P_k = p(g_k)`` are the corners of the flat
+triangles; we put a few sample points ``sum l_k P_k`` on each flat triangle (centroid and three
+points toward the corners) and add up their squared distances to the original mesh (closest
+point, ``geomlib.geometry.closest_points``). The split with the smaller sum wins. A crease running
+along ``a-c`` gives zero error for the ``a-c`` split, while the ``b-d`` split cuts the crease's
+corner off and its triangles sink below the surface.
+
+A split whose triangles are not both positive in uv (possible after alignment made a cell
+non-convex) is never chosen.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.geometry import closest_points
+from geomlib.validate import MeshError, as_array, check_mesh
+
+from .grid import split_ok, valid_diagonals
+from .sampling import sample_surface
+from .segments import segment_intersections
+
+__all__ = ["crossed_cells", "choose_diagonals"]
+
+# Barycentric sample points inside a triangle: the centroid and three points toward the corners.
+_SAMPLES = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
+
+def crossed_cells(grid_uv: np.ndarray, S0: np.ndarray, S1: np.ndarray) -> np.ndarray:
+    """Cells ``(res-1, res-1)`` whose interior a uv segment ``S0-S1`` passes through (given helper).
+
+    A segment crosses a cell when it meets one of the cell's diagonals strictly between the
+    diagonal's ends (a segment running *along* a cell side touches the diagonals only at corners).
+    """
+    g = np.asarray(grid_uv, np.float64)
+    res = g.shape[0]
+    a, b, c, d = (x.reshape(-1, 2) for x in (g[:-1, :-1], g[:-1, 1:], g[1:, 1:], g[1:, :-1]))
+    crossed = np.zeros(len(a), bool)
+    for P0, P1 in ((a, c), (b, d)):
+        ip, _, t, _, _ = segment_intersections(P0, P1, S0, S1)
+        inner = (t > 1e-9) & (t < 1 - 1e-9)
+        crossed[ip[inner]] = True
+    return crossed.reshape(res - 1, res - 1)
+
+
+def choose_diagonals(grid_uv, V, F, UV, edges, *, default: bool = True) -> np.ndarray:
+    """Per-cell diagonal: True = split along ``a-c`` (triangles abc, acd), False = ``b-d`` (abd, bcd).
+
+    Parameters
+    ----------
+    grid_uv : (res, res, 2) float64
+        Grid positions in uv (cell ``(i, j)`` has corners ``a=(i,j)``, ``b=(i,j+1)``,
+        ``c=(i+1,j+1)``, ``d=(i+1,j)``).
+    V, F : triangle mesh
+    UV : (n, 2) float64
+        The mesh's parameterization.
+    edges : (k, 2) int64
+        Sharp edges (from :func:`sharp_features`).
+    default : bool
+        Diagonal of cells that no sharp edge crosses (unless only the other split gives two positive
+        triangles there, see :func:`valid_diagonals`).
+
+    Returns
+    -------
+    diagonals : (res-1, res-1) bool
+    """
+    where = "choose_diagonals"
+    G = as_array(grid_uv, "grid_uv", shape=(None, None, 2), where=where)
+    res = G.shape[0]
+    if G.shape[1] != res or res < 2:
+        raise MeshError(f"{where}: grid_uv has shape {G.shape}; expected (res, res, 2) with res >= 2")
+    V, F = check_mesh(V, F, where=where)
+    UV = as_array(UV, "UV", shape=(len(V), 2), where=where)
+    edges = as_array(edges, "edges", shape=(None, 2), dtype=np.int64, where=where)
+    if edges.size and (edges.min() < 0 or edges.max() >= len(V)):
+        raise MeshError(f"{where}: edges hold vertex indices outside 0..{len(V) - 1}")
+    diag = valid_diagonals(G, default)
+    if len(edges) == 0:
+        return diag
+    # BEGIN SOLUTION: Task 8 (diagonals): in cells a sharp edge crosses, the split with the smaller surface deviation
+    cross = crossed_cells(G, UV[edges[:, 0]], UV[edges[:, 1]])
+    ci, cj = np.nonzero(cross)
+    if len(ci) == 0:
+        return diag
+    P = sample_surface(V, F, UV, G)  # surface point at every grid vertex
+    corner = {"a": (ci, cj), "b": (ci, cj + 1), "c": (ci + 1, cj + 1), "d": (ci + 1, cj)}
+
+    # Sample points on the flat triangles of both splits, measured to the mesh in one query.
+    splits = (("abc", "cda"), ("dab", "bcd"))  # a-c split, b-d split
+    flat = np.stack(
+        [
+            np.einsum("sk,qkd->qsd", _SAMPLES, np.stack([P[corner[k]] for k in tri], axis=1))
+            for sp in splits
+            for tri in sp
+        ],
+        axis=1,
+    )  # (q, 4 triangles, samples, 3)
+    sq, _, _ = closest_points(V, F, flat.reshape(-1, 3))
+    sq = sq.reshape(len(ci), 2, -1).sum(axis=2)  # (q, 2): squared deviation of each split
+    e_ac, e_bd = sq[:, 0], sq[:, 1]
+    ok = split_ok(G)[ci, cj]
+    e_ac = np.where(ok[:, 0], e_ac, np.inf)  # a split with a flipped triangle is never chosen
+    e_bd = np.where(ok[:, 1], e_bd, np.inf)
+    tie = np.isclose(e_ac, e_bd, rtol=1e-9, atol=1e-300) & ok.all(axis=1)
+    diag[ci, cj] = np.where(tie, bool(default), e_ac < e_bd)
+    # END SOLUTION
+    return diag

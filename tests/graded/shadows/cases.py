@@ -1,0 +1,375 @@
+"""Graded cases of the lab "shadows" (public): inputs built from geomlib only, never from the solution.
+
+Tolerances: light matrices, map coordinates and gradients to 1e-10 (a few matrix products);
+depth maps exactly up to 1e-9 (everyone calls the same deterministic rasterizer); 0/1 shadow tests
+and PCF fractions to 1e-12 (the points are random, so none sits within round-off of a texel border
+or of its stored depth); rendered images by ``ImageMatch`` (at most 0.5% of pixels off by more than
+2/255).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.grading import Case, checks
+
+from .support import (
+    CAMERA,
+    SCENE_BOUNDS,
+    MapClose,
+    NanClose,
+    SameRows,
+    ortho_light,
+    small_scene,
+    spot_light,
+    surface_points,
+)
+
+LIGHT_DIR = np.array([0.4, 0.5, -0.75])
+CUBE_POS = np.array([0.2, -0.3, 2.6])
+
+
+def _scene(**extra):
+    def make():
+        V, F = small_scene()
+        return {"V": V, "F": F, **extra}
+
+    return make
+
+
+def _map_inputs(M, size, seed, n=400, frustum=False):
+    """A depth map of the small scene through M, and random surface points with their map coordinates."""
+
+    def make():
+        from geomlib.raster import rasterize
+
+        V, F = small_scene()
+        g = rasterize(V, F, M, size, size, depth_only=True)
+        D = np.where(g.mask, g.depth, 1.0)
+        P, N = surface_points(V, F, n, seed)
+        C = np.c_[P, np.ones(len(P))] @ M.T
+        uvz = (C[:, :3] / C[:, 3:] + 1) / 2
+        if not frustum:
+            keep = np.all((uvz >= 0) & (uvz <= 1), axis=1)
+            P, N, uvz = P[keep], N[keep], uvz[keep]
+        return {"D": D, "P": P, "N": N, "uvz": uvz, "M": M}
+
+    return make
+
+
+def _pick(make, *names, **extra):
+    def f():
+        d = make()
+        return {**{k: d[k] for k in names}, **extra}
+
+    return f
+
+
+def _grad(make, size):
+    """Receiver-plane gradients computed here, with numpy, for PCF cases (so PCF does not need Task 4)."""
+
+    def f():
+        d = make()
+        M = d["M"]
+        pi = np.c_[d["N"], -np.einsum("ij,ij->i", d["N"], d["P"])]
+        abcd = pi @ np.linalg.inv(M)
+        g = np.clip(-abcd[:, :2] / abcd[:, 2:3], -20, 20) / size
+        return {"D": d["D"], "uvz": d["uvz"], "gradient": g}
+
+    return f
+
+
+M_ORTHO = ortho_light(LIGHT_DIR)
+M_SPOT = spot_light()
+MAP_ORTHO = _map_inputs(M_ORTHO, 64, seed=1)
+MAP_SPOT = _map_inputs(M_SPOT, 64, seed=2)
+
+CASES = [
+    # ---------------------------------------------------------------- Task 1: light matrix
+    Case(
+        id="directional-scene",
+        function="directional_light_matrix",
+        inputs=lambda: {"direction": LIGHT_DIR, "bounds": SCENE_BOUNDS},
+        outputs=("M",),
+        check=checks.Allclose(atol=1e-10),
+        part="light matrix",
+        points=2,
+        hint="look_at(c - R d, c, light_up_vector(d)), then a tight orthographic box from the 8 corners in eye space",
+    ),
+    Case(
+        id="directional-straight-down",
+        function="directional_light_matrix",
+        inputs=lambda: {
+            "direction": np.array([0.0, 0.0, -2.0]),
+            "bounds": np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 1.0]]),
+        },
+        outputs=("M",),
+        check=checks.Allclose(atol=1e-10),
+        part="light matrix",
+        points=1,
+        hint="normalise the direction; near = -z_max and far = -z_min of the corners in eye space",
+    ),
+    Case(
+        id="spot",
+        function="spot_light_matrix",
+        inputs=lambda: {
+            "position": np.array([-3.0, -3.5, 5.0]),
+            "target": np.array([0.0, 0.0, 0.0]),
+            "fov_deg": 70.0,
+            "near": 2.0,
+            "far": 12.0,
+        },
+        outputs=("M",),
+        check=checks.Allclose(atol=1e-10),
+        part="light matrix",
+        points=1,
+    ),
+    # ---------------------------------------------------------------- Task 2: depth pass
+    Case(
+        id="depth-ortho-64",
+        function="depth_map",
+        inputs=_scene(M=M_ORTHO, size=64),
+        params={"cull": "none"},
+        outputs=("D",),
+        check=MapClose("D", atol=1e-9),
+        part="depth pass",
+        points=2,
+        hint="rasterize(V, F, M, size, size, depth_only=True).depth, empty texels = 1.0",
+    ),
+    Case(
+        id="depth-spot-48",
+        function="depth_map",
+        inputs=_scene(M=M_SPOT, size=48),
+        params={"cull": "none"},
+        outputs=("D",),
+        check=MapClose("D", atol=1e-9),
+        part="depth pass",
+        points=1,
+    ),
+    # ---------------------------------------------------------------- Task 3: the comparison
+    Case(
+        id="uvz-ortho",
+        function="light_uvz",
+        inputs=_pick(_map_inputs(M_ORTHO, 64, seed=3, frustum=True), "P", "M"),
+        outputs=("uvz",),
+        check=checks.Allclose(atol=1e-10),
+        part="comparison",
+        points=1,
+        hint="(x, y, z, w) = M @ (P, 1); uvz = (xyz / w + 1) / 2",
+    ),
+    Case(
+        id="uvz-spot",
+        function="light_uvz",
+        inputs=lambda: {
+            "P": np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.5], [-3.0, -3.5, 5.0], [-6.0, -7.0, 10.0], [2.0, -1.0, 0.0]]),
+            "M": M_SPOT,
+        },
+        outputs=("uvz",),
+        check=NanClose("uvz", atol=1e-10),
+        part="comparison",
+        points=1,
+        hint="rows where w <= 0 (level with or behind the light) must be NaN",
+    ),
+    Case(
+        id="compare-ortho",
+        function="compare_depth",
+        inputs=_pick(MAP_ORTHO, "D", "uvz", bias=0.01),
+        outputs=("lit",),
+        check=checks.Allclose(atol=1e-12),
+        part="comparison",
+        points=2,
+        hint="col = floor(u size), row = size - 1 - floor(v size) (row 0 is the top), lit where z - bias <= D[row, col]",
+    ),
+    Case(
+        id="compare-spot-per-point-bias",
+        function="compare_depth",
+        inputs=lambda: {**_pick(MAP_SPOT, "D", "uvz")(), "bias": np.linspace(0.0, 0.02, len(MAP_SPOT()["uvz"]))},
+        outputs=("lit",),
+        check=checks.Allclose(atol=1e-12),
+        part="comparison",
+        points=1,
+    ),
+    # ---------------------------------------------------------------- Task 4: bias
+    Case(
+        id="gradient-ortho",
+        function="receiver_depth_gradient",
+        inputs=_pick(MAP_ORTHO, "P", "N", "M", size=64),
+        outputs=("g",),
+        check=checks.Allclose(atol=1e-10),
+        part="bias",
+        points=2,
+        hint="(a, b, c, d) = M^{-T} (N, -N.P); g = clip(-(a, b) / c, -max_slope, max_slope) / size",
+    ),
+    Case(
+        id="gradient-spot",
+        function="receiver_depth_gradient",
+        inputs=_pick(MAP_SPOT, "P", "N", "M", size=64),
+        params={"max_slope": 5.0},
+        outputs=("g",),
+        check=checks.Allclose(atol=1e-10),
+        part="bias",
+        points=1,
+    ),
+    Case(
+        id="bias-formula",
+        function="shadow_bias",
+        inputs=lambda: {
+            "gradient": np.array([[0.0, 0.0], [0.01, -0.02], [-0.5, 0.25]]),
+            "bias": 0.001,
+            "slope_bias": 1.5,
+        },
+        outputs=("b",),
+        check=checks.Allclose(atol=1e-12),
+        part="bias",
+        points=1,
+        hint="b = bias + slope_bias (|g_u| + |g_v|) / 2",
+    ),
+    # ---------------------------------------------------------------- Task 5: culling
+    Case(
+        id="cull-front-ortho",
+        function="cull_faces",
+        inputs=_scene(M=M_ORTHO),
+        params={"cull": "front"},
+        outputs=("F",),
+        check=SameRows("F"),
+        part="culling",
+        points=1,
+        hint="front-facing <=> det([x, y, w] of the three corners in clip space) > 0; cull='front' drops those",
+    ),
+    Case(
+        id="cull-back-spot",
+        function="cull_faces",
+        inputs=_scene(M=M_SPOT),
+        params={"cull": "back"},
+        outputs=("F",),
+        check=SameRows("F"),
+        part="culling",
+        points=1,
+    ),
+    Case(
+        id="depth-front-culled",
+        function="depth_map",
+        inputs=_scene(M=M_ORTHO, size=64),
+        params={"cull": "front"},
+        outputs=("D",),
+        check=MapClose("D", atol=1e-9),
+        part="culling",
+        points=1,
+    ),
+    # ---------------------------------------------------------------- Task 6: frustum
+    Case(
+        id="outside-ortho",
+        function="outside_frustum",
+        inputs=lambda: {
+            "uvz": _map_inputs(
+                ortho_light(LIGHT_DIR, bounds=[[-1.5, -1.5, 0], [1.5, 1.5, 1.9]]), 32, 5, frustum=True
+            )()["uvz"]
+        },
+        outputs=("outside",),
+        check=checks.Equal("outside"),
+        part="frustum handling",
+        points=1,
+        hint="outside: u or v outside [0, 1], or z > 1 (z < 0 is not outside)",
+    ),
+    # ---------------------------------------------------------------- Task 7: PCF
+    Case(
+        id="pcf3-ortho",
+        function="pcf_visibility",
+        inputs=_pick(MAP_ORTHO, "D", "uvz", bias=0.005),
+        params={"pcf": 3},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="PCF",
+        points=2,
+        hint="mean over i, j in -(k-1)/2..(k-1)/2 of [z - bias <= D[clamp(row - j), clamp(col + i)]]: j counts texels UP",
+    ),
+    Case(
+        id="pcf5-spot-gradient",
+        function="pcf_visibility",
+        inputs=lambda: {**_grad(MAP_SPOT, 64)(), "bias": 0.002},
+        params={"pcf": 5},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="PCF",
+        points=1,
+        hint="with a gradient, neighbour (i, j) compares z + g_u i + g_v j - bias",
+    ),
+    # ---------------------------------------------------------------- Task 8: cube map
+    Case(
+        id="cube-matrices",
+        function="cube_light_matrices",
+        inputs=lambda: {"position": CUBE_POS, "near": 0.2, "far": 12.0},
+        outputs=("Ms",),
+        check=checks.Allclose(atol=1e-10),
+        part="cube map",
+        points=1,
+        hint="perspective(90, 1, near, far) @ look_at(position, position + CUBE_DIRECTIONS[i], CUBE_UPS[i])",
+    ),
+    Case(
+        id="cube-faces",
+        function="cube_face_index",
+        inputs=lambda: {"directions": np.random.default_rng(7).normal(size=(200, 3))},
+        outputs=("face",),
+        check=checks.Equal("face"),
+        part="cube map",
+        points=1,
+    ),
+    Case(
+        id="point-light-visibility",
+        function="point_shadow_visibility",
+        inputs=lambda: _point_inputs(64, seed=8),
+        params={"bias": 0.002, "slope_bias": 0.0},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="cube map",
+        points=2,
+        hint="pick each point's face with cube_face_index(P - position) and use shadow_visibility with that face's map and matrix",
+    ),
+    # ---------------------------------------------------------------- everything together
+    Case(
+        id="visibility-ortho-defaults",
+        function="shadow_visibility",
+        inputs=_pick(MAP_ORTHO, "P", "N", "D", "M"),
+        params={"pcf": 3},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="all together",
+        points=1,
+    ),
+    Case(
+        id="render-small",
+        function="render_with_shadows",
+        # the scene as a (V, F) pair: one grey, flat-shaded mesh
+        inputs=lambda: {
+            "scene": small_scene(),
+            "camera": CAMERA,
+            "light": {"type": "directional", "direction": LIGHT_DIR},
+        },
+        params={"size": [96, 72], "map_size": 256},
+        outputs=("image",),
+        check=checks.ImageMatch(),
+        part="all together",
+        points=1,
+    ),
+]
+
+
+def _cube_matrices(pos, near, far):
+    from geomlib.camera import look_at, perspective
+
+    dirs = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+    ups = np.array([[0.0, -1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [0, -1, 0], [0, -1, 0]])
+    return [perspective(90.0, 1.0, near, far) @ look_at(pos, pos + d, u) for d, u in zip(dirs, ups)]
+
+
+def _point_inputs(size, seed, n=400, near=0.2, far=12.0):
+    """Six depth maps made here with geomlib's rasterizer (not with the lab's cube-map functions)."""
+    from geomlib.raster import rasterize
+
+    V, F = small_scene()
+    maps = []
+    for M in _cube_matrices(CUBE_POS, near, far):
+        g = rasterize(V, F, M, size, size, cull="front", depth_only=True)
+        maps.append(np.where(g.mask, g.depth, 1.0))
+    P, N = surface_points(V, F, n, seed)
+    return {"P": P, "N": N, "maps": np.stack(maps), "position": CUBE_POS, "near": near, "far": far}

@@ -1,0 +1,137 @@
+"""Hidden graded cases of the lab "shadows": other lights, sizes and points than the public ones."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.grading import Case, checks
+
+from .cases import _grad, _map_inputs, _pick, _point_inputs, _scene
+from .support import CAMERA, MapClose, SameRows, ortho_light, small_scene, spot_light
+
+DIR2 = np.array([-0.6, 0.2, -0.7])
+M2 = ortho_light(DIR2)
+S2 = spot_light(position=(3.0, 2.0, 4.0), target=(0.5, 0.0, 0.3), fov=55.0, near=1.0, far=10.0)
+MAP2 = _map_inputs(M2, 80, seed=11)
+MAP_S2 = _map_inputs(S2, 72, seed=12)
+
+CASES = [
+    Case(
+        id="hidden-directional-oblique",
+        function="directional_light_matrix",
+        inputs=lambda: {
+            "direction": np.array([1.0, -2.0, 0.3]),
+            "bounds": np.array([[-1.0, 0.0, 2.0], [4.0, 1.5, 3.0]]),
+        },
+        outputs=("M",),
+        check=checks.Allclose(atol=1e-10),
+        part="light matrix",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-spot-narrow",
+        function="spot_light_matrix",
+        inputs=lambda: {
+            "position": np.array([3.0, 2.0, 4.0]),
+            "target": np.array([0.5, 0.0, 0.3]),
+            "fov_deg": 25.0,
+            "near": 0.5,
+            "far": 30.0,
+        },
+        outputs=("M",),
+        check=checks.Allclose(atol=1e-10),
+        part="light matrix",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-depth-80",
+        function="depth_map",
+        inputs=_scene(M=M2, size=80),
+        params={"cull": "none"},
+        outputs=("D",),
+        check=MapClose("D", atol=1e-9),
+        part="depth pass",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-compare-spot",
+        function="compare_depth",
+        inputs=_pick(MAP_S2, "D", "uvz", bias=0.003),
+        outputs=("lit",),
+        check=checks.Allclose(atol=1e-12),
+        part="comparison",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-gradient",
+        function="receiver_depth_gradient",
+        inputs=_pick(MAP_S2, "P", "N", "M", size=72),
+        outputs=("g",),
+        check=checks.Allclose(atol=1e-10),
+        part="bias",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-cull-front-spot",
+        function="cull_faces",
+        inputs=_scene(M=S2),
+        params={"cull": "front"},
+        outputs=("F",),
+        check=SameRows("F"),
+        part="culling",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-outside-spot",
+        function="outside_frustum",
+        inputs=lambda: {"uvz": np.nan_to_num(_map_inputs(S2, 32, 13, frustum=True)()["uvz"], nan=2.0)},
+        outputs=("outside",),
+        check=checks.Equal("outside"),
+        part="frustum handling",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-pcf3-gradient",
+        function="pcf_visibility",
+        inputs=lambda: {**_grad(MAP2, 80)(), "bias": 0.001},
+        params={"pcf": 3},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="PCF",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-point-light",
+        function="point_shadow_visibility",
+        inputs=lambda: _point_inputs(48, seed=14),
+        params={"bias": 0.004, "slope_bias": 0.0},
+        outputs=("visibility",),
+        check=checks.Allclose(atol=1e-12),
+        part="cube map",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-render-spot",
+        function="render_with_shadows",
+        inputs=lambda: {
+            "scene": small_scene(),  # a (V, F) pair: one grey, flat-shaded mesh
+            "camera": CAMERA,
+            "light": {"type": "spot", "position": np.array([-3.0, -3.5, 5.0]), "target": np.zeros(3), "fov_deg": 70.0},
+        },
+        params={"size": [96, 72], "map_size": 256, "pcf": 1},
+        outputs=("image",),
+        check=checks.ImageMatch(),
+        part="all together",
+        points=1,
+        visibility="hidden",
+    ),
+]
