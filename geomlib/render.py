@@ -193,10 +193,6 @@ def close() -> None:
 
 atexit.register(close)
 
-# Older names, used by code written before the public ones existed.
-_pyrender = import_pyrender
-_renderer = offscreen_renderer
-
 
 # --------------------------------------------------------------------------------------------
 # Small geometry helpers

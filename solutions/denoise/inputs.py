@@ -1,0 +1,137 @@
+"""Given helpers: input checks shared by every function of the lab (not a task).
+
+Conventions of the lab (the texture convention is the one of :mod:`geomlib.textures`):
+
+* ``V`` float ``(n, 3)``, ``F`` int ``(m, 3)`` triangles, ``N`` ``(n, 3)`` one normal per vertex.
+  Normals are normalised here, so the lab's formulas may assume ``|n_i| = 1``.
+* UV space is ``[0, 1]^2``, ``u`` right, ``v`` up; image row 0 is ``v = 1``.
+* Offset maps are SQUARE single-channel images ``(s, s)``: ``uint8`` (8 bits), ``uint16``
+  (16 bits) or floats in ``[0, 1]``. A texel value ``h`` stands for the offset ``bias + scale h``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.validate import MeshError, as_array, as_image, check_choice
+
+__all__ = [
+    "WEIGHTS",
+    "BITS",
+    "normalize_rows",
+    "as_unit_normals",
+    "as_offsets",
+    "as_scalars",
+    "check_uv",
+    "check_bits",
+    "check_weld",
+    "check_weights",
+    "as_offset_image",
+]
+
+#: Laplacian weights of :func:`laplacian_offsets`.
+WEIGHTS = ("uniform", "cotan")
+
+#: Bit depths of a baked offset map.
+BITS = (8, 16)
+
+#: UV values this far outside [0, 1] still count as inside (round-off of exporters).
+UV_SLACK = 1e-9
+
+
+def normalize_rows(X: np.ndarray) -> np.ndarray:
+    """Rows of ``X`` scaled to unit length; zero rows stay zero (never NaN)."""
+    X = np.asarray(X, dtype=np.float64)
+    n = np.linalg.norm(X, axis=-1, keepdims=True)
+    return X / np.where(n > 0, n, 1.0)
+
+
+def as_unit_normals(N, n: int, where: str, name: str = "N", ref: str = "V") -> np.ndarray:
+    """One normal per vertex, ``(n, 3)`` float64, normalised; a zero row is an error."""
+    N = as_array(N, name, shape=(None, 3), where=where)
+    if len(N) != n:
+        raise MeshError(f"{where}: {name} has {len(N)} rows but {ref} has {n}; expected one normal per vertex")
+    length = np.linalg.norm(N, axis=1)
+    if (length == 0).any():
+        r = int(np.flatnonzero(length == 0)[0])
+        raise MeshError(
+            f"{where}: {name} row {r} is the zero vector; every vertex needs a normal to move along "
+            f"({int((length == 0).sum())} zero rows)"
+        )
+    return N / length[:, None]
+
+
+def as_offsets(delta, where: str, name: str = "delta") -> np.ndarray:
+    """Laplacian offsets ``(n, 3)`` float64, finite."""
+    return as_array(delta, name, shape=(None, 3), where=where)
+
+
+def as_scalars(s, n: int, where: str, name: str = "s") -> np.ndarray:
+    """One finite scalar per vertex, ``(n,)`` float64."""
+    s = as_array(s, name, shape=(None,), where=where)
+    if len(s) != n:
+        raise MeshError(f"{where}: {name} has {len(s)} values but V has {n}; expected one value per vertex")
+    return s
+
+
+def check_uv(UV, n: int, where: str, name: str = "UV") -> np.ndarray:
+    """Texture coordinates ``(n, 2)`` float64 inside ``[0, 1]^2``, one row per vertex."""
+    if UV is None:
+        raise MeshError(f"{where}: {name} is missing; this function needs texture coordinates, one (u, v) per vertex")
+    UV = as_array(UV, name, shape=(None, 2), where=where)
+    if len(UV) != n:
+        raise MeshError(f"{where}: {name} has {len(UV)} rows but V has {n}; expected one (u, v) per vertex")
+    bad = ((UV < -UV_SLACK) | (UV > 1 + UV_SLACK)).any(axis=1)
+    if bad.any():
+        r = int(np.flatnonzero(bad)[0])
+        raise MeshError(
+            f"{where}: {name} row {r} is ({UV[r, 0]:.6g}, {UV[r, 1]:.6g}), outside the texture square [0, 1]^2 "
+            f"({int(bad.sum())} rows are out of range)"
+        )
+    return UV
+
+
+def check_bits(bits, where: str) -> int:
+    """Bit depth of an offset map: 8 or 16."""
+    if isinstance(bits, bool) or not isinstance(bits, int | np.integer) or int(bits) not in BITS:
+        raise MeshError(f"{where}: bits must be 8 or 16, got {bits!r}")
+    return int(bits)
+
+
+def check_weld(weld, where: str) -> bool:
+    if not isinstance(weld, bool | np.bool_):
+        raise MeshError(f"{where}: weld must be True or False, got {weld!r}")
+    return bool(weld)
+
+
+def check_weights(weights, where: str) -> str:
+    return check_choice(weights, "weights", WEIGHTS, where=where)
+
+
+def as_offset_image(image, where: str, name: str = "image") -> np.ndarray:
+    """A square single-channel offset map as float64 ``(s, s)`` in ``[0, 1]``.
+
+    ``uint8`` images are divided by 255 and ``uint16`` images by 65535 (the inverse of the
+    quantisation in :func:`bake_offset_map`); float images must already lie in ``[0, 1]``.
+    """
+    img = as_image(image, name, where=where)
+    if img.ndim == 3:
+        raise MeshError(
+            f"{where}: {name} has {img.shape[2]} channels (shape {img.shape}); an offset map is a single-channel "
+            f"image (s, s)"
+        )
+    if img.shape[0] != img.shape[1]:
+        raise MeshError(f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; offset maps are square (s x s)")
+    if img.dtype == np.uint8:
+        return img.astype(np.float64) / 255.0
+    if img.dtype == np.uint16:
+        return img.astype(np.float64) / 65535.0
+    if img.dtype.kind != "f":
+        raise MeshError(f"{where}: {name} has dtype {img.dtype}; expected uint8, uint16 or floats in [0, 1]")
+    out = as_array(img, name, dtype=np.float64, where=where)
+    if out.min() < 0 or out.max() > 1:
+        raise MeshError(
+            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; a float offset map holds values in "
+            f"[0, 1] (bias and scale turn them into offsets)"
+        )
+    return out

@@ -1,0 +1,1 @@
+"""Graded tests of the denoise lab (Laplacian displacement denoising)."""
