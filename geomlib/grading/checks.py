@@ -158,6 +158,18 @@ def _canonical_faces(F: np.ndarray) -> np.ndarray:
     return np.take_along_axis(F, idx, axis=1)
 
 
+def _mesh_outputs(expected: dict, got: dict, vname: str, fname: str, ctx: Context):
+    """Expected and submitted (V, F), the submitted ones checked for array shapes (n, 3) and (m, k)."""
+    Ve, Fe = np.asarray(expected[vname], float), np.asarray(expected[fname])
+    Vg = as_output_array(got.get(vname), vname, ctx)
+    Fg = as_output_array(got.get(fname), fname, ctx)
+    if Vg.ndim != 2 or Vg.shape[1] != Ve.shape[1]:
+        raise BadReturn(f"{ctx.label}: {vname} has shape {Vg.shape}, expected (n, {Ve.shape[1]})")
+    if Fg.ndim != 2 or Fg.shape[1] != Fe.shape[1]:
+        raise BadReturn(f"{ctx.label}: {fname} has shape {Fg.shape}, expected (m, {Fe.shape[1]})")
+    return Ve, Fe, Vg, Fg
+
+
 @dataclass
 class MeshMatch:
     """Same vertices and faces up to the order of vertices and faces (and cyclic order within a face).
@@ -173,13 +185,7 @@ class MeshMatch:
     def __call__(self, expected: dict, got: dict, ctx: Context) -> None:
         from scipy.spatial import cKDTree
 
-        Ve, Fe = np.asarray(expected[self.vertices], float), np.asarray(expected[self.faces])
-        Vg = as_output_array(got.get(self.vertices), self.vertices, ctx)
-        Fg = as_output_array(got.get(self.faces), self.faces, ctx)
-        if Vg.ndim != 2 or Vg.shape[1] != Ve.shape[1]:
-            raise BadReturn(f"{ctx.label}: {self.vertices} has shape {Vg.shape}, expected (n, {Ve.shape[1]})")
-        if Fg.ndim != 2 or Fg.shape[1] != Fe.shape[1]:
-            raise BadReturn(f"{ctx.label}: {self.faces} has shape {Fg.shape}, expected (m, {Fe.shape[1]})")
+        Ve, Fe, Vg, Fg = _mesh_outputs(expected, got, self.vertices, self.faces, ctx)
         if len(Vg) != len(Ve):
             ctx.fail(f"expected {len(Ve)} vertices, got {len(Vg)}", self._picture(Ve, Fe, Vg, Fg, ctx))
         if len(Fg) != len(Fe):
@@ -234,13 +240,7 @@ class SurfaceDistance:
     def __call__(self, expected: dict, got: dict, ctx: Context) -> None:
         from geomlib import geometry
 
-        Ve, Fe = np.asarray(expected[self.vertices], float), np.asarray(expected[self.faces])
-        Vg = as_output_array(got.get(self.vertices), self.vertices, ctx)
-        Fg = as_output_array(got.get(self.faces), self.faces, ctx)
-        if Vg.ndim != 2 or Vg.shape[1] != 3 or Fg.ndim != 2 or Fg.shape[1] != Fe.shape[1]:
-            raise BadReturn(
-                f"{ctx.label}: expected ({self.vertices} (n, 3), {self.faces} (m, {Fe.shape[1]})), got shapes {Vg.shape}, {Fg.shape}"
-            )
+        Ve, Fe, Vg, Fg = _mesh_outputs(expected, got, self.vertices, self.faces, ctx)
         try:
             dist = geometry.mesh_distance(Ve, Fe, Vg, Fg)
         except ValueError as e:
