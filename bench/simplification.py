@@ -1,0 +1,242 @@
+"""Benchmark: lab "simplification" (QEM) against the anchor libraries, in one run.
+
+Run: ``uv run python bench/simplification.py [--quick] [--greedy] [--only NAME ...]``
+
+For every mesh and every reduction level (10% and 1% of the faces kept) it times
+
+* ours, ``method="fast"`` (batches of independent contractions, vectorised),
+* ours, ``method="greedy"`` (the readable heap loop the students write; only with ``--greedy``,
+  and only on meshes up to 25,000 faces, since it costs about 1 ms per contraction),
+* ``igl.qslim`` (the reference for quality and time),
+* ``fast_simplification.simplify``,
+* VTK quadric decimation (``pyvista.PolyData.decimate``),
+
+next to each other, and measures on each output: Hausdorff and RMS surface distance relative to
+the input's bounding-box diagonal (``geomlib.geometry.mesh_distance``, 50,000 samples per side),
+edge-manifoldness, flipped faces (output face normal against the input normal at the closest
+point of its centroid), boundary loops kept, faces reached. Times are the best of a few runs
+with the contenders interleaved; ratios are against ``igl.qslim`` in the same run. Peak memory:
+the tracemalloc peak of one call of ours (NumPy allocations; the C++ anchors are invisible to
+tracemalloc, so the process's maximum resident set size is printed at the end instead).
+
+Meshes: a noise-displaced icosphere (level 6, 81,920 faces; the issue's "100k sphere"), the
+built-in torus, sharp box and height field at benchmark resolution, the pyvista airplane, ant
+and nut, and the real meshes of ``../shared/data/meshes`` when that folder exists (bunny,
+armadillo, fandisk with sharp creases, camelhead with a boundary).
+"""
+
+from __future__ import annotations
+
+import argparse
+import resource
+import sys
+import time
+import tracemalloc
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import fast_simplification  # noqa: E402
+import igl  # noqa: E402
+import pyvista as pv  # noqa: E402
+
+from geomlib import datasets, topology  # noqa: E402
+from geomlib.geometry import closest_points, face_normals, mesh_distance  # noqa: E402
+from solutions.simplification import qem_simplify  # noqa: E402
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+GREEDY_MAX_FACES = 25_000
+
+
+def builtin_meshes(quick: bool) -> dict:
+    if quick:
+        V, F = datasets.icosphere(4)
+        return {
+            "noisy icosphere 5k": (datasets.add_noise(V, 0.005, seed=1, direction="normal", F=F), F),
+            "height field 32": datasets.height_field(32),
+        }
+    V, F = datasets.icosphere(6)
+    return {
+        "noisy icosphere 82k": (datasets.add_noise(V, 0.002, seed=1, direction="normal", F=F), F),
+        "torus 96x48": datasets.torus(n_major=96, n_minor=48),
+        "sharp box 24": datasets.sharp_box(n=24),
+        "height field 128": datasets.height_field(128),
+        "pyvista airplane": datasets.pyvista_mesh("airplane", manifold=True),
+        "pyvista ant": datasets.pyvista_mesh("ant"),
+        "pyvista nut": datasets.pyvista_mesh("nut"),
+    }
+
+
+def shared_meshes(quick: bool) -> dict:
+    from geomlib.io import read_mesh
+
+    names = (
+        ["fandisk.obj", "camelhead.off"] if quick else ["bunny_hr.obj", "armadillo.obj", "fandisk.obj", "camelhead.off"]
+    )
+    out = {}
+    for name in names:
+        path = SHARED / name
+        if path.is_file():
+            V, F = read_mesh(path, triangulate=True)
+            out[name] = (np.asarray(V, np.float64), np.asarray(F, np.int64))
+    return out
+
+
+# ----------------------------------------------------------------------------- contenders
+
+
+def ours_fast(V, F, t):
+    return qem_simplify(V, F, t, method="fast", on_unreachable="warn")
+
+
+def ours_greedy(V, F, t):
+    return qem_simplify(V, F, t, method="greedy", on_unreachable="warn")
+
+
+def qslim(V, F, t):
+    U, G, _, _ = igl.qslim(V, F.astype(np.int32), t)
+    return np.asarray(U), np.asarray(G, np.int64)
+
+
+def fast_simpl(V, F, t):
+    U, G = fast_simplification.simplify(V.astype(np.float32), F.astype(np.int32), 1.0 - t / len(F))
+    return np.asarray(U, np.float64), np.asarray(G, np.int64)
+
+
+def vtk_decimate(V, F, t):
+    out = pv.PolyData.from_regular_faces(V, F).decimate(1.0 - t / len(F))
+    return np.asarray(out.points, np.float64), np.asarray(out.faces).reshape(-1, 4)[:, 1:].astype(np.int64)
+
+
+# ----------------------------------------------------------------------------- measures
+
+
+def flipped_count(V0, F0, V, F) -> int:
+    """Faces turned against the input at the closest point to their centroid: more than 120° off, or more
+    than 90° for a well-shaped face (quality 4√3 area / Σ edge² > 0.3; a sliver's normal is ill-defined)."""
+    C = V[F].mean(axis=1)
+    _, face, _ = closest_points(V0, F0, C)
+    cos = np.einsum("ij,ij->i", face_normals(V, F), face_normals(V0, F0)[face])
+    area2 = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    quality = 2 * np.sqrt(3) * area2 / np.maximum(((V[F] - V[F[:, [1, 2, 0]]]) ** 2).sum(axis=(1, 2)), 1e-300)
+    return int(((cos < -0.5) | ((cos < 0) & (quality > 0.3))).sum())
+
+
+def quality(V0, F0, V, F, n_samples: int) -> dict:
+    used = np.unique(F)
+    remap = np.full(len(V), -1)
+    remap[used] = np.arange(len(used))
+    V, F = V[used], remap[F]
+    d = mesh_distance(V0, F0, V, F, n_samples=n_samples)
+    S = np.sort(F, axis=1)
+    return {
+        "faces": len(F),
+        "hausdorff": d["hausdorff"],
+        "rms": d["rms"],
+        "manifold": topology.is_edge_manifold(F) and len(np.unique(S, axis=0)) == len(F),
+        "flipped": flipped_count(V0, F0, V, F),
+        "loops": len(topology.boundary_edges(F)) and _loops(F),
+    }
+
+
+def _loops(F) -> int:
+    try:
+        return len(topology.boundary_loops(F))
+    except Exception:  # a pinched boundary: count it as broken
+        return -1
+
+
+def timed(fn, V, F, t, repeats: int) -> tuple[float, tuple]:
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn(V, F, t)
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def peak_memory_mb(fn, V, F, t) -> float:
+    tracemalloc.start()
+    fn(V, F, t)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    return peak / 2**20
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small meshes, one repeat, fewer samples")
+    ap.add_argument(
+        "--greedy", action="store_true", help=f"also time the greedy loop (meshes <= {GREEDY_MAX_FACES} faces)"
+    )
+    ap.add_argument("--only", nargs="*", help="substrings of mesh names to run")
+    ap.add_argument("--levels", nargs="*", type=float, default=[0.1, 0.01])
+    args = ap.parse_args()
+    repeats = 1 if args.quick else 3
+    n_samples = 20_000 if args.quick else 50_000
+    meshes = {**builtin_meshes(args.quick), **shared_meshes(args.quick)}
+    if args.only:
+        meshes = {k: v for k, v in meshes.items() if any(s in k for s in args.only)}
+    contenders = {"ours fast": ours_fast, "igl.qslim": qslim, "fast-simpl": fast_simpl, "VTK": vtk_decimate}
+    print(
+        f"{'mesh':24s} {'keep':>5s} {'method':11s} {'faces':>7s} {'time s':>8s} {'/qslim':>7s} "
+        f"{'Hausdorff':>10s} {'/qslim':>7s} {'RMS':>10s} {'/qslim':>7s} {'manif':>5s} {'flip':>5s} {'loops':>5s}"
+    )
+    summary = []
+    for name, (V, F) in meshes.items():
+        V, F = np.ascontiguousarray(V, np.float64), np.ascontiguousarray(F, np.int64)
+        loops0 = _loops(F)
+        for level in args.levels:
+            t = max(4, int(round(level * len(F))))
+            runs = dict(contenders)
+            if args.greedy and len(F) <= GREEDY_MAX_FACES:
+                runs["ours greedy"] = ours_greedy
+            res = {}
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                for label, fn in runs.items():
+                    try:
+                        sec, (U, G) = timed(fn, V, F, t, 1 if label == "ours greedy" else repeats)
+                        res[label] = (sec, quality(V, F, U, G, n_samples))
+                    except Exception as e:  # an anchor failing on a mesh is a result too
+                        res[label] = (np.nan, {"error": f"{type(e).__name__}: {e}"[:60]})
+            ref_t, ref_q = res["igl.qslim"]
+            for label, (sec, q) in res.items():
+                if "error" in q:
+                    print(f"{name[:24]:24s} {level:5.0%} {label:11s} failed: {q['error']}")
+                    continue
+                print(
+                    f"{name[:24]:24s} {level:5.0%} {label:11s} {q['faces']:7d} {sec:8.3f} {sec / ref_t:7.2f} "
+                    f"{q['hausdorff']:10.2e} {q['hausdorff'] / ref_q['hausdorff']:7.2f} {q['rms']:10.2e} "
+                    f"{q['rms'] / ref_q['rms']:7.2f} {'yes' if q['manifold'] else 'NO':>5s} {q['flipped']:5d} "
+                    f"{q['loops']}/{loops0:<3d}"
+                )
+            sec, q = res["ours fast"]
+            if "error" not in q:
+                summary.append((name, level, sec / ref_t, q["hausdorff"] / ref_q["hausdorff"], q["rms"] / ref_q["rms"]))
+            print()
+    if summary:
+        big = max(meshes, key=lambda k: len(meshes[k][1]))
+        V, F = meshes[big]
+        mem = peak_memory_mb(ours_fast, V, F, max(4, len(F) // 10))
+        print(
+            f"peak memory of ours (fast), {big} ({len(F)} faces) -> 10%: {mem:.0f} MB (tracemalloc); "
+            f"input arrays {(V.nbytes + F.nbytes) / 2**20:.1f} MB"
+        )
+        print(
+            f"max resident set size of this process: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB"
+        )
+        r = np.array([s[2:] for s in summary])
+        print(
+            f"ours fast vs igl.qslim over {len(r)} runs (geometric means): time x{np.exp(np.log(r[:, 0]).mean()):.2f}, "
+            f"Hausdorff x{np.exp(np.log(r[:, 1]).mean()):.3f}, RMS x{np.exp(np.log(r[:, 2]).mean()):.3f}; "
+            f"worst: time x{r[:, 0].max():.2f}, Hausdorff x{r[:, 1].max():.2f}, RMS x{r[:, 2].max():.3f}"
+        )
+
+
+if __name__ == "__main__":
+    main()

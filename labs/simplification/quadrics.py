@@ -1,0 +1,161 @@
+"""Quadric error metrics: the plane quadrics of faces, boundary edges and vertices.
+
+A plane ``p = (a, b, c, d)`` with unit normal ``(a, b, c)`` holds the points ``x`` with
+``a x + b y + c z + d = 0``. The squared distance of a point ``v = (x, y, z, 1)`` to it is
+
+    (pᵀ v)² = vᵀ (p pᵀ) v = vᵀ K_p v,
+
+so the *fundamental quadric* ``K_p = p pᵀ`` (a symmetric 4×4 matrix) measures squared distance
+to the plane, and a sum of quadrics measures the sum of squared distances to many planes with a
+single 4×4 matrix. This is the idea of Garland & Heckbert, "Surface simplification using quadric
+error metrics" (SIGGRAPH 1997).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.topology import boundary_edges
+from geomlib.validate import check_choice, check_float, check_mesh
+
+__all__ = ["face_planes", "face_quadrics", "boundary_quadrics", "vertex_quadrics", "quadric_error"]
+
+WEIGHTINGS = ("area", "uniform")
+
+
+def face_planes(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Plane of every triangle and its area (a given helper).
+
+    Parameters
+    ----------
+    V : (n, 3) float64
+    F : (m, 3) int64
+
+    Returns
+    -------
+    P : (m, 4) float64
+        ``(a, b, c, d)`` with ``(a, b, c)`` the unit normal ``(v1 - v0) × (v2 - v0) / |…|`` and
+        ``d = -(a, b, c) · v0``. Zero-area triangles get ``P = 0`` (they carry no plane).
+    A : (m,) float64
+        Triangle areas ``|(v1 - v0) × (v2 - v0)| / 2``.
+    """
+    v0, v1, v2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    c = np.cross(v1 - v0, v2 - v0)
+    length = np.linalg.norm(c, axis=1)
+    n = np.divide(c, length[:, None], out=np.zeros_like(c), where=length[:, None] > 0)
+    d = -np.einsum("ij,ij->i", n, v0)
+    return np.concatenate([n, d[:, None]], axis=1), 0.5 * length
+
+
+def face_quadrics(V, F, weighting: str = "area") -> np.ndarray:
+    """Fundamental quadric ``K_f = w_f · p_f p_fᵀ`` of every face.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+        Vertex positions.
+    F : (m, 3) array_like of int
+        Triangles.
+    weighting : {"area", "uniform"}
+        ``"area"``: ``w_f`` = triangle area (big faces count more, and the result does not depend on
+        how finely a flat region is triangulated); ``"uniform"``: ``w_f = 1`` (the 1997 paper).
+
+    Returns
+    -------
+    K : (m, 4, 4) float64
+        Symmetric positive semi-definite. ``vᵀ K_f v = w_f · dist(v, plane of f)²`` for
+        ``v = (x, y, z, 1)``. Zero-area faces give ``K_f = 0``.
+
+    Examples
+    --------
+    The triangle in the plane z = 0 with area 1/2 gives ``K = 1/2 · e_z e_zᵀ``:
+
+    >>> K = face_quadrics([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    >>> K[0, 2, 2], K[0].sum()
+    (0.5, 0.5)
+    """
+    V, F = check_mesh(V, F, where="face_quadrics")
+    check_choice(weighting, "weighting", WEIGHTINGS, where="face_quadrics")
+    P, area = face_planes(V, F)
+    raise NotImplementedError('Task 1 (quadrics): K_f = w_f * p pᵀ with p = (n, -n·v0), w_f = area or 1')
+
+
+def boundary_quadrics(V, F, weight: float = 1000.0) -> np.ndarray:
+    """Penalty quadrics that keep boundary vertices on their boundary curves.
+
+    For every boundary edge ``a → b`` of face ``f`` (unit normal ``n_f``) take the plane through
+    ``a`` that contains the edge and is perpendicular to the face: its normal is
+    ``m = (b - a) × n_f / |…|``. Its quadric ``weight · |b - a|² · q qᵀ`` with ``q = (m, -m·a)``
+    is added to *both* edge ends. Moving a boundary vertex off its boundary then costs about
+    ``weight`` times as much as moving it off the surface; the ``|b - a|²`` factor gives the
+    penalty the units of an area, like area-weighted face quadrics.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+    F : (m, 3) array_like of int
+    weight : float, >= 0
+
+    Returns
+    -------
+    Q : (n, 4, 4) float64
+        Sum of the penalty quadrics at each vertex (zero away from the boundary; all zero for a
+        closed mesh).
+    """
+    V, F = check_mesh(V, F, where="boundary_quadrics")
+    weight = check_float(weight, "weight", minimum=0.0, where="boundary_quadrics")
+    # Directed boundary edges (a, b) and the face each belongs to (given: topology bookkeeping).
+    B = boundary_edges(F)
+    he_face = np.repeat(np.arange(len(F)), 3)
+    he = np.stack([F.ravel(), F[:, [1, 2, 0]].ravel()], axis=1)
+    n_vertices = len(V)
+    he_key = he[:, 0] * n_vertices + he[:, 1]
+    order = np.argsort(he_key)
+    B_face = he_face[order[np.searchsorted(he_key[order], B[:, 0] * n_vertices + B[:, 1])]]
+    P, _ = face_planes(V, F)
+    raise NotImplementedError('Task 1 (quadrics): boundary plane normal m = (b - a) × n_f / |…|, K = weight |b - a|² q qᵀ')
+
+
+def vertex_quadrics(V, F, weighting: str = "area", boundary_weight: float = 0.0) -> np.ndarray:
+    """Quadric of every vertex: the sum of the quadrics of its faces.
+
+    ``Q_v = Σ_{f ∋ v} K_f`` (plus the boundary penalty quadrics when ``boundary_weight > 0``), so
+    ``vᵀ Q_v v`` is the (weighted) sum of squared distances of ``v`` to the planes of the faces
+    around the vertex; it is 0 at the vertex's own position.
+
+    Parameters
+    ----------
+    V : (n, 3) array_like of float
+    F : (m, 3) array_like of int
+    weighting : {"area", "uniform"}
+        See :func:`face_quadrics`.
+    boundary_weight : float, >= 0
+        Weight of :func:`boundary_quadrics`; 0 (default) adds none.
+
+    Returns
+    -------
+    Q : (n, 4, 4) float64
+        Unreferenced vertices get zeros.
+    """
+    V, F = check_mesh(V, F, where="vertex_quadrics")
+    check_choice(weighting, "weighting", WEIGHTINGS, where="vertex_quadrics")
+    boundary_weight = check_float(boundary_weight, "boundary_weight", minimum=0.0, where="vertex_quadrics")
+    K = face_quadrics(V, F, weighting)
+    raise NotImplementedError('Task 1 (quadrics): Q_v = sum of K_f over the faces f around v, + boundary_quadrics(V, F, boundary_weight) when > 0')
+
+
+def quadric_error(Q: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """``vᵀ Q v`` with ``v = (x, y, z, 1)``, batched (a given helper).
+
+    Parameters
+    ----------
+    Q : (..., 4, 4) float64
+    X : (..., 3) float64
+        Points; the leading shapes broadcast.
+
+    Returns
+    -------
+    (...) float64
+    """
+    Xh = np.concatenate([X, np.ones((*np.shape(X)[:-1], 1))], axis=-1)
+    return np.einsum("...i,...ij,...j->...", Xh, Q, Xh)

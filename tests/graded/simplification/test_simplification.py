@@ -1,0 +1,365 @@
+"""Graded tests of the simplification lab.
+
+Two kinds: ``test_references`` compares with stored reference outputs on realistic meshes (see
+``cases.py``); the tests below use tiny meshes whose answers are worked out by hand in the
+docstrings and comments, identities that any correct implementation satisfies, and bad input.
+Expected values never come from running a solution at test time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets, topology
+from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading.errors import Mismatch
+
+from .cases import CASES
+from .support import (
+    FAN_F,
+    FAN_V,
+    GRID_F,
+    GRID_V,
+    OCTA_F,
+    OCTA_V,
+    TET_F,
+    TET_V,
+    cracked_sheet,
+    noisy_icosphere,
+    random_quadrics,
+    rename_and_drop,
+    two_tetrahedra,
+    validity_problem,
+)
+
+test_references = reference_tests(CASES)
+
+#: The triangle through (1, 0, 0), (0, 1, 0), (0, 0, 1): plane x + y + z = 1, area √3 / 2.
+TILTED_V = np.array([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]])
+TILTED_F = np.array([[0, 1, 2]])
+TILTED_P = np.array([1.0, 1.0, 1.0, -1.0]) / np.sqrt(3)  # unit normal, d = -n · v0
+
+
+def expect_true(label: str, condition: bool, message: str) -> None:
+    if not condition:
+        raise Mismatch(f"{label}: {message}")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 1: quadrics
+
+
+@graded(points=1, part="quadrics")
+def test_face_quadric_of_a_tilted_triangle(lab):
+    """plane x + y + z = 1: p = (1, 1, 1, -1)/√3, K = area · p pᵀ with area √3/2"""
+    K = lab.face_quadrics(TILTED_V, TILTED_F)
+    expect_close(
+        "face_quadrics on the tilted triangle",
+        np.asarray(K)[0],
+        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
+        name="K[0]",
+    )
+    K = lab.face_quadrics(TILTED_V, TILTED_F, weighting="uniform")
+    expect_close(
+        'face_quadrics(weighting="uniform") on the tilted triangle',
+        np.asarray(K)[0],
+        np.outer(TILTED_P, TILTED_P),
+        name="K[0]",
+        hint="uniform weighting has no area factor",
+    )
+
+
+@graded(points=1, part="quadrics")
+def test_boundary_quadrics_of_one_triangle(lab):
+    """triangle (0,0,0), (1,0,0), (0,1,0) facing +z, weight 2: vertex 0 gets the walls y = 0 and x = 0
+
+    Edge 0→1: m = (1,0,0) × (0,0,1) = (0,-1,0), |e|² = 1 → 2 · diag(0, 1, 0, 0).
+    Edge 2→0: m = (0,-1,0) × (0,0,1) = (-1,0,0), |e|² = 1 → 2 · diag(1, 0, 0, 0).
+    Edge 1→2: m = (1,1,0)/√2 through (1,0,0), |e|² = 2 → q = (1,1,0,-1)/√2, 2 · 2 · q qᵀ.
+    """
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    Q = np.asarray(lab.boundary_quadrics(V, [[0, 1, 2]], weight=2.0))
+    q = np.array([1.0, 1.0, 0.0, -1.0]) / np.sqrt(2)
+    expect_close("boundary_quadrics at vertex 0", Q[0], 2 * np.diag([1.0, 1.0, 0, 0]), name="Q[0]")
+    expect_close("boundary_quadrics at vertex 1", Q[1], 2 * np.diag([0, 1.0, 0, 0]) + 4 * np.outer(q, q), name="Q[1]")
+
+
+@graded(points=1, part="quadrics")
+def test_vertex_quadrics_vanish_at_their_vertex(lab):
+    """vᵀ Q_v v = 0 at each vertex's own position (it lies on all its planes); Q is symmetric PSD"""
+    V, F = noisy_icosphere(2, 0.02, 1)
+    Q = np.asarray(lab.vertex_quadrics(V, F))
+    Vh = np.c_[V, np.ones(len(V))]
+    expect_close(
+        "vertex_quadrics: vᵀ Q_v v at every vertex", np.einsum("ki,kij,kj->k", Vh, Q, Vh), np.zeros(len(V)), atol=1e-12
+    )
+    expect_close("vertex_quadrics: Q - Qᵀ", Q - np.swapaxes(Q, 1, 2), np.zeros_like(Q))
+    # the quadric of a vertex sums the quadrics of its faces: at any point x, xᵀ Q_v x = Σ area · dist²
+    x = np.array([0.3, -0.2, 0.9, 1.0])
+    v = 7
+    faces = F[(F == v).any(axis=1)]
+    n = np.cross(V[faces[:, 1]] - V[faces[:, 0]], V[faces[:, 2]] - V[faces[:, 0]])
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    dist = np.einsum("ij,ij->i", x[:3] - V[faces[:, 0]], n / (2 * area[:, None]))
+    expect_close("vertex_quadrics: xᵀ Q_7 x", x @ Q[v] @ x, np.sum(area * dist**2), atol=1e-12)
+
+
+@graded(points=1, part="quadrics")
+def test_quadrics_reject_an_unknown_weighting(lab):
+    """a correct result on valid input, then a MeshError naming the bad weighting"""
+    K = lab.face_quadrics(TILTED_V, TILTED_F)
+    expect_close(
+        "face_quadrics on the tilted triangle",
+        np.asarray(K)[0],
+        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
+        name="K[0]",
+    )
+    expect_raises(lambda: lab.face_quadrics(TILTED_V, TILTED_F, weighting="volume"), "MeshError", match="weighting")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 2: placement
+
+
+def planes(*ps) -> np.ndarray:
+    return sum(np.outer(p, p) for p in np.asarray(ps, dtype=float))
+
+
+@graded(points=1, part="placement")
+def test_placement_regular_system(lab):
+    """planes x = 0, y = 0, z = 0 and x = 1: A = diag(2, 1, 1), b = (-1, 0, 0) → x = (1/2, 0, 0), cost 1/4 + 1/4"""
+    Q = planes([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, -1])
+    pos, cost = lab.optimal_contraction(Q, [5.0, 5, 5], [6.0, 6, 6])
+    expect_close("optimal_contraction, regular A", pos, [0.5, 0, 0], atol=1e-12, name="position")
+    expect_close("optimal_contraction, regular A", cost, 0.5, atol=1e-12, name="cost")
+
+
+@graded(points=1, part="placement")
+def test_placement_flat_neighbourhood_takes_the_midpoint(lab):
+    """all planes z = 0: A singular and the cost 0 along the whole segment → the midpoint"""
+    pos, cost = lab.optimal_contraction(planes([0, 0, 1, 0]), [0.0, 0, 0], [1.0, 2, 0])
+    expect_close(
+        "optimal_contraction, flat neighbourhood",
+        pos,
+        [0.5, 1, 0],
+        atol=1e-12,
+        name="position",
+        hint="A is singular and the cost is constant on the segment: ties go to the midpoint",
+    )
+    expect_close("optimal_contraction, flat neighbourhood", cost, 0.0, atol=1e-12, name="cost")
+
+
+@graded(points=1, part="placement")
+def test_placement_linear_neighbourhood_searches_the_segment(lab):
+    """planes x = 0 and y = 0 (a line of minimisers): on v1 + t(v2 - v1) the cost is (4t - 1)² + 1/4 → t = 1/4"""
+    Q = planes([1, 0, 0, 0], [0, 1, 0, 0])
+    pos, cost = lab.optimal_contraction(Q, [-1.0, 0.5, 0], [3.0, 0.5, 2])
+    expect_close(
+        "optimal_contraction, linear neighbourhood",
+        pos,
+        [0.0, 0.5, 0.5],
+        atol=1e-9,
+        name="position",
+        hint="t* = -dᵀ(A v1 + b) / (dᵀ A d), clipped to [0, 1]",
+    )
+    expect_close("optimal_contraction, linear neighbourhood", cost, 0.25, atol=1e-9, name="cost")
+    # t* = 5 for the line x = 5, y = 0 and the segment (0,0,0)-(1,0,0): clipped to t = 1, cost 16
+    pos, cost = lab.optimal_contraction(planes([1, 0, 0, -5], [0, 1, 0, 0]), [0.0, 0, 0], [1.0, 0, 0])
+    expect_close(
+        "optimal_contraction, minimiser beyond v2",
+        pos,
+        [1.0, 0, 0],
+        atol=1e-12,
+        name="position",
+        hint="clip t to [0, 1]",
+    )
+    expect_close("optimal_contraction, minimiser beyond v2", cost, 16.0, atol=1e-9, name="cost")
+
+
+@graded(points=1, part="placement")
+def test_placement_batched_equals_one_by_one(lab):
+    """k pairs at once give the same answers as k single calls (regular, flat and linear mixed)"""
+    Q = np.concatenate(
+        [random_quadrics(4, seed=3) + 0.1 * np.eye(4), [planes([0, 0, 1, 0])], [planes([1, 0, 0, 0], [0, 1, 0, 0])]]
+    )
+    rng = np.random.default_rng(4)
+    v1, v2 = rng.normal(size=(6, 3)), rng.normal(size=(6, 3))
+    pos, cost = lab.optimal_contraction(Q, v1, v2)
+    expect_true(
+        "optimal_contraction on 6 pairs",
+        np.shape(pos) == (6, 3) and np.shape(cost) == (6,),
+        f"expected shapes (6, 3) and (6,), got {np.shape(pos)} and {np.shape(cost)}",
+    )
+    for k in range(6):
+        p1, c1 = lab.optimal_contraction(Q[k], v1[k], v2[k])
+        expect_close(f"optimal_contraction: pair {k} alone vs in the batch", pos[k], p1, atol=1e-9, name="position")
+        expect_close(f"optimal_contraction: pair {k} alone vs in the batch", cost[k], c1, atol=1e-9, name="cost")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 3: contraction
+
+
+@graded(points=1, part="contraction")
+def test_link_condition_tetrahedron_and_octahedron(lab):
+    """tetrahedron: every edge fails (two copies of a triangle would remain); octahedron: every edge passes"""
+    E = topology.unique_edges(TET_F)
+    link, _ = lab.check_contractions(TET_V, TET_F, E, 0.5 * (TET_V[E[:, 0]] + TET_V[E[:, 1]]))
+    expect_true(
+        "link condition on a tetrahedron", not np.any(link), f"got {np.asarray(link).tolist()}, expected all False"
+    )
+    E = topology.unique_edges(OCTA_F)
+    link, _ = lab.check_contractions(OCTA_V, OCTA_F, E, OCTA_V[E[:, 0]])
+    expect_true(
+        "link condition on an octahedron",
+        np.all(link),
+        f"got {np.asarray(link).tolist()}, expected all True (each edge has exactly its 2 opposite vertices in common)",
+    )
+
+
+@graded(points=1, part="contraction")
+def test_link_condition_on_a_boundary(lab):
+    """3 x 3 grid: boundary edges pass; interior edges between two boundary vertices would pinch the disk"""
+    E = topology.unique_edges(GRID_F)
+    link, _ = lab.check_contractions(GRID_V, GRID_F, E, GRID_V[E[:, 0]])
+    B = {tuple(sorted(e)) for e in topology.boundary_edges(GRID_F).tolist()}
+    expected = []
+    for a, b in E.tolist():
+        if (a, b) in B:  # a boundary edge: common neighbours = the opposite vertex (+ the outside)
+            expected.append(True)
+        else:  # interior edges: those touching the centre vertex 4 pass, the others join two boundary vertices
+            expected.append(4 in (a, b))
+    got = np.asarray(link).tolist()
+    bad = [tuple(e) for e, g, x in zip(E.tolist(), got, expected) if g != x]
+    expect_true(
+        "link condition on the 3 x 3 grid",
+        not bad,
+        f"edges {bad} are wrong (expected {[x for e, x in zip(E.tolist(), expected) if tuple(e) in bad]}); "
+        "count the outside of the boundary as one extra vertex next to every boundary vertex",
+    )
+
+
+@graded(points=1, part="contraction")
+def test_flip_test_on_a_fan(lab):
+    """fan around vertex 0: moving (0, 1) to (0.5, 0) is fine; (-2, 2) turns face (0, 2, 3) over; (-0.5, 0.5) flattens it"""
+    _, flips = lab.check_contractions(FAN_V, FAN_F, [[0, 1]] * 3, [[0.5, 0, 0], [-2.0, 2.0, 0], [-0.5, 0.5, 0]])
+    expect_true(
+        "flip test on the fan",
+        np.asarray(flips).tolist() == [False, True, True],
+        f"got {np.asarray(flips).tolist()}, expected [False, True, True] (a face on the line through vertices 2 and 3 "
+        "is degenerate and counts as flipped)",
+    )
+
+
+@graded(points=1, part="contraction")
+def test_contract_one_octahedron_edge(lab):
+    """contracting (0, 2) of the octahedron: the two faces on the edge die, 2 becomes 0, Q[0] = Q0 + Q2"""
+    Q = random_quadrics(6, seed=1)
+    V, F, Q2, removed = lab.contract_pairs(OCTA_V, OCTA_F, Q, [[0, 2]], [[0.5, 0.5, 0.0]])
+    expect_close("contract_pairs: removed faces", removed, [2], name="removed")
+    expected_F = rename_and_drop(OCTA_F, [(0, 2)])
+    if np.shape(F) != expected_F.shape or not np.array_equal(F, expected_F):
+        raise Mismatch(
+            f"contract_pairs on the octahedron: F should be {expected_F.tolist()}, got {np.asarray(F).tolist()}"
+        )
+    expect_close("contract_pairs: V[0]", np.asarray(V)[0], [0.5, 0.5, 0.0], name="V[0]")
+    expect_close("contract_pairs: Q[0]", np.asarray(Q2)[0], Q[0] + Q[2], name="Q[0]")
+
+
+@graded(points=1, part="contraction")
+def test_contraction_chain_keeps_the_bookkeeping(lab):
+    """three contractions in a row around one vertex: each must see the faces the previous one gave it"""
+    V, F = datasets.icosphere(1)
+    Q = random_quadrics(len(V), seed=2)
+    A = topology.vertex_adjacency(F)
+    ring = A.indices[A.indptr[0] : A.indptr[1]]
+    pairs = [(0, int(ring[0])), (0, int(ring[2])), (0, int(ring[4]))]
+    _, F2, Q2, removed = lab.contract_pairs(V, F, Q, pairs, np.repeat(V[:1], 3, axis=0))
+    expected_F = rename_and_drop(F, pairs)
+    if np.shape(F2) != expected_F.shape or not np.array_equal(F2, expected_F):
+        raise Mismatch(
+            f"contract_pairs, 3 contractions into vertex 0: expected {len(expected_F)} faces (kept in their original order, "
+            f"renamed), got {np.shape(F2)[0] if np.ndim(F2) == 2 else F2}; update vertex_faces of the survivor"
+        )
+    expect_close("contract_pairs: faces removed by each", removed, [2, 2, 2], name="removed")
+    expect_close(
+        "contract_pairs: Q[0] after three merges",
+        np.asarray(Q2)[0],
+        Q[[0, *[j for _, j in pairs]]].sum(axis=0),
+        name="Q[0]",
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Task 4: the greedy loop
+
+
+@graded(points=1, part="greedy loop")
+def test_face_count_is_within_two_of_the_target(lab):
+    """targets 200, 101 and 40 on a torus of 576 faces: each result within 2, valid, no flips"""
+    V, F = datasets.torus(n_major=24, n_minor=12)
+    for target in (200, 101, 40):
+        V2, F2 = lab.qem_simplify(V, F, target)
+        problem = validity_problem(V, F, V2, F2, target)
+        if problem:
+            raise Mismatch(f"qem_simplify(torus, {target}): {problem}")
+
+
+@graded(points=1, part="greedy loop")
+def test_box_simplifies_to_twelve_exact_triangles(lab):
+    """a sharp box of 432 faces needs only 12 triangles: the 8 corners stay where they are (zero cost)"""
+    V, F = datasets.sharp_box(n=6)
+    V2, F2 = lab.qem_simplify(V, F, 12)
+    problem = validity_problem(V, F, V2, F2, 12)
+    if problem:
+        raise Mismatch(f"qem_simplify(sharp box, 12): {problem}")
+    corners = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    V2 = np.asarray(V2, float)
+    d = np.linalg.norm(V2[:, None] - corners[None], axis=2).min(axis=0)
+    expect_true(
+        "qem_simplify(sharp box, 12)",
+        d.max() < 1e-6,
+        f"a box corner has no vertex within 1e-6 (nearest at {d.max():.3g}); three planes meet in each corner, so the "
+        "optimal position of a pair there is the corner itself",
+    )
+
+
+@graded(points=1, part="greedy loop")
+def test_unreachable_target_gives_a_clear_error(lab):
+    """two tetrahedra (8 faces) cannot lose a face without breaking the link condition"""
+    V, F = two_tetrahedra()
+    expect_raises(
+        lambda: lab.qem_simplify(V, F, 4), "MeshError", match="stopped at 8", label="qem_simplify(two tetrahedra, 4)"
+    )
+
+
+@graded(points=1, part="greedy loop")
+def test_non_edge_pairs_close_a_crack(lab):
+    """two sheets 0.02 apart: with pair_threshold = 0.05 the crack is zipped into one piece"""
+    V, F = cracked_sheet()
+    V2, F2 = lab.qem_simplify(V, F, 20, pair_threshold=0.05, preserve_boundary=False)
+    F2 = np.asarray(F2)
+    count = topology.connected_components_faces(F2)[0]
+    expect_true(
+        "qem_simplify(cracked sheet, 20, pair_threshold=0.05)",
+        count == 1 and topology.is_edge_manifold(F2) and abs(len(F2) - 20) <= 2,
+        f"got {count} piece(s) and {len(F2)} faces, edge-manifold: {topology.is_edge_manifold(F2)}; expected one "
+        "piece of about 20 faces: non-edge pairs closer than the threshold must be in the heap too",
+    )
+
+
+@graded(points=1, part="greedy loop")
+def test_bad_targets(lab):
+    """a valid call first, then MeshErrors for target < 4, target > faces and a non-integer target"""
+    V, F = noisy_icosphere(1, 0.01, 0)
+    V2, F2 = lab.qem_simplify(V, F, 40)
+    problem = validity_problem(V, F, V2, F2, 40)
+    if problem:
+        raise Mismatch(f"qem_simplify(icosphere, 40): {problem}")
+    expect_raises(lambda: lab.qem_simplify(V, F, 3), "MeshError", match=">= 4", label="qem_simplify(target_faces=3)")
+    expect_raises(
+        lambda: lab.qem_simplify(V, F, 81), "MeshError", match="more than", label="qem_simplify(target_faces=81)"
+    )
+    expect_raises(
+        lambda: lab.qem_simplify(V, F, 40.5), "MeshError", match="integer", label="qem_simplify(target_faces=40.5)"
+    )
