@@ -79,7 +79,9 @@ def as_array(
         raise MeshError(f"{p}{name} is missing (got None)")
     try:
         a = np.asarray(x)
-    except Exception as e:  # ragged lists and the like
+    except ValueError:
+        raise MeshError(f"{p}{name} is ragged (rows of different lengths); expected one numeric array") from None
+    except Exception as e:
         raise MeshError(f"{p}{name} could not be read as an array ({e})") from None
     if a.dtype == object:
         raise MeshError(f"{p}{name} is ragged or holds non-numbers (dtype object); expected a numeric array")

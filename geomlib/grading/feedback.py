@@ -40,11 +40,9 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
         a = render.render(Ve, Fe_t, wireframe=len(Fe_t) < 5000, size=size)
         b = render.render(Vg, Fg_t, wireframe=len(Fg_t) < 5000, size=size)
         c = render.render(Vg, Fg_t, colors=colors, size=size)
-        img = plot.panels(
-            [a, b, c],
-            ["expected", "submitted", f"distance to nearest expected vertex (max {d.max():.3g})"],
-            title=ctx.label,
-        )
+        bar = plot.colorbar(0.0, max(float(d.max()), 1e-12), cmap="inferno", label="distance", height=size[1])
+        captions = ["expected", "submitted", f"distance to nearest expected vertex (max {d.max():.3g})", ""]
+        img = plot.panels([a, b, c, bar], captions, title=ctx.label)
         plot.save_png(path, img)
         return _relpath(path)
     except Exception:
@@ -65,10 +63,11 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
                 x = np.repeat(x[..., None], 3, axis=2)
             return (x[..., :3] * 255).round().astype(np.uint8)
 
-        heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=max(float(per_pixel.max()), 1e-12))
-        img = plot.panels(
-            [to_rgb(expected), to_rgb(got), heat], ["expected", "submitted", "|difference|"], title=ctx.label
-        )
+        vmax = max(float(per_pixel.max()), 1e-12)
+        heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=vmax)
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label="|difference|", height=max(128, heat.shape[0]))
+        captions = ["expected", "submitted", "|difference|", ""]
+        img = plot.panels([to_rgb(expected), to_rgb(got), heat, bar], captions, title=ctx.label)
         plot.save_png(path, img)
         return _relpath(path)
     except Exception:

@@ -1,0 +1,133 @@
+"""MeshError messages name the problem and the place."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from geomlib import datasets
+from geomlib.validate import (
+    MeshError,
+    as_image,
+    as_polygons,
+    check_choice,
+    check_float,
+    check_int,
+    check_mesh,
+    check_polygon_mesh,
+)
+
+TRI = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+
+
+def test_mesh_error_is_a_value_error():
+    assert issubclass(MeshError, ValueError)
+
+
+@pytest.mark.parametrize(
+    "V, F, message",
+    [
+        (
+            np.array([[0, 0, np.nan], [1, 0, 0], [0, 1, 0.0]]),
+            [[0, 1, 2]],
+            "f: V: row 0 has a non-finite value (0, 0, nan)",
+        ),
+        (np.array([[0, 0, 0], [1, 0, 0], [0, 1, np.inf]]), [[0, 1, 2]], "f: V: row 2 has a non-finite value"),
+        (TRI[:, :2], [[0, 1, 2]], "f: V has shape (3, 2), expected (n, 3)"),
+        (TRI, [[0, 1, 3]], "f: F: face 0 uses vertex 3, but V has only 3 vertices (valid indices 0..2)"),
+        (TRI, [[0, 1, 2], [0, -1, 2]], "f: F: face 1 (0, -1, 2) has a negative index"),
+        (TRI, [[0, 1, 1]], "f: F: face 0 (0, 1, 1) is degenerate (repeats a vertex)"),
+        (TRI, [[0, 1, 2], [1, 2, 0]], "f: F: faces 0 and 1 are duplicates (both use vertices (0, 1, 2))"),
+        (TRI, [[0, 1, 2, 0]], "f: F has shape (1, 4): this function needs triangles (m, 3)"),
+        (TRI, [[0, 1.5, 2]], "f: F holds a non-integer value 1.5"),
+        (TRI, np.array([["a", "b", "c"]]), "f: F has dtype <U1, expected integers"),
+        (TRI, None, "f: F is missing (got None)"),
+        ([[0, 0], [1, 0, 0]], [[0, 1, 2]], "f: V is ragged (rows of different lengths)"),
+    ],
+)
+def test_bad_meshes_name_the_problem_and_the_place(V, F, message):
+    with pytest.raises(MeshError) as e:
+        check_mesh(V, F, where="f")
+    assert message in str(e.value)
+
+
+def test_non_manifold_edge_names_the_edge_and_its_faces():
+    V = np.random.default_rng(0).random((5, 3))
+    with pytest.raises(MeshError, match=r"edge \(0, 1\) is shared by 3 faces \(0, 1, 2\)"):
+        check_mesh(V, [[0, 1, 2], [1, 0, 3], [0, 1, 4]], where="f", manifold=True)
+
+
+def test_non_manifold_vertex_names_the_vertex():
+    V = np.random.default_rng(0).random((5, 3))
+    with pytest.raises(MeshError, match=r"vertex 0 is non-manifold \(its faces form 2 separate fans\)"):
+        check_mesh(V, [[0, 1, 2], [0, 3, 4]], where="f", manifold=True)
+
+
+def test_two_cones_touching_at_a_vertex_are_non_manifold():
+    # Two closed tetrahedra sharing only vertex 0: every edge has 2 faces, but vertex 0 has 2 fans.
+    V = np.random.default_rng(1).random((7, 3))
+    a = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    b = [[0, 5, 4], [0, 4, 6], [0, 6, 5], [4, 5, 6]]
+    with pytest.raises(MeshError, match="vertex 0 is non-manifold"):
+        check_mesh(V, a + b, manifold=True)
+
+
+def test_inconsistent_orientation_is_named():
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    with pytest.raises(MeshError, match="faces 0 and 1 both traverse edge .* same direction"):
+        check_mesh(V, [[0, 1, 2], [0, 2, 3][::-1]], manifold=True)
+
+
+def test_closed_requirement_counts_boundary_edges():
+    V, F = datasets.grid_patch(2)
+    with pytest.raises(MeshError, match="mesh has 8 boundary edges"):
+        check_mesh(V, F, closed=True)
+
+
+def test_valid_meshes_pass_and_come_back_as_float64_int64():
+    for V, F in (datasets.icosphere(1), datasets.torus(), datasets.grid_patch(3)):
+        V2, F2 = check_mesh(V.astype(np.float32), F.astype(np.int32), manifold=True)
+        assert V2.dtype == np.float64 and F2.dtype == np.int64
+
+
+def test_polygons():
+    idx, off = as_polygons([[0, 1, 2, 3], [3, 2, 4]], 5)
+    assert idx.tolist() == [0, 1, 2, 3, 3, 2, 4] and off.tolist() == [0, 4, 7]
+    with pytest.raises(MeshError, match="face 1 has 2 vertices, a polygon needs at least 3"):
+        as_polygons([[0, 1, 2], [1, 2]], 3, where="f")
+    with pytest.raises(MeshError, match="face 0 uses vertex 7, but V has only 5 vertices"):
+        as_polygons([[0, 1, 7]], 5)
+    with pytest.raises(MeshError, match=r"face 0 \(0, 1, 0, 2\) is degenerate"):
+        as_polygons([[0, 1, 0, 2]], 5)
+    V, Q = datasets.quad_cube()
+    check_polygon_mesh(V, Q, manifold=True)
+    with pytest.raises(MeshError, match=r"faces: edge \(0, 1\) is shared by 3 faces"):
+        check_polygon_mesh(V, np.vstack([Q, Q[:1, ::-1]]), manifold=True)
+
+
+def test_parameters():
+    assert check_int(np.int64(3), "levels") == 3
+    for bad, msg in (
+        (-1, "levels must be >= 0, got -1"),
+        (1.5, "levels must be an integer, got 1.5"),
+        (True, "must be an integer"),
+    ):
+        with pytest.raises(MeshError, match=msg):
+            check_int(bad, "levels", minimum=0)
+    with pytest.raises(MeshError, match="lam must be <= 1"):
+        check_float(2.0, "lam", maximum=1.0)
+    with pytest.raises(MeshError, match="lam must be finite"):
+        check_float(np.nan, "lam")
+    with pytest.raises(MeshError, match="weights must be one of 'warren', 'loop'; got 'cotan'"):
+        check_choice("cotan", "weights", ("warren", "loop"))
+
+
+def test_images():
+    with pytest.raises(MeshError, match="height is 8x6 pixels; expected a square image"):
+        as_image(np.zeros((8, 6)), "height", square=True)
+    with pytest.raises(MeshError, match="has 4 channel"):
+        as_image(np.zeros((4, 4, 4)), "normal_map", channels=3)
+    with pytest.raises(MeshError, match="is 4x4 pixels; expected 8x8"):
+        as_image(np.zeros((4, 4)), size=(8, 8))
+    with pytest.raises(MeshError, match=r"shape \(4,\); expected an image"):
+        as_image(np.zeros(4))
