@@ -313,7 +313,7 @@ def transport_grid(
     field,
     res: int,
     *,
-    boundary: str = "slide",
+    boundary: str = "fixed",
     iterations: int = 20,
     smoothing: float = 1.0,
     return_info: bool = False,
@@ -328,11 +328,12 @@ def transport_grid(
         ``n >= 4``; about ``2 * res`` is a good size.
     res : int
         Grid vertices per side (>= 2).
-    boundary : {"slide", "fixed"}
-        ``"slide"`` (default): boundary vertices stay on their own edge of the square but may slide
-        along it as the transport map moves them; the four corners never move. ``"fixed"``: boundary
-        vertices keep their uniform positions; their tangential offset is removed from the interior
-        with a harmonic blend.
+    boundary : {"fixed", "slide"}
+        ``"fixed"`` (default, as in the lecture): boundary vertices keep their uniform positions on
+        their edges; their tangential offset is removed from the interior with a harmonic blend.
+        ``"slide"``: boundary vertices stay on their own edge of the square but may slide along it as
+        the transport map moves them (the lecture's noted option: it improves the fit; ``bake_vdm``
+        uses it by default); the four corners never move.
     iterations : int
         Back-and-forth iterations.
     smoothing : float

@@ -148,8 +148,9 @@ def bake_vdm(
     background, sigma : float
         Importance field parameters (:func:`importance_field`); ``field_res`` its pixels per side
         (default ``max(64, res)``).
-    boundary : str
-        :func:`transport_grid`'s boundary mode.
+    boundary : {"slide", "fixed"}
+        :func:`transport_grid`'s boundary mode; sliding boundary vertices fit the mesh better, so the
+        bake uses it by default.
     area_weighted : bool
         Weight the background importance by the parameterization's area stretch
         (:func:`area_density`), so that feature-free regions are sampled by surface area.
