@@ -135,8 +135,13 @@ def _local_minima(
 
 def _unique(x: np.ndarray) -> np.ndarray:
     """Sorted distinct values of an int array (a sort is faster than np.unique's hash path here)."""
+    if len(x) == 0:
+        return x
     x = np.sort(x)
-    return x[np.r_[True, x[1:] != x[:-1]]] if len(x) else x
+    keep = np.empty(len(x), dtype=bool)
+    keep[0] = True
+    np.not_equal(x[1:], x[:-1], out=keep[1:])
+    return x[keep]
 
 
 class _VertexFaces:
@@ -155,8 +160,10 @@ class _VertexFaces:
     def around_each(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The faces around each of ``vertices``: face ids and, for each, the position in ``vertices``."""
         lens = self.counts[vertices]
-        offsets = np.repeat(self.start[vertices] - np.r_[0, np.cumsum(lens)[:-1]], lens)
-        return self.face[offsets + np.arange(int(lens.sum()))], np.repeat(np.arange(len(vertices)), lens)
+        ends = np.cumsum(lens)
+        total = int(ends[-1]) if len(ends) else 0
+        offsets = np.repeat(self.start[vertices] - (ends - lens), lens)
+        return self.face[offsets + np.arange(total)], np.repeat(np.arange(len(vertices)), lens)
 
 
 def _valid(
@@ -179,9 +186,10 @@ def _valid(
     fa, ea = vf.around_each(a)
     fb, eb = vf.around_each(b)
     # Link condition: the neighbours of a (side 0) and of b (side 1), without the pair itself.
+    Ta, Tb = F[fa], F[fb]
     rec = []
-    for faces, e, side in ((fa, ea, 0), (fb, eb, 1)):
-        w, e3 = F[faces].ravel(), np.repeat(e, 3)
+    for T, e, side in ((Ta, ea, 0), (Tb, eb, 1)):
+        w, e3 = T.ravel(), np.repeat(e, 3)
         keep = (w != a[e3]) & (w != b[e3])
         rec.append((e3[keep] * n + w[keep]) * 2 + side)
     rec = _unique(np.concatenate(rec))  # distinct (edge, neighbour, side)
@@ -195,15 +203,16 @@ def _valid(
     link_ok = common + both_boundary == edge_count + (edge_count == 1)
     link_ok &= ~((degree[:, 0] + boundary[a] <= 3) & (degree[:, 1] + boundary[b] <= 3))
     # Flip test on the faces around a that do not use b, and around b that do not use a.
-    fa_only = ~(F[fa] == b[ea][:, None]).any(axis=1)
-    fb_only = ~(F[fb] == a[eb][:, None]).any(axis=1)
-    faces = np.r_[fa[fa_only], fb[fb_only]]
-    e = np.r_[ea[fa_only], eb[fb_only]]
-    T = F[faces]
+    fa_only = ~(Ta == b[ea][:, None]).any(axis=1)
+    fb_only = ~(Tb == a[eb][:, None]).any(axis=1)
+    faces = np.concatenate([fa[fa_only], fb[fb_only]])
+    e = np.concatenate([ea[fa_only], eb[fb_only]])
+    T = np.concatenate([Ta[fa_only], Tb[fb_only]])
     P = V[T]
     n_old = _cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
-    moved = (T == a[e][:, None]) | (T == b[e][:, None])
-    P[moved] = pos[np.broadcast_to(e[:, None], T.shape)[moved]]
+    # each of these faces holds exactly one end of its edge: that corner moves to the new position
+    moving = np.concatenate([a[ea[fa_only]], b[eb[fb_only]]])
+    P[np.arange(len(T)), (T == moving[:, None]).argmax(axis=1)] = pos[e]
     n_new = _cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
     len_new = np.sqrt((n_new * n_new).sum(axis=1))
     flipped = np.zeros(len(T), dtype=bool)
@@ -346,7 +355,7 @@ def fast_collapse(
                 break  # diminishing returns: leave the rest to the next pass
             accepted.append(good)
             if len(good):
-                blocked[F[vf.around(np.r_[lo[good], hi[good]])].ravel()] = True  # the ends and their 1-rings
+                blocked[F[vf.around(np.concatenate([lo[good], hi[good]]))].ravel()] = True  # the ends and their 1-rings
         acc = np.concatenate(accepted) if accepted else np.zeros(0, np.int64)
         if len(acc) == 0 and not any(len(f) for f in failed):
             break  # every usable edge was tested and failed: no valid contraction left
@@ -354,8 +363,8 @@ def fast_collapse(
         acc = acc[np.cumsum(edge_count[acc]) - edge_count[acc] < excess]  # stop once the target is met
         touched[blocked] = n_pass
         fail = np.concatenate(failed)
-        new_keys = np.r_[bad_keys, keys[fail]]
-        new_pass = np.r_[bad_pass, np.full(len(fail), n_pass)]
+        new_keys = np.concatenate([bad_keys, keys[fail]])
+        new_pass = np.concatenate([bad_pass, np.full(len(fail), n_pass)])
         order = np.argsort(new_keys, kind="stable")  # equal keys stay in pass order: keep the last
         new_keys, new_pass = new_keys[order], new_pass[order]
         last = np.r_[new_keys[1:] != new_keys[:-1], True][: len(new_keys)]
@@ -403,6 +412,7 @@ def refine_positions(
     max_points: int = 200_000,
     min_cos: float = 0.2,
     normals0: np.ndarray | None = None,
+    keep_max_error: bool = True,
 ) -> np.ndarray:
     """Move the vertices of a simplified mesh to fit the input surface in the least-squares sense.
 
@@ -422,6 +432,12 @@ def refine_positions(
     QEM places each vertex at the minimum of its *accumulated quadric*, a proxy for the distance to
     the input; this step minimises the distance itself, which lowers the RMS error by 10-30%.
 
+    A least-squares fit lowers the mean distance but can raise the largest one (a peak or a crease
+    that the fit averages away). With ``keep_max_error`` the faces that end up farther from the
+    input than the farthest face was before the fit (measured at 7 points per face) get their
+    old corner positions back, so the one-sided Hausdorff distance from the result to the input
+    does not grow.
+
     Parameters
     ----------
     V0, F0 : (n0, 3) float64, (m0, 3) int64
@@ -431,6 +447,8 @@ def refine_positions(
     normals0 : (m, 3) float64, optional
         Normal of each face of ``G`` in the input mesh (``face_normal0``): a move must not turn a
         face against it either (as in the flip test of the contractions).
+    keep_max_error : bool
+        Undo the moves that would raise the largest distance from the result to the input.
 
     Returns
     -------
@@ -461,6 +479,25 @@ def refine_positions(
         shape=(len(E), n),
     )
     weight = smoothness * len(P) / max(len(E), 1)
+    if keep_max_error:
+        import igl
+
+        tree = igl.AABB()
+        V0, F0 = np.ascontiguousarray(V0, np.float64), np.ascontiguousarray(F0, np.int64)
+        tree.init(V0, F0)
+        # the centroid and the points halfway between it and each corner (the corners come per vertex)
+        weights = np.array([[1 / 3] * 3, [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
+
+        def tree_error(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
+            """Largest squared distance to the input over 7 sample points of each of ``faces`` of (X, G)."""
+            corners = _unique(G[faces].ravel())
+            S = np.concatenate([X[corners], np.einsum("kc,fcd->fkd", weights, X[G[faces]]).reshape(-1, 3)])
+            d2 = np.asarray(tree.squared_distance(V0, F0, S)[0])
+            at_corner = np.zeros(n)
+            at_corner[corners] = d2[: len(corners)]
+            inside = d2[len(corners) :].reshape(len(faces), len(weights)).max(axis=1)
+            return np.maximum(inside, at_corner[G[faces]].max(axis=1))
+
     for _ in range(iterations):
         _, face, C = closest_points(U, G, P)
         beta = _barycentric(C, U[G[face, 0]], U[G[face, 1]], U[G[face, 2]])
@@ -470,6 +507,17 @@ def refine_positions(
         R = R[free] - M[free][:, fixed] @ U[fixed]
         new = U.copy()
         new[free] = spsolve(M[free][:, free].tocsc(), R).reshape(-1, 3)
+        if keep_max_error:
+            check = np.arange(len(G))
+            limit = tree_error(U, check).max()
+            for _ in range(8):  # each round puts back the corners of the faces that got too far
+                back = _unique(G[check[tree_error(new, check) > limit]].ravel())
+                if len(back) == 0:
+                    break
+                new[back] = U[back]
+                hit = np.zeros(n, dtype=bool)
+                hit[back] = True
+                check = np.flatnonzero(hit[G].any(axis=1))  # only faces around the reverted corners changed
         n_old = _cross(U[G[:, 1]] - U[G[:, 0]], U[G[:, 2]] - U[G[:, 0]])
         refs = (n_old,) if normals0 is None else (n_old, normals0)
         for _ in range(8):  # undo moves that turn faces (few vertices, few rounds)
