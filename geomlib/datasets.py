@@ -655,9 +655,6 @@ def split_nonmanifold_vertices(V, F) -> tuple[np.ndarray, np.ndarray]:
     F2 : (m, 3) int64
         The same faces, re-indexed.
     """
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-
     V, F = check_mesh(V, F, where="split_nonmanifold_vertices")
     h, n = F.size, len(V)
     nxt = (np.arange(h).reshape(-1, 3)[:, [1, 2, 0]]).ravel()
@@ -668,11 +665,8 @@ def split_nonmanifold_vertices(V, F) -> tuple[np.ndarray, np.ndarray]:
     twin = np.where(key[order][pos] == b * n + a, order[pos], -1)
     j = np.flatnonzero(twin >= 0)
     # Corner j and the corner of the same vertex across its outgoing edge lie in the same fan.
-    G = sp.coo_matrix((np.ones(len(j)), (j, nxt[twin[j]])), shape=(h, h))
-    k, label = connected_components(G, directed=False)
-    owner = np.empty(k, np.int64)
-    owner[label] = a
-    return V[owner], label.reshape(-1, 3).astype(np.int64)
+    label, owner = topology.corner_fans(a, j, nxt[twin[j]])
+    return V[owner], label.reshape(-1, 3)
 
 
 # --------------------------------------------------------------------------------------------

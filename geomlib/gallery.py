@@ -18,37 +18,10 @@ import numpy as np
 from geomlib import topology
 from geomlib.plot import Figure, panels, save_png, write_index
 
-__all__ = ["build_gallery", "write_index", "extraordinary_vertices"]
+__all__ = ["build_gallery", "write_index"]
 
 #: Largest number of extraordinary vertices still marked with dots (more would be clutter).
 MAX_MARKED = 60
-
-
-def extraordinary_vertices(faces, n_vertices: int) -> np.ndarray:
-    """Interior vertices whose valence is not the regular one (6 on triangle meshes, 4 on quad-dominant ones).
-
-    Parameters
-    ----------
-    faces : (m, k) int array, list of polygons, or ``(indices, offsets)``
-        The faces.
-    n_vertices : int
-        Number of vertices.
-
-    Returns
-    -------
-    (k,) int64
-        Sorted vertex indices (boundary vertices are never listed).
-    """
-    idx, off = topology.to_ragged(faces)
-    sizes = np.diff(off)
-    regular = 6 if np.mean(sizes) < 3.5 else 4
-    val = topology.valence((idx, off), n_vertices)
-    boundary = np.zeros(n_vertices, dtype=bool)
-    b = topology.boundary_edges((idx, off))
-    boundary[b.ravel()] = True
-    used = np.zeros(n_vertices, dtype=bool)
-    used[idx] = True
-    return np.flatnonzero(used & ~boundary & (val != regular)).astype(np.int64)
 
 
 def _thumbnail(img: np.ndarray, width: int) -> np.ndarray:
@@ -101,7 +74,7 @@ def build_gallery(out_dir, quick: bool = False, *, names: list[str] | None = Non
             V = np.asarray(V, dtype=np.float64)
             idx, off = topology.to_ragged(faces)
             E = topology.unique_edges((idx, off))
-            special = extraordinary_vertices((idx, off), len(V))
+            special = topology.extraordinary_vertices((idx, off), len(V))
             marked = special if 0 < len(special) <= MAX_MARKED else None
             opts = dict(
                 wireframe=True,

@@ -28,6 +28,8 @@ __all__ = [
     "vertex_adjacency",
     "valence",
     "vertex_fan_counts",
+    "corner_fans",
+    "extraordinary_vertices",
     "euler_characteristic",
     "genus",
     "connected_components_faces",
@@ -227,12 +229,59 @@ def vertex_fan_counts(faces, offsets: np.ndarray | None = None, n_vertices: int 
     hi1 = np.where(a[h1] < b[h1], nxt[h1], h1)
     lo2 = np.where(a[h2] < b[h2], h2, nxt[h2])
     hi2 = np.where(a[h2] < b[h2], nxt[h2], h2)
-    rows, cols = np.r_[lo1, hi1], np.r_[lo2, hi2]
+    _, owner = corner_fans(idx, np.r_[lo1, hi1], np.r_[lo2, hi2])
+    return np.bincount(owner, minlength=n).astype(np.int64)
+
+
+def corner_fans(idx: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Group face corners into fans: corners linked across shared edges, around one vertex each.
+
+    Parameters
+    ----------
+    idx : (c,) int
+        Vertex of every corner (ragged face indices).
+    rows, cols : (k,) int
+        Pairs of corners of the same vertex that lie in faces sharing an edge through it.
+
+    Returns
+    -------
+    labels : (c,) int64
+        Fan of every corner.
+    owner : (f,) int64
+        Vertex of every fan; a vertex owning more than one fan is non-manifold.
+    """
+    N = len(idx)
     G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(N, N))
     ncomp, labels = connected_components(G, directed=False)
-    first = np.full(ncomp, -1, dtype=np.int64)
-    first[labels[::-1]] = np.arange(N)[::-1]  # one corner per component
-    return np.bincount(idx[first], minlength=n).astype(np.int64)
+    owner = np.empty(ncomp, dtype=np.int64)
+    owner[labels] = idx
+    return labels.astype(np.int64), owner
+
+
+def extraordinary_vertices(faces, n_vertices: int, regular: int | None = None) -> np.ndarray:
+    """*Polygons*: interior vertices whose valence is not the regular one.
+
+    Parameters
+    ----------
+    faces : (m, k) int array, list of polygons, or ``(indices, offsets)``
+    n_vertices : int
+    regular : int, optional
+        Regular valence; default 6 on triangle-dominant meshes (mean face size < 3.5), else 4.
+
+    Returns
+    -------
+    (k,) int64
+        Sorted vertex indices (boundary and unreferenced vertices are never listed).
+    """
+    idx, off = to_ragged(faces)
+    if regular is None:
+        regular = 6 if np.mean(np.diff(off)) < 3.5 else 4
+    val = valence((idx, off), n_vertices)
+    boundary = np.zeros(n_vertices, dtype=bool)
+    boundary[boundary_edges((idx, off)).ravel()] = True
+    used = np.zeros(n_vertices, dtype=bool)
+    used[idx] = True
+    return np.flatnonzero(used & ~boundary & (val != regular)).astype(np.int64)
 
 
 def euler_characteristic(faces, n_vertices: int | None = None) -> int:

@@ -178,9 +178,6 @@ def check_manifold(F, n_vertices: int, *, name: str = "F", where: str | None = N
     group sizes (edges in more than two faces), directions within a group (orientation), and the
     corner links across interior edges whose connected components are the fans around each vertex.
     """
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-
     from geomlib import topology
 
     p = _prefix(where)
@@ -220,11 +217,7 @@ def check_manifold(F, n_vertices: int, *, name: str = "F", where: str | None = N
         )
     # Across an interior edge a->b (face f, half-edge h0) / b->a (face g, h1): the corners at a are
     # h0 and nxt[h1], the corners at b are nxt[h0] and h1. Linked corners belong to one fan.
-    rows, cols = np.r_[h0, nxt[h0]], np.r_[nxt[h1], h1]
-    G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(h, h))
-    ncomp, labels = connected_components(G, directed=False)
-    owner = np.empty(ncomp, dtype=np.int64)
-    owner[labels] = idx
+    _, owner = topology.corner_fans(idx, np.r_[h0, nxt[h0]], np.r_[nxt[h1], h1])
     fans = np.bincount(owner, minlength=n)
     if (fans > 1).any():
         v = int(np.flatnonzero(fans > 1)[0])

@@ -39,14 +39,6 @@ def airplane() -> tuple[np.ndarray, np.ndarray]:
     return datasets.pyvista_mesh("airplane", manifold=True)
 
 
-def _extraordinary(faces, n: int) -> np.ndarray:
-    """Vertices of valence != 4 (interior vertices only; boundary ones are not counted)."""
-    val = topology.valence(faces, n)
-    bnd = np.zeros(n, bool)
-    bnd[topology.boundary_edges(faces).ravel()] = True
-    return np.flatnonzero((val != 4) & ~bnd)
-
-
 def _levels(subdivide, V, F, levels: int, **kw) -> list[tuple[np.ndarray, np.ndarray]]:
     out = [(np.asarray(V, float), F)]
     for _ in range(levels):  # one level at a time, so every level can be drawn
@@ -135,7 +127,7 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
         for k in range(L + 1):
             if k:
                 V, faces = catmull_clark(V, faces, 1)
-            ext = _extraordinary(faces, len(V))
+            ext = topology.extraordinary_vertices(faces, len(V), regular=4)
             images.append(
                 render_polygons(
                     V, faces, camera=pose, size=size, supersample=_ss(quick), wireframe=True, wire_opacity=0.8 if k < 3 else 0.35,

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from geomlib import gallery, plot
+from geomlib import gallery, plot, topology
 from geomlib.plot import Figure
 from geomlib.validate import MeshError
 
@@ -188,11 +188,11 @@ def test_extraordinary_vertices():
     from geomlib import datasets
 
     V, F = datasets.icosphere(2)
-    assert len(gallery.extraordinary_vertices(F, len(V))) == 12
+    assert len(topology.extraordinary_vertices(F, len(V))) == 12
     cube = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]
-    assert list(gallery.extraordinary_vertices(cube, 8)) == list(range(8))
+    assert list(topology.extraordinary_vertices(cube, 8)) == list(range(8))
     grid = [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 7, 6], [4, 5, 8, 7]]  # 3 x 3 vertices: only boundary + one regular
-    assert len(gallery.extraordinary_vertices(grid, 9)) == 0
+    assert len(topology.extraordinary_vertices(grid, 9)) == 0
 
 
 def test_build_gallery_files_and_captions(tmp_path, monkeypatch):
