@@ -233,7 +233,9 @@ def vertex_fan_counts(faces, offsets: np.ndarray | None = None, n_vertices: int 
     return np.bincount(owner, minlength=n).astype(np.int64)
 
 
-def corner_fans(idx: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def corner_fans(
+    idx: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, one_per_row: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Group face corners into fans: corners linked across shared edges, around one vertex each.
 
     Parameters
@@ -242,6 +244,11 @@ def corner_fans(idx: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> tuple[np
         Vertex of every corner (ragged face indices).
     rows, cols : (k,) int
         Pairs of corners of the same vertex that lie in faces sharing an edge through it.
+    one_per_row : bool
+        The caller promises that no corner appears twice in ``rows`` (e.g. each corner linked
+        only across its outgoing half-edge). The link graph is then built directly as a CSR
+        matrix with int32 indices and no COO copy: on meshes of millions of corners this halves
+        the peak memory of the call.
 
     Returns
     -------
@@ -251,8 +258,19 @@ def corner_fans(idx: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> tuple[np
         Vertex of every fan; a vertex owning more than one fan is non-manifold.
     """
     N = len(idx)
-    G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(N, N))
-    ncomp, labels = connected_components(G, directed=False)
+    if one_per_row and N < 2**31:
+        link = np.full(N, -1, dtype=np.int32)
+        link[rows] = cols
+        has = link >= 0
+        indptr = np.zeros(N + 1, dtype=np.int32)
+        np.cumsum(has, out=indptr[1:])
+        G = sp.csr_matrix((np.ones(int(indptr[-1]), dtype=np.int8), link[has], indptr), shape=(N, N))
+        del link, has, indptr
+        ncomp, labels = connected_components(G, directed=True, connection="weak")
+    else:
+        G = sp.coo_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(N, N))
+        ncomp, labels = connected_components(G, directed=False)
+    del G
     owner = np.empty(ncomp, dtype=np.int64)
     owner[labels] = idx
     return labels.astype(np.int64), owner

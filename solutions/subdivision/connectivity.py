@@ -17,9 +17,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from geomlib.topology import corner_fans
 from geomlib.validate import MeshError
 
 __all__ = ["MeshTopology", "mesh_topology"]
@@ -190,25 +189,12 @@ def mesh_topology(faces, n_vertices: int, *, where: str | None = None, name: str
     boundary_vertex = np.zeros(n, dtype=bool)
     boundary_vertex[E[boundary_edge].ravel()] = True
     # Fans: link corner j with the corner of the same vertex across its outgoing half-edge j, i.e.
-    # the corner after the twin half-edge. Every corner has at most one such link, so the graph is
-    # a CSR matrix with <= 1 entry per row (int32 indices: no copies inside scipy).
+    # the corner after the twin half-edge. Every corner has at most one such link.
     inner = np.flatnonzero(~boundary_edge)
     h0, h1 = EH[inner, 0], EH[inner, 1]
     del inner
-    link = np.full(h, -1, dtype=np.int32)
-    link[h0] = nxt[h1]
-    link[h1] = nxt[h0]
+    _, owner = corner_fans(idx, np.concatenate([h0, h1]), np.concatenate([nxt[h1], nxt[h0]]), one_per_row=True)
     del h0, h1
-    has = link >= 0
-    indptr = np.zeros(h + 1, dtype=np.int32)
-    np.cumsum(has, out=indptr[1:])
-    G = sp.csr_matrix((np.ones(int(indptr[-1]), dtype=np.int8), link[has], indptr), shape=(h, h))
-    del link, has, indptr
-    n_comp, labels = connected_components(G, directed=True, connection="weak")
-    del G
-    owner = np.empty(n_comp, dtype=np.int64)
-    owner[labels] = idx
-    del labels
     fans = np.bincount(owner, minlength=n)
     if (fans > 1).any():
         v = int(np.flatnonzero(fans > 1)[0])

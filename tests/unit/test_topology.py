@@ -211,3 +211,18 @@ def test_empty_faces():
     empty = np.zeros((0, 3), np.int64)
     assert tp.unique_edges(empty).shape == (0, 2)
     assert tp.boundary_loops(empty) == []
+
+
+@pytest.mark.parametrize("one_per_row", [False, True])
+def test_corner_fans_split_a_bowtie_vertex_into_two_fans(one_per_row):
+    # Two triangle pairs meet only at vertex 0: each pair shares an edge through 0 (0-2 and 0-5).
+    F = np.array([[0, 1, 2], [0, 2, 3], [0, 4, 5], [0, 5, 6]])
+    idx = F.ravel()  # corner 3 f + i is corner i of face f
+    # faces 0 and 1 link their corners at vertices 0 and 2; faces 2 and 3 those at 0 and 5
+    rows = np.array([0, 2, 6, 8])
+    cols = np.array([3, 4, 9, 10])
+    labels, owner = tp.corner_fans(idx, rows, cols, one_per_row=one_per_row)
+    fans = np.bincount(owner, minlength=7)
+    assert fans[0] == 2  # the bowtie vertex
+    assert fans[2] == 1 and fans[5] == 1
+    assert labels[0] == labels[3] and labels[6] == labels[9] and labels[0] != labels[6]
