@@ -114,6 +114,8 @@ def point_shadow_visibility(
     pcf: int = 1,
     *,
     max_slope: float = DEFAULT_MAX_SLOPE,
+    pcf_sampling: str = "grid",
+    pcf_samples: int = 16,
 ) -> np.ndarray:
     """Visibility of a point light through its cube of shadow maps.
 
@@ -127,8 +129,9 @@ def point_shadow_visibility(
         The light.
     near, far : float
         As for the maps.
-    bias, slope_bias, pcf, max_slope
-        As in :func:`shadow_visibility` (PCF does not cross cube faces: it reads the face's border).
+    bias, slope_bias, pcf, max_slope, pcf_sampling, pcf_samples
+        As in :func:`shadow_visibility`, passed on to it (PCF does not cross cube faces: it reads the
+        face's border).
 
     Returns
     -------
@@ -145,4 +148,4 @@ def point_shadow_visibility(
         raise MeshError(f"{where}: maps has shape {maps.shape}, expected (6, size, size): one map per cube face")
     pos = as_array(position, "position", shape=(3,), where=where)
     near, far = _near_far(near, far, where)
-    raise NotImplementedError("Task 8 (cube map): face = cube_face_index(P - position); shadow_visibility with maps[face], Ms[face] for each face's points")
+    raise NotImplementedError("Task 8 (cube map): face = cube_face_index(P - position); shadow_visibility with maps[face], Ms[face] for each face's points (pass the other options on)")

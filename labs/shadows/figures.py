@@ -138,13 +138,16 @@ def fig_pcf(out: Path, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
     meas = _measured("zoom", classic_scene, ZOOM_CAMERA, CLASSIC_LIGHT, size)
     rows = [meas.panel(f"PCF {k} x {k}, 512² map", map_size=512, pcf=k) for k in (1, 3, 5)]
-    page = panels([r[0] for r in rows], [r[1] for r in rows], title="Percentage-closer filtering")
+    rows.append(meas.panel("Poisson disk: 16 samples, radius 2.5 texels", map_size=512, pcf=5, pcf_sampling="poisson"))
+    page = panels([r[0] for r in rows], [r[1] for r in rows], ncols=2, title="Percentage-closer filtering")
     path = save_png(out / "shadows_pcf.png", page)
     return Figure(
         path,
         "Percentage-closer filtering averages the 0/1 shadow test over a k x k block of texels around the "
         "point, turning the staircase of a 512² map into a soft edge about k texels wide. It filters the "
-        "test results, not the depths: averaging depths first would blur the occluder, not the shadow.",
+        "test results, not the depths: averaging depths first would blur the occluder, not the shadow. "
+        "The last panel spreads 16 samples over a disk instead, rotated differently at every texel: the "
+        "square block's bands along the edge become fine noise, with 16 lookups instead of 25.",
         LAB,
     )
 

@@ -169,6 +169,8 @@ def light_visibility(
     frustum_fix: bool = True,
     bounds=None,
     max_slope: float = DEFAULT_MAX_SLOPE,
+    pcf_sampling: str = "grid",
+    pcf_samples: int = 16,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Both passes for the eye's points: ``(visibility (k,), shadow maps (1 or 6, s, s))`` (given)."""
     where = "light_visibility"
@@ -181,12 +183,15 @@ def light_visibility(
         maps = cube_depth_maps(S.V, S.F, setup.light["position"], map_size, setup.near, setup.far, cull)
         vis = point_shadow_visibility(
             eb.P, eb.N_face, maps, setup.light["position"], setup.near, setup.far, bias, slope_bias, pcf,
-            max_slope=max_slope,
+            max_slope=max_slope, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
         )  # fmt: skip
         return vis, maps
     M = setup.matrices[0]
     D = depth_map(S.V, S.F, M, map_size, cull)
-    vis = shadow_visibility(eb.P, eb.N_face, D, M, bias, slope_bias, pcf, frustum_fix=frustum_fix, max_slope=max_slope)
+    vis = shadow_visibility(
+        eb.P, eb.N_face, D, M, bias, slope_bias, pcf,
+        frustum_fix=frustum_fix, max_slope=max_slope, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
+    )  # fmt: skip
     return vis, D[None]
 
 
@@ -263,6 +268,8 @@ def render_with_shadows(
     cull: str = "none",
     frustum_fix: bool = True,
     bounds=None,
+    pcf_sampling: str = "grid",
+    pcf_samples: int = 16,
     ambient: float = 0.25,
     diffuse: float = 0.85,
     specular: float = 0.25,
@@ -284,7 +291,7 @@ def render_with_shadows(
         Vertical field of view of the camera.
     map_size : int
         Shadow-map size in texels.
-    bias, slope_bias, pcf, frustum_fix
+    bias, slope_bias, pcf, frustum_fix, pcf_sampling, pcf_samples
         As in :func:`shadow_visibility` (``frustum_fix`` does not apply to point lights).
     cull : {"front", "back", "none"}
         Culling in the depth pass. The default draws every face: with the slope-scaled bias there is
@@ -311,7 +318,7 @@ def render_with_shadows(
     L = as_light(light, where)
     vis, _ = light_visibility(
         S, eb, L, map_size=map_size, bias=bias, slope_bias=slope_bias, pcf=pcf, cull=cull,
-        frustum_fix=frustum_fix, bounds=bounds,
+        frustum_fix=frustum_fix, bounds=bounds, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
     )  # fmt: skip
     image = shade(eb, vis, L, ambient=ambient, diffuse=diffuse, specular=specular, shininess=shininess)
     if not return_visibility:

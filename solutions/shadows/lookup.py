@@ -37,6 +37,9 @@ __all__ = [
     "shadow_bias",
     "outside_frustum",
     "pcf_visibility",
+    "PCF_SAMPLINGS",
+    "poisson_disk",
+    "poisson_pcf_visibility",
     "shadow_visibility",
 ]
 
@@ -46,6 +49,8 @@ DEFAULT_BIAS_TEXELS = 1.0
 DEFAULT_SLOPE_BIAS = 1.5
 #: Steepest NDC depth slope ``|dz/dx|`` used for the bias (surfaces seen edge-on by the light).
 DEFAULT_MAX_SLOPE = 20.0
+#: How :func:`shadow_visibility` places its PCF samples: a k x k block of texels, or a rotated Poisson disk.
+PCF_SAMPLINGS = ("grid", "poisson")
 
 
 # --------------------------------------------------------------------------------------------
@@ -335,6 +340,123 @@ def pcf_visibility(D, uvz, bias=0.0, pcf: int = 3, gradient=None) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------------------------
+# Poisson-disk PCF (given; an extension of Task 7)
+
+
+def poisson_disk(samples: int = 16, *, seed: int = 0, candidates: int = 32) -> np.ndarray:
+    """Well-spread points in the unit disk: Mitchell's best-candidate sampling (given).
+
+    Each new point is the one of ``candidates`` uniform random points in the disk that lies
+    farthest from the points chosen so far, so no two points come close (a Poisson-disk
+    distribution) while the disk is covered evenly. The same ``seed`` gives the same points.
+
+    Parameters
+    ----------
+    samples : int, 1..256
+    seed : int
+    candidates : int
+        Candidates per point; more spreads the points more evenly.
+
+    Returns
+    -------
+    (samples, 2) float64
+        Offsets ``(x, y)`` with ``x² + y² <= 1``.
+
+    Examples
+    --------
+    >>> d = poisson_disk(16)
+    >>> d.shape, bool((np.hypot(d[:, 0], d[:, 1]) <= 1).all())
+    ((16, 2), True)
+    """
+    where = "poisson_disk"
+    samples = check_int(samples, "samples", minimum=1, maximum=256, where=where)
+    candidates = check_int(candidates, "candidates", minimum=1, maximum=4096, where=where)
+    rng = np.random.default_rng(check_int(seed, "seed", minimum=0, where=where))
+
+    def uniform_in_disk(k: int) -> np.ndarray:
+        r, t = np.sqrt(rng.random(k)), 2 * np.pi * rng.random(k)
+        return np.stack([r * np.cos(t), r * np.sin(t)], axis=1)
+
+    pts = uniform_in_disk(1)
+    for _ in range(samples - 1):
+        c = uniform_in_disk(candidates)
+        gap = ((c[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2).min(axis=1)
+        pts = np.vstack([pts, c[np.argmax(gap)]])
+    return pts
+
+
+def _texel_angle(row: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """A rotation angle per texel from an integer hash: fixed on the map, so the noise does not crawl."""
+    h = (row.astype(np.uint64) * np.uint64(73856093)) ^ (col.astype(np.uint64) * np.uint64(19349663))
+    h = (h * np.uint64(0x9E3779B97F4A7C15)) >> np.uint64(40)
+    return (h.astype(np.float64) / 2.0**24) * (2 * np.pi)
+
+
+def poisson_pcf_visibility(
+    D, uvz, bias=0.0, radius: float = 1.5, samples: int = 16, gradient=None, *, rotate: bool = True
+) -> np.ndarray:
+    """PCF with the samples on a rotated Poisson disk instead of a k x k block of texels (given).
+
+    The k x k block gives only ``k² + 1`` visibility levels, and its square footprint shows as
+    stair-stepped bands along a soft edge. Samples spread evenly over a *disk* of ``radius`` texels,
+    rotated by a different angle at every texel, turn the bands into fine noise (which the eye
+    forgives) at the same or lower cost: 16 disk samples against 25 for a 5 x 5 block.
+
+    Parameters
+    ----------
+    D : (size, size) array_like
+        Shadow map (row 0 = top, ``v = 1``).
+    uvz : (n, 3) array_like
+        Finite map coordinates from :func:`light_uvz`.
+    bias : float or (n,) array_like
+        Depth bias, as in :func:`compare_depth`.
+    radius : float, > 0
+        Disk radius in texels; ``k / 2`` covers about the area of a k x k block.
+    samples : int
+        Number of disk samples (:func:`poisson_disk`).
+    gradient : (n, 2) array_like, optional
+        ``(dz/du, dz/dv)`` per texel, as in :func:`pcf_visibility`: each sample is compared with
+        the point's tangent plane extended to the sample.
+    rotate : bool
+        Rotate the disk per texel (noise instead of bands); ``False`` uses the same disk everywhere.
+
+    Returns
+    -------
+    visibility : (n,) float64 in [0, 1]
+        Mean over the disk offsets ``(dx, dy)`` (texels, ``dy`` up) of
+        ``z + g_u dx + g_v dy - bias <= D[texel containing (u size + dx, v size + dy)]``.
+    """
+    where = "poisson_pcf_visibility"
+    D = check_shadow_map(D, where)
+    uvz = _uvz(uvz, where)
+    b = _bias_array(bias, len(uvz), where)
+    radius = check_float(radius, "radius", minimum=0.0, where=where)
+    if radius <= 0:
+        raise MeshError(f"{where}: radius must be > 0 texels, got {radius}")
+    if not isinstance(rotate, bool | np.bool_):
+        raise MeshError(f"{where}: rotate must be True or False, got {rotate!r}")
+    g = (
+        np.zeros((len(uvz), 2))
+        if gradient is None
+        else as_array(gradient, "gradient", shape=(len(uvz), 2), where=where)
+    )
+    disk = poisson_disk(samples) * radius
+    size = D.shape[0]
+    x, y = uvz[:, 0] * size, uvz[:, 1] * size  # continuous texel coordinates, y up
+    z = uvz[:, 2] - b
+    if rotate:
+        t = _texel_angle(np.floor(y).astype(np.int64), np.floor(x).astype(np.int64))
+        cos, sin = np.cos(t), np.sin(t)
+    lit = np.zeros(len(uvz))
+    for ox, oy in disk:  # a few offsets, each vectorised over all points
+        dx, dy = (cos * ox - sin * oy, sin * ox + cos * oy) if rotate else (ox, oy)
+        col = np.clip(np.floor(x + dx), 0, size - 1).astype(np.int64)
+        row = np.clip(size - 1 - np.floor(y + dy), 0, size - 1).astype(np.int64)
+        lit += z + g[:, 0] * dx + g[:, 1] * dy <= D[row, col]
+    return lit / len(disk)
+
+
+# --------------------------------------------------------------------------------------------
 # Everything together (given)
 
 
@@ -349,6 +471,8 @@ def shadow_visibility(
     *,
     frustum_fix: bool = True,
     max_slope: float = DEFAULT_MAX_SLOPE,
+    pcf_sampling: str = "grid",
+    pcf_samples: int = 16,
 ) -> np.ndarray:
     """How much of the light reaches each point: 1 lit, 0 in shadow, fractions at soft PCF edges (given).
 
@@ -374,6 +498,12 @@ def shadow_visibility(
         they read clamped border texels and, beyond the far plane, are always dark.
     max_slope : float
         Clamp of the NDC depth slope (see :func:`receiver_depth_gradient`).
+    pcf_sampling : {"grid", "poisson"}
+        ``"grid"``: the ``pcf x pcf`` block of :func:`pcf_visibility`. ``"poisson"``:
+        ``pcf_samples`` samples on a rotated Poisson disk of radius ``pcf / 2`` texels
+        (:func:`poisson_pcf_visibility`); noise instead of bands along soft edges.
+    pcf_samples : int
+        Disk samples for ``pcf_sampling="poisson"``.
 
     Returns
     -------
@@ -397,6 +527,11 @@ def shadow_visibility(
         DEFAULT_SLOPE_BIAS if slope_bias is None else check_float(slope_bias, "slope_bias", minimum=0.0, where=where)
     )
     k = _pcf_size(pcf, where)
+    if pcf_sampling not in PCF_SAMPLINGS:
+        raise MeshError(
+            f"{where}: pcf_sampling must be one of {', '.join(map(repr, PCF_SAMPLINGS))}; got {pcf_sampling!r}"
+        )
+    pcf_samples = check_int(pcf_samples, "pcf_samples", minimum=1, maximum=256, where=where)
     if not isinstance(frustum_fix, bool | np.bool_):
         raise MeshError(f"{where}: frustum_fix must be True or False, got {frustum_fix!r}")
 
@@ -414,5 +549,10 @@ def shadow_visibility(
     else:
         g = receiver_depth_gradient(P[idx], N[idx], M, size, max_slope)
         b = shadow_bias(g, bias, slope_bias)
-    vis[idx] = compare_depth(D, uvz, b) if k == 1 else pcf_visibility(D, uvz, b, k, gradient=g)
+    if k == 1:
+        vis[idx] = compare_depth(D, uvz, b)
+    elif pcf_sampling == "poisson":
+        vis[idx] = poisson_pcf_visibility(D, uvz, b, k / 2, pcf_samples, gradient=g)
+    else:
+        vis[idx] = pcf_visibility(D, uvz, b, k, gradient=g)
     return vis

@@ -37,6 +37,8 @@ from solutions.shadows import (
     outside_frustum,
     pcf_visibility,
     point_shadow_visibility,
+    poisson_disk,
+    poisson_pcf_visibility,
     receiver_depth_gradient,
     render_with_shadows,
     shadow_bias,
@@ -271,6 +273,73 @@ def test_pcf_by_hand_and_reduction_to_compare():
     np.testing.assert_allclose(pcf_visibility(Df, at, 0.0, 3, gradient=g), 2 / 3)
 
 
+def test_poisson_disk_is_deterministic_inside_the_disk_and_well_spread():
+    d = poisson_disk(16)
+    np.testing.assert_array_equal(d, poisson_disk(16))  # same seed, same disk
+    assert not np.allclose(d, poisson_disk(16, seed=1))
+    assert d.shape == (16, 2) and (np.hypot(d[:, 0], d[:, 1]) <= 1 + 1e-12).all()
+
+    def min_gap(p):
+        g = np.sqrt(((p[:, None] - p[None]) ** 2).sum(axis=2))
+        np.fill_diagonal(g, np.inf)
+        return g.min()
+
+    # uniform random points in the disk, for comparison: their closest pair is much closer
+    rng = np.random.default_rng(7)
+    uniform = []
+    for _ in range(50):
+        r, t = np.sqrt(rng.random(16)), 2 * np.pi * rng.random(16)
+        uniform.append(min_gap(np.stack([r * np.cos(t), r * np.sin(t)], axis=1)))
+    assert min_gap(d) > 3 * np.mean(uniform)
+    # and it covers the disk: every point of the disk is near a sample
+    g = np.stack(np.meshgrid(np.linspace(-1, 1, 81), np.linspace(-1, 1, 81)), axis=-1).reshape(-1, 2)
+    g = g[np.hypot(g[:, 0], g[:, 1]) <= 1]
+    assert np.sqrt(((g[:, None] - d[None]) ** 2).sum(axis=2)).min(axis=1).max() < 0.45
+
+
+def test_poisson_pcf_by_hand():
+    size = 16
+    D = np.ones((size, size))
+    D[:, : size // 2] = 0.3  # left half occupied at depth 0.3: the edge is at u = 0.5
+    disk = poisson_disk(16) * 2.0
+    far_lit, far_dark = [[0.9, 0.5, 0.5]], [[0.1, 0.5, 0.5]]
+    for rotate in (True, False):
+        assert poisson_pcf_visibility(D, far_lit, 0.0, 2.0, 16, rotate=rotate) == 1.0
+        assert poisson_pcf_visibility(D, far_dark, 0.0, 2.0, 16, rotate=rotate) == 0.0
+    # on the edge, without rotation: the share of disk samples that land on the lit half
+    at = np.array([[0.5 + 0.25 / size, 0.5 + 0.5 / size, 0.5]])  # a quarter texel right of the edge
+    expected = np.mean(0.25 + disk[:, 0] >= 0)
+    np.testing.assert_allclose(poisson_pcf_visibility(D, at, 0.0, 2.0, 16, rotate=False), expected)
+    assert 0 < expected < 1
+    # the same across a horizontal edge: rows 0..7 (the top half, v >= 0.5) occupied; dy points up
+    Dh = np.ones((size, size))
+    Dh[: size // 2] = 0.3
+    above = np.array([[0.5 + 0.5 / size, 0.5 + 0.25 / size, 0.5]])  # a quarter texel into the top half
+    np.testing.assert_allclose(
+        poisson_pcf_visibility(Dh, above, 0.0, 2.0, 16, rotate=False), np.mean(0.25 + disk[:, 1] < 0)
+    )
+    # a depth gradient tilts the plane the samples are compared with (as in pcf_visibility)
+    Df = np.full((size, size), 0.5)
+    mid = np.array([[0.5 + 0.5 / size, 0.5 + 0.5 / size, 0.5]])
+    v = poisson_pcf_visibility(Df, mid, 0.0, 2.0, 16, gradient=[[0.1, 0.0]], rotate=False)
+    np.testing.assert_allclose(v, np.mean(disk[:, 0] <= 0))
+
+
+def test_poisson_pcf_agrees_with_the_grid_and_the_truth(scene, eye, truth):
+    grid, _ = light_visibility(scene, eye, CLASSIC_LIGHT, map_size=256, pcf=5)
+    disk, _ = light_visibility(scene, eye, CLASSIC_LIGHT, map_size=256, pcf=5, pcf_sampling="poisson")
+    assert abs(disk.mean() - grid.mean()) < 0.005
+    partial = (disk > 0) & (disk < 1)
+    assert 0 < partial.mean() < 0.2  # soft only along the shadow edges
+    assert (partial & (grid == 1)).mean() < 0.01  # its soft pixels are where the grid's are
+    wrong = [np.sum((v >= 0.5) != truth["lit"]) / truth["reached"].sum() for v in (grid, disk)]
+    assert wrong[1] < wrong[0] + 0.005, wrong
+    # point lights pass the option on to each cube face
+    pg, _ = light_visibility(scene, eye, POINT, map_size=128, pcf=3)
+    pd, _ = light_visibility(scene, eye, POINT, map_size=128, pcf=3, pcf_sampling="poisson")
+    assert abs(pd.mean() - pg.mean()) < 0.01 and not np.array_equal(pd, pg)
+
+
 def test_receiver_gradient_of_a_tilted_plane_by_hand():
     """Light straight down on bounds [0, 1]^3, map 100 texels: u runs along -y, v along +x (up = x axis),
     depth = 1 - z. The plane z = 0.5 + 0.25 (x - 0.5) rises 0.0025 per texel of v, so depth falls by that."""
@@ -482,6 +551,10 @@ def test_bad_input_is_rejected_with_clear_messages():
         (lambda: shadow_bias([[0.1, 0.1]], -1.0, 1.0), "bias"),
         (lambda: shadow_visibility(V, V[:3], np.ones((8, 8)), M), "one normal per point"),
         (lambda: shadow_visibility(V, V, np.ones((8, 8)), M, frustum_fix="yes"), "frustum_fix"),
+        (lambda: shadow_visibility(V, V, np.ones((8, 8)), M, pcf=3, pcf_sampling="random"), "'grid', 'poisson'"),
+        (lambda: shadow_visibility(V, V, np.ones((8, 8)), M, pcf=3, pcf_samples=0), "pcf_samples"),
+        (lambda: poisson_pcf_visibility(np.ones((4, 4)), [[0.5, 0.5, 0.5]], 0.0, 0.0), "radius must be > 0"),
+        (lambda: poisson_disk(0), "samples"),
         (lambda: receiver_depth_gradient(V, V, np.zeros((4, 4)), 8), "singular"),
         (lambda: cube_light_matrices((0, 0, 0), 0.0, 1.0), "near"),
         (lambda: point_shadow_visibility(V, V, np.ones((5, 8, 8)), (0, 0, 0), 0.1, 1), "cube face"),
