@@ -125,10 +125,13 @@ def _token_layout(joined: bytes, n_lines: int, *, token_ids: bool = False) -> tu
 def _fromstring(text: bytes, dtype) -> np.ndarray | None:
     """Whitespace-separated numbers parsed in C; None if some token is not a number."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
+        # NumPy < 2.3 only warns (DeprecationWarning) when a token does not parse, and returns the
+        # numbers read so far: "2.5" read as int64 gives 2 and stops. Treat the warning as the error
+        # that newer NumPy raises.
+        warnings.simplefilter("error", DeprecationWarning)
         try:
             return np.fromstring(text, dtype=dtype, sep=" ")
-        except ValueError:
+        except (ValueError, DeprecationWarning):
             return None
 
 
