@@ -85,6 +85,11 @@ def _bias_array(bias, n: int, where: str) -> np.ndarray:
     return b
 
 
+def _gradient_array(gradient, n: int, where: str) -> np.ndarray:
+    """``(n, 2)`` receiver depth gradient, zeros when ``gradient`` is None (a flat receiver)."""
+    return np.zeros((n, 2)) if gradient is None else as_array(gradient, "gradient", shape=(n, 2), where=where)
+
+
 def _pcf_size(pcf, where: str) -> int:
     k = check_int(pcf, "pcf", minimum=1, maximum=15, where=where)
     if k % 2 == 0:
@@ -295,11 +300,7 @@ def pcf_visibility(D, uvz, bias=0.0, pcf: int = 3, gradient=None) -> np.ndarray:
     uvz = _uvz(uvz, where)
     b = _bias_array(bias, len(uvz), where)
     k = _pcf_size(pcf, where)
-    g = (
-        np.zeros((len(uvz), 2))
-        if gradient is None
-        else as_array(gradient, "gradient", shape=(len(uvz), 2), where=where)
-    )
+    g = _gradient_array(gradient, len(uvz), where)
     raise NotImplementedError('Task 7 (PCF): mean over i, j in -(k-1)/2..(k-1)/2 of [z + g_u i + g_v j - bias <= D[clamp(row - j), clamp(col + i)]]')
 
 
@@ -399,11 +400,7 @@ def poisson_pcf_visibility(
         raise MeshError(f"{where}: radius must be > 0 texels, got {radius}")
     if not isinstance(rotate, bool | np.bool_):
         raise MeshError(f"{where}: rotate must be True or False, got {rotate!r}")
-    g = (
-        np.zeros((len(uvz), 2))
-        if gradient is None
-        else as_array(gradient, "gradient", shape=(len(uvz), 2), where=where)
-    )
+    g = _gradient_array(gradient, len(uvz), where)
     disk = poisson_disk(samples) * radius
     size = D.shape[0]
     x, y = uvz[:, 0] * size, uvz[:, 1] * size  # continuous texel coordinates, y up
