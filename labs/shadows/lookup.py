@@ -462,7 +462,8 @@ def shadow_visibility(
     pcf_sampling : {"grid", "poisson"}
         ``"grid"``: the ``pcf x pcf`` block of :func:`pcf_visibility`. ``"poisson"``:
         ``pcf_samples`` samples on a rotated Poisson disk of radius ``pcf / 2`` texels
-        (:func:`poisson_pcf_visibility`); noise instead of bands along soft edges.
+        (:func:`poisson_pcf_visibility`); noise instead of bands along soft edges. ``pcf = 1`` is
+        the hard 0/1 test either way.
     pcf_samples : int
         Disk samples for ``pcf_sampling="poisson"``.
 
