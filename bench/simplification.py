@@ -1,6 +1,6 @@
 """Benchmark: lab "simplification" (QEM) against the anchor libraries, in one run.
 
-Run: ``uv run python bench/simplification.py [--quick] [--greedy] [--only NAME ...]``
+Run: ``uv run python bench/simplification.py [--quick] [--greedy] [--breakdown] [--only NAME ...]``
 
 For every mesh and every reduction level (10% and 1% of the faces kept) it times
 
@@ -18,6 +18,11 @@ point of its centroid), boundary loops kept, faces reached. Times are the best o
 with the contenders interleaved; ratios are against ``igl.qslim`` in the same run. Peak memory:
 the tracemalloc peak of one call of ours (NumPy allocations; the C++ anchors are invisible to
 tracemalloc, so the process's maximum resident set size is printed at the end instead).
+
+With ``--breakdown`` it prints, per mesh and level, where the fast path's time goes instead:
+input validation, quadrics, the batched contraction loop (with its number of passes and
+contractions) and the least-squares refit, next to igl.qslim's total. On small meshes the parts
+outside the loop alone are comparable to igl.qslim's whole run.
 
 Meshes: a noise-displaced icosphere (level 6, 81,920 faces; the issue's "100k sphere"), the
 built-in torus, sharp box and height field at benchmark resolution, the pyvista airplane, ant
@@ -150,6 +155,35 @@ def _loops(F) -> int:
         return -1
 
 
+def breakdown(name: str, V, F, t: int, repeats: int) -> None:
+    """One line: igl.qslim's time next to the stages of ours (fast path, defaults of qem_simplify)."""
+    from geomlib.validate import check_mesh
+    from solutions.simplification.fast import fast_collapse, refine_positions
+    from solutions.simplification.quadrics import vertex_quadrics
+
+    def best(fn):
+        b, out = np.inf, None
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            out = fn()
+            b = min(b, time.perf_counter() - t0)
+        return 1000 * b, out
+
+    stats: dict = {}
+    ms_q, _ = best(lambda: qslim(V, F, t))
+    ms_check, _ = best(lambda: check_mesh(V, F, where="bench", manifold=True))
+    ms_quad, Q = best(lambda: vertex_quadrics(V, F, "area", 10.0))
+    ms_loop, (U, G, N0) = best(lambda: fast_collapse(V, F, Q, t, return_normals=True, stats=stats))
+    ms_fit, _ = best(lambda: refine_positions(V, F, U, G, normals0=N0))
+    outside = ms_check + ms_quad + ms_fit
+    print(
+        f"{name[:24]:24s} {len(F):7d} -> {t:6d}  qslim {ms_q:8.1f} ms | ours: check {ms_check:6.1f} + quadrics "
+        f"{ms_quad:6.1f} + refit {ms_fit:7.1f} = {outside:7.1f} ms ({outside / ms_q:4.2f}x qslim) + loop "
+        f"{ms_loop:8.1f} ms ({stats['passes']} passes, {stats['contractions']} contractions, "
+        f"{ms_loop / max(stats['passes'], 1):5.1f} ms/pass)"
+    )
+
+
 def timed(fn, V, F, t, repeats: int) -> tuple[float, tuple]:
     best, out = np.inf, None
     for _ in range(repeats):
@@ -175,12 +209,19 @@ def main() -> None:
     )
     ap.add_argument("--only", nargs="*", help="substrings of mesh names to run")
     ap.add_argument("--levels", nargs="*", type=float, default=[0.1, 0.01])
+    ap.add_argument("--breakdown", action="store_true", help="where the fast path's time goes, against igl.qslim")
     args = ap.parse_args()
     repeats = 1 if args.quick else 3
     n_samples = 20_000 if args.quick else 50_000
     meshes = {**builtin_meshes(args.quick), **shared_meshes(args.quick)}
     if args.only:
         meshes = {k: v for k, v in meshes.items() if any(s in k for s in args.only)}
+    if args.breakdown:
+        for name, (V, F) in meshes.items():
+            V, F = np.ascontiguousarray(V, np.float64), np.ascontiguousarray(F, np.int64)
+            for level in args.levels:
+                breakdown(name, V, F, max(4, int(round(level * len(F)))), repeats)
+        return
     contenders = {"ours fast": ours_fast, "igl.qslim": qslim, "fast-simpl": fast_simpl, "VTK": vtk_decimate}
     print(
         f"{'mesh':24s} {'keep':>5s} {'method':11s} {'faces':>7s} {'time s':>8s} {'/qslim':>7s} "

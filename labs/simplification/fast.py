@@ -235,6 +235,7 @@ def fast_collapse(
     candidate_fraction: float = 0.3,
     rounds: int = 10,
     return_normals: bool = False,
+    stats: dict | None = None,
 ):
     """Simplify ``(V, F)`` with quadrics ``Q`` to about ``target_faces`` faces by batched contractions.
 
@@ -258,6 +259,9 @@ def fast_collapse(
 
     return_normals : bool
         Also return the input normal of every output face (for :func:`refine_positions`).
+    stats : dict, optional
+        Filled with ``passes`` (batched passes run) and ``contractions`` (edges contracted), for
+        benchmarks.
 
     Returns
     -------
@@ -284,7 +288,7 @@ def fast_collapse(
     cache_cost = np.zeros(0)
     cache_pos = np.zeros((0, 3))
     changed = np.zeros(n, dtype=bool)
-    n_pass = 0
+    n_pass = n_contracted = 0
     while len(F) > target_faces:
         n_pass += 1
         excess = len(F) - target_faces
@@ -370,6 +374,7 @@ def fast_collapse(
         last = np.r_[new_keys[1:] != new_keys[:-1], True][: len(new_keys)]
         bad_keys, bad_pass = new_keys[last], new_pass[last]
         # Contract all accepted edges at once: hi merges into lo.
+        n_contracted += len(acc)
         a, b = lo[acc], hi[acc]
         V[a] = cand_pos[acc]
         q[a] += q[b]
@@ -384,6 +389,8 @@ def fast_collapse(
     used = np.zeros(n, dtype=bool)
     used[F.ravel()] = True
     new_index = np.cumsum(used) - 1
+    if stats is not None:
+        stats.update(passes=n_pass, contractions=n_contracted)
     if return_normals:
         return V[used], new_index[F], N0
     return V[used], new_index[F]

@@ -14,6 +14,7 @@ error metrics" (SIGGRAPH 1997).
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 
 from geomlib.topology import boundary_edges
 from geomlib.validate import check_choice, check_float, check_mesh
@@ -106,6 +107,8 @@ def boundary_quadrics(V, F, weight: float = 1000.0) -> np.ndarray:
     weight = check_float(weight, "weight", minimum=0.0, where="boundary_quadrics")
     # Directed boundary edges (a, b) and the face each belongs to (given: topology bookkeeping).
     B = boundary_edges(F)
+    if len(B) == 0:
+        return np.zeros((len(V), 4, 4))  # a closed mesh: no boundary to protect
     he_face = np.repeat(np.arange(len(F)), 3)
     he = np.stack([F.ravel(), F[:, [1, 2, 0]].ravel()], axis=1)
     n_vertices = len(V)

@@ -8,6 +8,7 @@ import pytest
 from geomlib import datasets
 from geomlib.validate import (
     MeshError,
+    as_faces,
     as_image,
     as_polygons,
     check_choice,
@@ -131,3 +132,15 @@ def test_images():
         as_image(np.zeros((4, 4)), size=(8, 8))
     with pytest.raises(MeshError, match=r"shape \(4,\); expected an image"):
         as_image(np.zeros(4))
+
+
+@pytest.mark.parametrize("n_vertices", [6, 3_000_000], ids=["packed-keys", "lexsort-fallback"])
+@pytest.mark.parametrize("k", [3, 4])
+def test_duplicate_faces_are_found_with_either_sort(n_vertices, k):
+    """Rows are packed into one int64 key when n^k fits; huge index ranges fall back to a lexsort."""
+    F = np.array([[0, 1, 2, 3], [1, 2, 4, 5], [3, 4, 5, 0], [5, 2, 1, 4]])[:, :k]
+    if k == 3:
+        F[3] = [2, 1, 4]  # the corners of face 1 in another order
+    with pytest.raises(MeshError, match="faces 1 and 3 are duplicates"):
+        as_faces(F, n_vertices, k=k)
+    as_faces(F[:3], n_vertices, k=k)  # without the copy: accepted
