@@ -78,13 +78,13 @@ def unique_ints(keys: np.ndarray, return_inverse: bool = False, return_counts: b
     ~70x slower than sorting here (0.8 s vs 0.012 s for 260k keys), so topology uses this instead.
     """
     keys = np.asarray(keys).ravel()
+    if not (return_inverse or return_counts):
+        sk = np.sort(keys)  # values only: a plain sort, no argsort
+        return sk[np.r_[True, sk[1:] != sk[:-1]]] if len(sk) else sk
     order = np.argsort(keys, kind="stable")
     sk = keys[order]
     start = np.r_[True, sk[1:] != sk[:-1]] if len(sk) else np.zeros(0, bool)
-    u = sk[start]
-    if not (return_inverse or return_counts):
-        return u
-    out = [u]
+    out = [sk[start]]
     if return_inverse:
         inv = np.empty(len(keys), dtype=np.int64)
         inv[order] = np.cumsum(start) - 1

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.topology import boundary_edges
+from geomlib.topology import boundary_edges, unique_ints
 
 from .contraction import DEGENERATE_RTOL, _cross
 from .placement import SINGULAR_RCOND, TIE_RTOL
@@ -133,17 +133,6 @@ def _local_minima(
     return (m2[lo] == rank) & (m2[hi] == rank)
 
 
-def _unique(x: np.ndarray) -> np.ndarray:
-    """Sorted distinct values of an int array (a sort is faster than np.unique's hash path here)."""
-    if len(x) == 0:
-        return x
-    x = np.sort(x)
-    keep = np.empty(len(x), dtype=bool)
-    keep[0] = True
-    np.not_equal(x[1:], x[:-1], out=keep[1:])
-    return x[keep]
-
-
 class _VertexFaces:
     """Faces around each vertex of ``F`` (CSR, built once per pass: F does not change within a pass)."""
 
@@ -155,7 +144,7 @@ class _VertexFaces:
 
     def around(self, vertices: np.ndarray) -> np.ndarray:
         """Faces that use any of ``vertices`` (each face once, sorted)."""
-        return _unique(self.around_each(vertices)[0])
+        return unique_ints(self.around_each(vertices)[0])
 
     def around_each(self, vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The faces around each of ``vertices``: face ids and, for each, the position in ``vertices``."""
@@ -192,7 +181,7 @@ def _valid(
         w, e3 = T.ravel(), np.repeat(e, 3)
         keep = (w != a[e3]) & (w != b[e3])
         rec.append((e3[keep] * n + w[keep]) * 2 + side)
-    rec = _unique(np.concatenate(rec))  # distinct (edge, neighbour, side)
+    rec = unique_ints(np.concatenate(rec))  # distinct (edge, neighbour, side)
     pw, sd = rec // 2, rec % 2
     degree = np.zeros((s, 2), dtype=np.int64)
     np.add.at(degree, (pw // n, sd), 1)
@@ -497,7 +486,7 @@ def refine_positions(
 
         def tree_error(X: np.ndarray, faces: np.ndarray) -> np.ndarray:
             """Largest squared distance to the input over 7 sample points of each of ``faces`` of (X, G)."""
-            corners = _unique(G[faces].ravel())
+            corners = unique_ints(G[faces].ravel())
             S = np.concatenate([X[corners], np.einsum("kc,fcd->fkd", weights, X[G[faces]]).reshape(-1, 3)])
             d2 = np.asarray(tree.squared_distance(V0, F0, S)[0])
             at_corner = np.zeros(n)
@@ -518,7 +507,7 @@ def refine_positions(
             check = np.arange(len(G))
             limit = tree_error(U, check).max()
             for _ in range(8):  # each round puts back the corners of the faces that got too far
-                back = _unique(G[check[tree_error(new, check) > limit]].ravel())
+                back = unique_ints(G[check[tree_error(new, check) > limit]].ravel())
                 if len(back) == 0:
                     break
                 new[back] = U[back]
