@@ -65,9 +65,9 @@ def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
 
 def _midpoint_subdivide(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Split every triangle into four at its edge midpoints (orientation kept)."""
-    he = np.sort(topology.halfedges(F), axis=1)  # half-edge 3f + i runs corner i -> i + 1
-    E, inv = topology.unique_rows(he, return_inverse=True)
-    mid = len(V) + inv.reshape(-1, 3)  # new vertex on edges (0,1), (1,2), (2,0)
+    H = topology.halfedge_mesh(F, len(V), checked=True)  # half-edge 3f + i runs corner i -> i + 1
+    E = H.E
+    mid = len(V) + H.he_edge.reshape(-1, 3)  # new vertex on edges (0,1), (1,2), (2,0)
     a, b, c = F.T
     m01, m12, m20 = mid.T
     F2 = np.concatenate([np.stack(t, axis=1) for t in ((a, m01, m20), (m01, b, m12), (m20, m12, c), (m01, m12, m20))])
@@ -656,17 +656,9 @@ def split_nonmanifold_vertices(V, F) -> tuple[np.ndarray, np.ndarray]:
         The same faces, re-indexed.
     """
     V, F = check_mesh(V, F, where="split_nonmanifold_vertices")
-    h, n = F.size, len(V)
-    nxt = (np.arange(h).reshape(-1, 3)[:, [1, 2, 0]]).ravel()
-    a, b = F.ravel(), F.ravel()[nxt]
-    key = a * n + b
-    order = np.argsort(key)
-    pos = np.minimum(np.searchsorted(key[order], b * n + a), h - 1)
-    twin = np.where(key[order][pos] == b * n + a, order[pos], -1)
-    j = np.flatnonzero(twin >= 0)
-    # Corner j and the corner of the same vertex across its outgoing edge lie in the same fan.
-    label, owner = topology.corner_fans(a, j, nxt[twin[j]])
-    return V[owner], label.reshape(-1, 3)
+    # Every fan of the half-edge structure becomes one vertex.
+    H = topology.halfedge_mesh(F, len(V), checked=True)
+    return V[H.fan_vertex], H.corner_fan.reshape(-1, 3)
 
 
 # --------------------------------------------------------------------------------------------

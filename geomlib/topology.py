@@ -1,23 +1,46 @@
-"""Mesh connectivity: edges, adjacency, valence, boundaries, Euler characteristic.
+"""Mesh connectivity: one half-edge structure, and edges, boundaries, valence, fans, χ built on it.
 
-Every function takes triangle faces ``F`` as an int ``(m, 3)`` array; those marked
-*polygons* also take an ``(m, k)`` array of any k, a list of polygons, or the ragged
-``(indices, offsets)`` pair that :func:`to_ragged` returns (face ``f`` is
-``indices[offsets[f]:offsets[f + 1]]``). All work is vectorised NumPy/SciPy.
+Faces
+-----
+Every function takes polygon faces in any of these forms: an int ``(m, k)`` array (triangles are
+``k = 3``), a list of index sequences of mixed sizes, or the ragged ``(indices, offsets)`` pair
+that :func:`to_ragged` returns (face ``f`` is ``indices[offsets[f]:offsets[f + 1]]``). Bad faces
+(non-integers, negative indices, polygons of fewer than 3 corners, indices past ``n_vertices``)
+raise :class:`~geomlib.errors.MeshError` naming the problem and the face.
 
-Conventions follow libigl: an undirected edge is stored with its smaller index first,
-and edges are sorted lexicographically, so ``unique_edges`` is deterministic.
+Corners and half-edges
+----------------------
+Corner ``j`` is entry ``j`` of ``indices``; half-edge ``j`` leaves it for the next corner of the
+same face, ``indices[j] -> indices[nxt[j]]``. :class:`HalfEdgeMesh` holds the whole connectivity
+(next/previous corner, twin, edge of every half-edge, faces on both sides of every edge,
+boundary flags, valence, fans around every vertex), built by :func:`halfedge_mesh` in one
+vectorised pass: one ``argsort`` of the undirected edge keys ``min * n + max``, the rest gathers
+and ``bincount``. Every other function of this module, :func:`geomlib.validate.check_manifold`,
+:func:`geomlib.datasets.split_nonmanifold_vertices` and the subdivision lab's ``connectivity.py``
+read this one structure.
+
+Conventions follow libigl: an undirected edge is stored with its smaller index first, and edges
+are sorted lexicographically, so ``unique_edges`` is deterministic.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from geomlib.errors import MeshError, fmt_row, prefix, to_int64
+
 __all__ = [
+    "HalfEdgeMesh",
+    "halfedge_mesh",
+    "check_halfedges",
     "to_ragged",
     "face_sizes",
+    "next_corners",
     "halfedges",
     "unique_ints",
     "unique_rows",
@@ -39,24 +62,122 @@ __all__ = [
 ]
 
 
-def to_ragged(faces) -> tuple[np.ndarray, np.ndarray]:
-    """*Polygons*: return ``(indices, offsets)`` int64 arrays for any face representation."""
-    if isinstance(faces, tuple) and len(faces) == 2 and isinstance(faces[1], np.ndarray) and faces[1].ndim == 1:
-        idx, off = faces
-        if len(off) and off[0] == 0 and (len(faces[0]) == off[-1]):
-            return np.asarray(idx, np.int64), np.asarray(off, np.int64)
+# --------------------------------------------------------------------------------------------
+# face representations
+
+
+def _is_ragged_pair(faces) -> bool:
+    """``(indices, offsets)``: two 1-D int arrays, offsets from 0 to ``len(indices)``, every face >= 3.
+
+    The size rule is what keeps a tuple of two polygons given as arrays, e.g. two triangles
+    ``(array([1, 2, 3]), array([0, 2, 3]))``, from being misread as faces of sizes 2 and 1.
+    """
+    if not (isinstance(faces, tuple) and len(faces) == 2):
+        return False
+    idx, off = faces
+    if not all(isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype.kind in "iu" for a in (idx, off)):
+        return False
+    return len(off) >= 1 and off[0] == 0 and off[-1] == len(idx) and bool((np.diff(off) >= 3).all())
+
+
+def _ragged(faces) -> tuple[np.ndarray, np.ndarray]:
+    """Unchecked conversion to int64 ``(indices, offsets)`` (for faces a public entry already checked)."""
+    if _is_ragged_pair(faces):
+        return np.asarray(faces[0], np.int64), np.asarray(faces[1], np.int64)
     if isinstance(faces, np.ndarray) and faces.dtype != object and faces.ndim == 2:
         m, k = faces.shape
-        return faces.astype(np.int64).ravel(), np.arange(0, m * k + 1, k, dtype=np.int64)
-    polys = [np.asarray(f, dtype=np.int64) for f in faces]
+        return faces.astype(np.int64).ravel(), np.arange(0, m * k + 1, max(k, 1), dtype=np.int64)[: m + 1]
+    polys = [np.asarray(f, dtype=np.int64).ravel() for f in faces]
     lens = np.array([len(p) for p in polys], dtype=np.int64)
     idx = np.concatenate(polys) if polys else np.zeros(0, np.int64)
     return idx, np.concatenate([[0], np.cumsum(lens)]).astype(np.int64)
 
 
+def to_ragged(
+    faces, n_vertices: int | None = None, *, name: str = "faces", where: str | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """*Polygons*: check faces and return them as ``(indices, offsets)`` int64 arrays.
+
+    Parameters
+    ----------
+    faces : (m, k) int array, list of index sequences, or ``(indices, offsets)``
+        A tuple of two 1-D int arrays is read as a ragged pair when ``offsets`` runs from 0 to
+        ``len(indices)`` and every face has at least 3 corners; pass two polygons as a list.
+    n_vertices : int, optional
+        When given, every index must be below it.
+    name, where : str
+        Argument and function names for error messages.
+
+    Raises
+    ------
+    MeshError
+        Faces missing, not integers, negative, past ``n_vertices``, or a polygon of fewer than 3
+        corners. Repeated corners within a face are not checked here
+        (:func:`geomlib.validate.as_polygons` does).
+    """
+    p = prefix(where)
+    if faces is None:
+        raise MeshError(f"{p}{name} is missing (got None)")
+    if _is_ragged_pair(faces):
+        idx, off = to_int64(faces[0], name, where), np.asarray(faces[1], np.int64)
+    elif isinstance(faces, np.ndarray) and faces.dtype != object:
+        if faces.ndim != 2:
+            raise MeshError(f"{p}{name} has shape {faces.shape}, expected (m, k) faces or a list of polygons")
+        arr = to_int64(faces, name, where)
+        idx, off = _ragged(arr)
+    else:
+        try:
+            polys = [np.asarray(f) for f in faces]
+        except TypeError:
+            raise MeshError(f"{p}{name} must be an (m, k) int array or a list of polygons, got {faces!r}") from None
+        for i, a in enumerate(polys):
+            if a.ndim != 1 or a.dtype == object:
+                raise MeshError(f"{p}{name}: face {i} is not a flat sequence of integer indices")
+            polys[i] = to_int64(a, f"{name}: face {i}", where) if a.size else a.astype(np.int64)
+        idx, off = _ragged(polys)
+    lens = np.diff(off)
+    if len(lens) and lens.min() < 3:
+        f = int(np.flatnonzero(lens < 3)[0])
+        raise MeshError(f"{p}{name}: face {f} has {lens[f]} vertices, a polygon needs at least 3")
+    if idx.size and idx.min() < 0:
+        f = int(np.searchsorted(off, np.flatnonzero(idx < 0)[0], side="right") - 1)
+        raise MeshError(f"{p}{name}: face {f} {fmt_row(idx[off[f] : off[f + 1]])} has a negative index")
+    if n_vertices is not None:
+        n = _count(n_vertices, "n_vertices", where)
+        if idx.size and idx.max() >= n:
+            j = int(np.flatnonzero(idx >= n)[0])
+            f = int(np.searchsorted(off, j, side="right") - 1)
+            raise MeshError(
+                f"{p}{name}: face {f} uses vertex {int(idx[j])}, but V has only {n} vertices (valid indices 0..{n - 1})"
+            )
+    return idx, off
+
+
+def _count(n, name: str, where: str | None) -> int:
+    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 0:
+        raise MeshError(f"{prefix(where)}{name} must be an integer >= 0, got {n!r}")
+    return int(n)
+
+
 def face_sizes(faces) -> np.ndarray:
     """*Polygons*: number of corners of each face, ``(m,)``."""
-    return np.diff(to_ragged(faces)[1])
+    return np.diff(to_ragged(faces, where="face_sizes")[1])
+
+
+def next_corners(offsets: np.ndarray) -> np.ndarray:
+    """Next corner of every corner in its face, ``(h,)`` int64 (the last corner wraps to the first).
+
+    Only the face sizes matter, so this needs ``offsets`` alone; half-edge ``j`` runs from corner
+    ``j`` to corner ``next_corners(offsets)[j]``.
+    """
+    off = np.asarray(offsets, np.int64)
+    h, lens = int(off[-1]), np.diff(off)
+    if len(lens) and (lens == lens[0]).all():  # one face size: a reshape, no per-corner division
+        k = int(lens[0])
+        return (np.arange(0, h, k, dtype=np.int64)[:, None] + np.roll(np.arange(k), -1)).ravel()
+    nxt = np.arange(1, h + 1, dtype=np.int64)
+    nxt[off[1:] - 1] = off[:-1]
+    return nxt
 
 
 def halfedges(faces, offsets: np.ndarray | None = None) -> np.ndarray:
@@ -64,11 +185,361 @@ def halfedges(faces, offsets: np.ndarray | None = None) -> np.ndarray:
 
     Half-edge ``j`` belongs to face ``np.repeat(arange(m), face_sizes)[j]``.
     """
-    idx, off = (faces, offsets) if offsets is not None else to_ragged(faces)
+    idx, off = (np.asarray(faces, np.int64), offsets) if offsets is not None else to_ragged(faces, where="halfedges")
+    return np.stack([idx, idx[next_corners(off)]], axis=1)
+
+
+# --------------------------------------------------------------------------------------------
+# the half-edge structure
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class HalfEdgeMesh:
+    """Corner / half-edge connectivity of a polygon mesh (``n`` vertices, ``m`` faces, ``e`` edges, ``h`` corners).
+
+    Corner ``j`` is entry ``j`` of the ragged faces; half-edge ``j`` runs from it to the next corner
+    of its face. Build it with :func:`halfedge_mesh`; the fields below are computed on first use
+    and then kept (``cached_property``), so a caller pays only for what it reads.
+
+    Attributes
+    ----------
+    idx, off : (h,), (m + 1,) int64
+        Ragged faces: face ``f`` is ``idx[off[f]:off[f + 1]]``; ``idx[j]`` is the vertex of corner ``j``.
+    nxt : (h,) int64
+        Next corner in the same face (half-edge ``j`` is ``idx[j] -> idx[nxt[j]]``).
+    twin : (h,) int64
+        The half-edge running the other way along the same edge; ``-1`` on a boundary edge, and
+        also on edges that are not a proper pair (more than two faces, or two faces running the
+        same way) — :attr:`edge_size` tells those apart.
+    he_edge : (h,) int64
+        Undirected edge of every half-edge (row of ``E``).
+    E : (e, 2) int64
+        Unique undirected edges, smaller index first, sorted lexicographically
+        (the order of :func:`unique_edges`).
+    n_vertices : int
+    prv : (h,) int64
+        Previous corner in the same face.
+    he_face : (h,) int64
+        Face of every corner.
+    edge_size : (e,) int64
+        Half-edges on every edge: 1 boundary, 2 interior, more = non-manifold edge.
+    EH : (e, 2) int64
+        ``EH[i, 0]`` the half-edge running ``E[i, 0] -> E[i, 1]``, ``EH[i, 1]`` the one running back;
+        ``-1`` where there is none (on a non-manifold edge the last one of each direction).
+    EF : (e, 2) int64
+        The faces of those half-edges (``-1`` where none).
+    boundary_edge : (e,) bool
+        Edges with exactly one face.
+    boundary_vertex : (n,) bool
+        Vertices on a boundary edge.
+    valence : (n,) int64
+        Number of edges at every vertex (0 for a vertex no face uses).
+    vertex_corner : (n,) int64
+        One outgoing half-edge of every vertex (its boundary half-edge on the boundary), ``-1`` if unused.
+    corner_fan, fan_vertex, vertex_fans : (h,), (k,), (n,) int64
+        Fan of every corner (corners linked across shared edges around one vertex), vertex of every
+        fan, and number of fans at every vertex (1 at a manifold vertex, 0 at an unused one).
+
+    Invariants
+    ----------
+    :func:`check_halfedges` checks them; a mesh edited in place (split, collapse, flip) must keep them:
+
+    1. ``off`` starts at 0, rises by >= 3 per face and ends at ``h``; ``nxt`` cycles through each
+       face's corners in order, ``prv`` is its inverse.
+    2. ``twin`` is an involution without fixed points: ``twin[twin[j]] == j``, and twins run in
+       opposite directions: ``idx[twin[j]] == idx[nxt[j]]``, ``idx[nxt[twin[j]]] == idx[j]``.
+    3. ``E[he_edge[j]]`` is ``(idx[j], idx[nxt[j]])`` sorted; rows of ``E`` are distinct with
+       ``E[:, 0] < E[:, 1]``; twins share their edge.
+    4. On a manifold, oriented mesh every edge has one or two half-edges and ``twin[j] == -1``
+       exactly on one-half-edge (boundary) edges; every used vertex has one fan.
+
+    The structure is frozen: an editing operation builds new arrays and a new ``HalfEdgeMesh``
+    (``dataclasses.replace``), never writes into these, so the cached fields cannot go stale.
+    """
+
+    idx: np.ndarray
+    off: np.ndarray
+    nxt: np.ndarray
+    twin: np.ndarray
+    he_edge: np.ndarray
+    E: np.ndarray
+    n_vertices: int
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.off) - 1
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.E)
+
+    @property
+    def n_halfedges(self) -> int:
+        return len(self.idx)
+
+    def __repr__(self) -> str:
+        return (
+            f"HalfEdgeMesh(n_vertices={self.n_vertices}, n_faces={self.n_faces}, n_edges={self.n_edges}, "
+            f"n_halfedges={self.n_halfedges})"
+        )
+
+    @cached_property
+    def prv(self) -> np.ndarray:
+        prv = np.empty_like(self.nxt)
+        prv[self.nxt] = np.arange(len(self.nxt))
+        return prv
+
+    @cached_property
+    def he_face(self) -> np.ndarray:
+        return np.repeat(np.arange(self.n_faces, dtype=np.int64), np.diff(self.off))
+
+    @cached_property
+    def edge_size(self) -> np.ndarray:
+        return np.bincount(self.he_edge, minlength=self.n_edges).astype(np.int64)
+
+    @cached_property
+    def EH(self) -> np.ndarray:
+        EH = np.full((self.n_edges, 2), -1, dtype=np.int64)
+        back = (self.idx >= self.idx[self.nxt]).astype(np.int64)  # not from the smaller to the larger index
+        EH[self.he_edge, back] = np.arange(len(self.idx))
+        return EH
+
+    @cached_property
+    def EF(self) -> np.ndarray:
+        return np.where(self.EH >= 0, self.he_face[np.maximum(self.EH, 0)], -1)
+
+    @cached_property
+    def boundary_edge(self) -> np.ndarray:
+        return self.edge_size == 1
+
+    @cached_property
+    def boundary_vertex(self) -> np.ndarray:
+        bv = np.zeros(self.n_vertices, dtype=bool)
+        bv[self.E[self.boundary_edge].ravel()] = True
+        return bv
+
+    @cached_property
+    def valence(self) -> np.ndarray:
+        return np.bincount(self.E.ravel(), minlength=self.n_vertices).astype(np.int64)
+
+    @cached_property
+    def vertex_corner(self) -> np.ndarray:
+        vc = np.full(self.n_vertices, -1, dtype=np.int64)
+        vc[self.idx[::-1]] = np.arange(len(self.idx) - 1, -1, -1)  # first corner of every vertex
+        bh = np.flatnonzero(self.edge_size[self.he_edge] == 1)
+        vc[self.idx[bh]] = bh
+        return vc
+
+    @cached_property
+    def _fans(self) -> tuple[np.ndarray, np.ndarray]:
+        idx, nxt, twin = self.idx, self.nxt, self.twin
+        paired = twin >= 0
+        if (paired | (self.edge_size[self.he_edge] == 1)).all():
+            # Every edge is a boundary or a proper pair: corner j and the corner after its twin sit
+            # at the same vertex in faces sharing an edge; each corner has at most one such link.
+            j = np.flatnonzero(paired)
+            return corner_fans(idx, j, nxt[twin[j]], one_per_row=True)
+        # General case: chain the half-edges of every edge in order and link, for each consecutive
+        # pair, their corners at the smaller endpoint and their corners at the larger one.
+        order = np.argsort(self.he_edge, kind="stable")
+        same = np.flatnonzero(self.he_edge[order[1:]] == self.he_edge[order[:-1]])
+        h1, h2 = order[same], order[same + 1]
+        up1, up2 = idx[h1] < idx[nxt[h1]], idx[h2] < idx[nxt[h2]]
+        lo1, hi1 = np.where(up1, h1, nxt[h1]), np.where(up1, nxt[h1], h1)
+        lo2, hi2 = np.where(up2, h2, nxt[h2]), np.where(up2, nxt[h2], h2)
+        return corner_fans(idx, np.r_[lo1, hi1], np.r_[lo2, hi2])
+
+    @property
+    def corner_fan(self) -> np.ndarray:
+        return self._fans[0]
+
+    @property
+    def fan_vertex(self) -> np.ndarray:
+        return self._fans[1]
+
+    @cached_property
+    def vertex_fans(self) -> np.ndarray:
+        return np.bincount(self.fan_vertex, minlength=self.n_vertices).astype(np.int64)
+
+
+def halfedge_mesh(
+    faces,
+    n_vertices: int | None = None,
+    *,
+    manifold: bool = False,
+    checked: bool = False,
+    name: str = "faces",
+    where: str | None = None,
+) -> HalfEdgeMesh:
+    """*Polygons*: build the :class:`HalfEdgeMesh` of a mesh in one vectorised pass.
+
+    Parameters
+    ----------
+    faces : (m, k) int array, list of polygons, or ``(indices, offsets)``
+    n_vertices : int, optional
+        Number of vertices; default one past the largest index.
+    manifold : bool
+        Raise :class:`MeshError` unless the mesh is edge-manifold, consistently oriented and
+        vertex-manifold (the checks come almost free with the build).
+    checked : bool
+        The faces come from a public entry that validated them already (an int64 ``(m, k)``
+        array or a ragged pair, indices in range): skip the input checks.
+    name, where : str
+        Argument and function names for error messages.
+
+    Notes
+    -----
+    One stable ``argsort`` of the undirected keys ``min * n + max`` groups the half-edges of every
+    edge: the first of each group gives ``E``, the group number ``he_edge``, groups of two running
+    opposite ways give ``twin``. Cost O(h log h); temporaries are freed early because this runs
+    on meshes of millions of half-edges.
+    """
+    if checked:
+        idx, off = _ragged(faces)
+        n = int(n_vertices) if n_vertices is not None else (int(idx.max()) + 1 if idx.size else 0)
+    else:
+        idx, off = to_ragged(faces, n_vertices, name=name, where=where)
+        n = (
+            _count(n_vertices, "n_vertices", where)
+            if n_vertices is not None
+            else (int(idx.max()) + 1 if idx.size else 0)
+        )
+    h = len(idx)
+    nxt = next_corners(off)
+    b = idx[nxt]
+    keys = np.minimum(idx, b)
+    keys *= max(n, 1)
+    keys += np.maximum(idx, b)
+    del b
+    order = np.argsort(keys, kind="stable")
+    sk = keys[order]
+    del keys
+    new = np.empty(h, dtype=bool)
+    new[:1] = True
+    np.not_equal(sk[1:], sk[:-1], out=new[1:])
+    first = np.flatnonzero(new)
+    E = np.stack([sk[first] // max(n, 1), sk[first] % max(n, 1)], axis=1)
+    del sk
+    he_edge = np.empty(h, dtype=np.int64)
+    he_edge[order] = np.cumsum(new) - 1
+    del new
+    size = np.diff(np.append(first, h))
+    pair = first[size == 2]
+    h0, h1 = order[pair], order[pair + 1]
+    del order, first, pair
+    opposite = idx[h0] != idx[h1]
+    h0, h1 = h0[opposite], h1[opposite]
+    twin = np.full(h, -1, dtype=np.int64)
+    twin[h0] = h1
+    twin[h1] = h0
+    del h0, h1, opposite
+    H = HalfEdgeMesh(idx, off, nxt, twin, he_edge, E, n)
+    H.__dict__["edge_size"] = size  # computed anyway: saves a bincount
+    if manifold:
+        _require_manifold(H, name, where)
+    return H
+
+
+def _same_corners(H: HalfEdgeMesh, f: int, g: int) -> bool:
+    return set(H.idx[H.off[f] : H.off[f + 1]].tolist()) == set(H.idx[H.off[g] : H.off[g + 1]].tolist())
+
+
+def _require_manifold(H: HalfEdgeMesh, name: str, where: str | None) -> None:
+    """The manifold and orientation messages of geomlib, in one place."""
+    p = prefix(where)
+    size = H.edge_size
+    if (size > 2).any():
+        i = int(np.flatnonzero(size > 2)[0])
+        fs = sorted(set(H.he_face[H.he_edge == i].tolist()))
+        dup = [(f, g) for f in fs for g in fs if f < g and _same_corners(H, f, g)]
+        why = f" (faces {dup[0][0]} and {dup[0][1]} are duplicates: same corners)" if dup else ""
+        raise MeshError(
+            f"{p}{name}: edge ({H.E[i, 0]}, {H.E[i, 1]}) is shared by {size[i]} faces {tuple(fs)}{why}; "
+            f"this needs an edge-manifold mesh (each edge in at most 2 faces)"
+        )
+    unpaired = (H.twin < 0) & (size[H.he_edge] == 2)  # two faces running the same way along an edge
+    if unpaired.any():
+        j = int(np.flatnonzero(unpaired)[0])
+        hs = np.flatnonzero(H.he_edge == H.he_edge[j])
+        f0, f1 = sorted(H.he_face[hs].tolist())
+        u, v = int(H.idx[hs[0]]), int(H.idx[H.nxt[hs[0]]])
+        raise MeshError(
+            f"{p}{name}: faces {f0} and {f1} are duplicates (same corners)"
+            if _same_corners(H, f0, f1)
+            else f"{p}{name}: faces {f0} and {f1} both traverse edge ({u}, {v}) in the same direction; "
+            f"the mesh is not consistently oriented"
+        )
+    fans = H.vertex_fans
+    if (fans > 1).any():
+        v = int(np.flatnonzero(fans > 1)[0])
+        raise MeshError(
+            f"{p}{name}: vertex {v} is non-manifold (its faces form {int(fans[v])} separate fans); "
+            f"this needs a vertex-manifold mesh"
+        )
+
+
+def check_halfedges(H: HalfEdgeMesh, *, manifold: bool = True) -> None:
+    """Raise :class:`MeshError` naming the first broken invariant of a :class:`HalfEdgeMesh`.
+
+    Checks invariants 1-3 of :class:`HalfEdgeMesh` always and 4 with ``manifold``. Meant for code
+    that edits the structure (edge split, collapse, flip): call it after each operation in tests.
+    Cost O(h log h).
+    """
+    p = "check_halfedges: "
+    idx, off, nxt, twin, he_edge, E = H.idx, H.off, H.nxt, H.twin, H.he_edge, H.E
+    h, e, n = len(idx), len(E), H.n_vertices
+    for nm, a, shape in (("idx", idx, (h,)), ("nxt", nxt, (h,)), ("twin", twin, (h,)), ("he_edge", he_edge, (h,)),
+                         ("E", E, (e, 2))):  # fmt: skip
+        if a.shape != shape or a.dtype != np.int64:
+            raise MeshError(f"{p}{nm} has shape {a.shape} and dtype {a.dtype}, expected {shape} int64")
     lens = np.diff(off)
-    pos = np.arange(len(idx)) - np.repeat(off[:-1], lens)
-    nxt = np.repeat(off[:-1], lens) + (pos + 1) % np.repeat(lens, lens)
-    return np.stack([idx, idx[nxt]], axis=1)
+    if len(off) == 0 or off[0] != 0 or off[-1] != h or (len(lens) and lens.min() < 3):
+        raise MeshError(f"{p}off must rise from 0 to {h} by at least 3 per face")
+    if h and (idx.min() < 0 or idx.max() >= n):
+        raise MeshError(f"{p}idx holds a vertex outside 0..{n - 1}")
+    bad = np.flatnonzero(nxt != next_corners(off))
+    if len(bad):
+        raise MeshError(f"{p}nxt[{bad[0]}] is {nxt[bad[0]]}, not the next corner of its face")
+    paired = np.flatnonzero(twin >= 0)
+    if len(paired) and twin.max() >= h:
+        raise MeshError(f"{p}twin holds a half-edge past {h - 1}")
+    t = twin[paired]
+    for cond, what in (
+        (twin[t] != paired, "is not an involution (twin[twin[j]] != j)"),
+        (t == paired, "maps a half-edge to itself"),
+        ((idx[t] != idx[nxt[paired]]) | (idx[nxt[t]] != idx[paired]), "pairs half-edges that do not run opposite ways"),
+        (he_edge[t] != he_edge[paired], "pairs half-edges of different edges"),
+    ):
+        if cond.any():
+            j = int(paired[np.flatnonzero(cond)[0]])
+            raise MeshError(f"{p}twin {what}: half-edge {j} -> {int(twin[j])}")
+    if h and (he_edge.min() < 0 or he_edge.max() >= e):
+        raise MeshError(f"{p}he_edge holds an edge outside 0..{e - 1}")
+    ends = np.sort(np.stack([idx, idx[nxt]], axis=1), axis=1)
+    wrong = np.flatnonzero((E[he_edge] != ends).any(axis=1))
+    if len(wrong):
+        j = int(wrong[0])
+        raise MeshError(f"{p}half-edge {j} runs {fmt_row(ends[j])} but he_edge names edge {fmt_row(E[he_edge[j]])}")
+    if e and ((E[:, 0] >= E[:, 1]).any() or len(unique_rows(E)) != e or np.bincount(he_edge, minlength=e).min() < 1):
+        raise MeshError(f"{p}E must hold distinct used edges, smaller index first")
+    if manifold:
+        size = np.bincount(he_edge, minlength=e)
+        if (size > 2).any():
+            raise MeshError(f"{p}edge {int(np.flatnonzero(size > 2)[0])} has more than two half-edges")
+        lone = (twin < 0) != (size[he_edge] == 1)
+        if lone.any():
+            raise MeshError(f"{p}half-edge {int(np.flatnonzero(lone)[0])} has no twin but its edge has two half-edges")
+        fans = HalfEdgeMesh(idx, off, nxt, twin, he_edge, E, n).vertex_fans  # fresh: no stale cache
+        if (fans > 1).any():
+            raise MeshError(f"{p}vertex {int(np.flatnonzero(fans > 1)[0])} has {int(fans.max())} fans (non-manifold)")
+
+
+def _mesh(faces, n_vertices, where: str) -> HalfEdgeMesh:
+    return halfedge_mesh(faces, n_vertices, where=where)
+
+
+# --------------------------------------------------------------------------------------------
+# sorting helpers
 
 
 def unique_ints(keys: np.ndarray, return_inverse: bool = False, return_counts: bool = False):
@@ -106,10 +577,13 @@ def unique_rows(E: np.ndarray, return_inverse: bool = False, return_counts: bool
     return (np.stack([u // n, u % n], axis=1), *out[1:])
 
 
+# --------------------------------------------------------------------------------------------
+# edges and boundaries
+
+
 def unique_edges(faces) -> np.ndarray:
     """*Polygons*: undirected edges ``(e, 2)``, smaller index first, lexicographically sorted."""
-    he = np.sort(halfedges(faces), axis=1)
-    return unique_rows(he) if len(he) else np.zeros((0, 2), np.int64)
+    return _mesh(faces, None, "unique_edges").E
 
 
 def edge_faces(faces) -> tuple[np.ndarray, np.ndarray]:
@@ -124,63 +598,61 @@ def edge_faces(faces) -> tuple[np.ndarray, np.ndarray]:
         running the other way; ``-1`` where there is no such face (boundary). On a non-manifold
         edge one face per direction is kept.
     """
-    idx, off = to_ragged(faces)
-    he = halfedges(idx, off)
-    hf = np.repeat(np.arange(len(off) - 1), np.diff(off))
-    und = np.sort(he, axis=1)
-    E, inv = unique_rows(und, return_inverse=True)
-    EF = np.full((len(E), 2), -1, dtype=np.int64)
-    forward = he[:, 0] < he[:, 1]
-    EF[inv[forward], 0] = hf[forward]
-    EF[inv[~forward], 1] = hf[~forward]
-    return E, EF
-
-
-def _edge_use(faces) -> tuple[np.ndarray, np.ndarray]:
-    und = np.sort(halfedges(faces), axis=1)
-    return unique_rows(und, return_counts=True)
+    H = _mesh(faces, None, "edge_faces")
+    return H.E, H.EF
 
 
 def boundary_edges(faces) -> np.ndarray:
     """*Polygons*: directed boundary edges ``(b, 2)``, oriented as in their one face."""
-    he = halfedges(faces)
-    und = np.sort(he, axis=1)
-    _, inv, counts = unique_rows(und, return_inverse=True, return_counts=True)
-    return he[counts[inv] == 1]
+    H = _mesh(faces, None, "boundary_edges")
+    j = np.flatnonzero(H.edge_size[H.he_edge] == 1)
+    return np.stack([H.idx[j], H.idx[H.nxt[j]]], axis=1)
 
 
 def boundary_loops(faces) -> list[np.ndarray]:
     """*Polygons*: boundary loops as ordered vertex index arrays, longest first.
 
-    Each loop follows the orientation of its faces. Raises :class:`~geomlib.validate.MeshError`
+    Each loop follows the orientation of its faces. Raises :class:`~geomlib.errors.MeshError`
     when a boundary vertex has more than one outgoing boundary edge (boundary pinch).
     """
-    from geomlib.validate import MeshError
-
-    B = boundary_edges(faces)
-    if len(B) == 0:
+    H = _mesh(faces, None, "boundary_loops")
+    bh = np.flatnonzero(H.edge_size[H.he_edge] == 1)
+    if len(bh) == 0:
         return []
-    starts, counts = unique_ints(B[:, 0], return_counts=True)
-    if (counts > 1).any():
+    start, end = H.idx[bh], H.idx[H.nxt[bh]]
+    for ends, way in ((start, "outgoing"), (end, "incoming")):
+        count = np.bincount(ends, minlength=H.n_vertices)
+        if count.max() > 1:
+            v = int(np.argmax(count))
+            raise MeshError(
+                f"boundary_loops: boundary vertex {v} has {count[v]} {way} boundary edges (non-manifold boundary)"
+            )
+    out = np.full(H.n_vertices, -1, dtype=np.int64)  # the outgoing boundary edge of each vertex
+    out[start] = end
+    if (out[end] < 0).any():
+        k = int(np.flatnonzero(out[end] < 0)[0])
         raise MeshError(
-            f"boundary vertex {int(starts[np.argmax(counts)])} has {counts.max()} outgoing boundary edges (non-manifold boundary)"
+            f"boundary_loops: boundary edge ({start[k]}, {end[k]}) ends at a vertex with no outgoing boundary "
+            f"edge; the faces around vertex {end[k]} are not consistently oriented"
         )
-    nxt = dict(zip(B[:, 0].tolist(), B[:, 1].tolist(), strict=True))
-    seen: set[int] = set()
+    seen = np.zeros(H.n_vertices, dtype=bool)
     loops = []
-    for s in B[:, 0].tolist():  # sequential walk: loops are 1-D chains, O(boundary length)
-        if s in seen:
+    for s in start.tolist():  # sequential walk: loops are 1-D chains, O(boundary length)
+        if seen[s]:
             continue
         loop = [s]
-        seen.add(s)
-        v = nxt[s]
+        v = int(out[s])
         while v != s:
             loop.append(v)
-            seen.add(v)
-            v = nxt[v]
+            v = int(out[v])
+        seen[loop] = True
         loops.append(np.array(loop, dtype=np.int64))
     loops.sort(key=len, reverse=True)
     return loops
+
+
+# --------------------------------------------------------------------------------------------
+# vertices
 
 
 def vertex_adjacency(faces, n_vertices: int | None = None) -> sp.csr_matrix:
@@ -188,8 +660,8 @@ def vertex_adjacency(faces, n_vertices: int | None = None) -> sp.csr_matrix:
 
     Row ``i``'s column indices (``A.indices[A.indptr[i]:A.indptr[i+1]]``) are the neighbours of ``i``.
     """
-    E = unique_edges(faces)
-    n = int(n_vertices if n_vertices is not None else (E.max() + 1 if len(E) else 0))
+    H = _mesh(faces, n_vertices, "vertex_adjacency")
+    E, n = H.E, H.n_vertices
     A = sp.coo_matrix((np.ones(2 * len(E)), (np.r_[E[:, 0], E[:, 1]], np.r_[E[:, 1], E[:, 0]])), shape=(n, n))
     A = A.tocsr()
     A.sort_indices()
@@ -198,8 +670,7 @@ def vertex_adjacency(faces, n_vertices: int | None = None) -> sp.csr_matrix:
 
 def valence(faces, n_vertices: int | None = None) -> np.ndarray:
     """*Polygons*: number of distinct edge neighbours of every vertex, ``(n,)``."""
-    A = vertex_adjacency(faces, n_vertices)
-    return np.diff(A.indptr)
+    return _mesh(faces, n_vertices, "valence").valence
 
 
 def vertex_fan_counts(faces, offsets: np.ndarray | None = None, n_vertices: int | None = None) -> np.ndarray:
@@ -207,30 +678,8 @@ def vertex_fan_counts(faces, offsets: np.ndarray | None = None, n_vertices: int 
 
     A manifold vertex (interior or boundary) has exactly one fan; 0 means unreferenced.
     """
-    idx, off = (faces, offsets) if offsets is not None else to_ragged(faces)
-    n = int(n_vertices if n_vertices is not None else (idx.max() + 1 if len(idx) else 0))
-    N = len(idx)
-    if N == 0:
-        return np.zeros(n, dtype=np.int64)
-    lens = np.diff(off)
-    base = np.repeat(off[:-1], lens)
-    pos = np.arange(N) - base
-    nxt = base + (pos + 1) % np.repeat(lens, lens)
-    # Half-edge h runs from corner h (vertex a) to corner nxt[h] (vertex b). Two faces sharing the
-    # undirected edge {a, b} link their corners at a and their corners at b: corners of one vertex
-    # that end up connected form one fan.
-    a, b = idx, idx[nxt]
-    key = np.minimum(a, b) * n + np.maximum(a, b)
-    order = np.argsort(key, kind="stable")
-    k = key[order]
-    same = np.flatnonzero(k[1:] == k[:-1])
-    h1, h2 = order[same], order[same + 1]
-    lo1 = np.where(a[h1] < b[h1], h1, nxt[h1])  # corner at the smaller endpoint, in each face
-    hi1 = np.where(a[h1] < b[h1], nxt[h1], h1)
-    lo2 = np.where(a[h2] < b[h2], h2, nxt[h2])
-    hi2 = np.where(a[h2] < b[h2], nxt[h2], h2)
-    _, owner = corner_fans(idx, np.r_[lo1, hi1], np.r_[lo2, hi2])
-    return np.bincount(owner, minlength=n).astype(np.int64)
+    faces = (np.asarray(faces, np.int64), np.asarray(offsets, np.int64)) if offsets is not None else faces
+    return _mesh(faces, n_vertices, "vertex_fan_counts").vertex_fans
 
 
 def corner_fans(
@@ -291,22 +740,21 @@ def extraordinary_vertices(faces, n_vertices: int, regular: int | None = None) -
     (k,) int64
         Sorted vertex indices (boundary and unreferenced vertices are never listed).
     """
-    idx, off = to_ragged(faces)
+    H = _mesh(faces, n_vertices, "extraordinary_vertices")
     if regular is None:
-        regular = 6 if np.mean(np.diff(off)) < 3.5 else 4
-    val = valence((idx, off), n_vertices)
-    boundary = np.zeros(n_vertices, dtype=bool)
-    boundary[boundary_edges((idx, off)).ravel()] = True
-    used = np.zeros(n_vertices, dtype=bool)
-    used[idx] = True
-    return np.flatnonzero(used & ~boundary & (val != regular)).astype(np.int64)
+        regular = 6 if H.n_faces and np.mean(np.diff(H.off)) < 3.5 else 4
+    return np.flatnonzero((H.valence > 0) & ~H.boundary_vertex & (H.valence != regular)).astype(np.int64)
+
+
+# --------------------------------------------------------------------------------------------
+# global properties
 
 
 def euler_characteristic(faces, n_vertices: int | None = None) -> int:
     """*Polygons*: χ = V − E + F, counting only vertices that some face uses (unless ``n_vertices``)."""
-    idx, off = to_ragged(faces)
-    nv = int(n_vertices) if n_vertices is not None else len(unique_ints(idx))
-    return nv - len(unique_edges((idx, off))) + (len(off) - 1)
+    H = _mesh(faces, n_vertices, "euler_characteristic")
+    nv = H.n_vertices if n_vertices is not None else int(np.count_nonzero(H.valence))
+    return nv - H.n_edges + H.n_faces
 
 
 def genus(faces) -> int:
@@ -317,23 +765,22 @@ def genus(faces) -> int:
 
 def connected_components_faces(faces) -> tuple[int, np.ndarray]:
     """*Polygons*: number of edge-connected face components and the label of each face."""
-    E, EF = edge_faces(faces)
+    H = _mesh(faces, None, "connected_components_faces")
+    EF = H.EF
     ok = (EF >= 0).all(axis=1)
-    m = len(to_ragged(faces)[1]) - 1
+    m = H.n_faces
     G = sp.coo_matrix((np.ones(ok.sum()), (EF[ok, 0], EF[ok, 1])), shape=(m, m))
     return connected_components(G, directed=False)
 
 
 def is_edge_manifold(faces) -> bool:
     """*Polygons*: True when no edge is used by more than two faces."""
-    _, counts = _edge_use(faces)
-    return bool((counts <= 2).all())
+    return bool((_mesh(faces, None, "is_edge_manifold").edge_size <= 2).all())
 
 
 def is_closed(faces) -> bool:
     """*Polygons*: True when every edge is used by exactly two faces."""
-    _, counts = _edge_use(faces)
-    return bool((counts == 2).all())
+    return bool((_mesh(faces, None, "is_closed").edge_size == 2).all())
 
 
 def triangulate_polygons(faces) -> tuple[np.ndarray, np.ndarray]:
@@ -346,7 +793,7 @@ def triangulate_polygons(faces) -> tuple[np.ndarray, np.ndarray]:
     source : (t,) int64
         The polygon each triangle came from.
     """
-    idx, off = to_ragged(faces)
+    idx, off = to_ragged(faces, where="triangulate_polygons")
     lens = np.diff(off)
     ntri = lens - 2
     src = np.repeat(np.arange(len(lens)), ntri)

@@ -12,14 +12,19 @@ Examples
 >>> check_mesh(V, [[0, 1, 3]], where="loop_subdivide")
 Traceback (most recent call last):
 ...
-geomlib.validate.MeshError: loop_subdivide: F: face 0 uses vertex 3, but V has only 3 vertices (valid indices 0..2)
+geomlib.errors.MeshError: loop_subdivide: F: face 0 uses vertex 3, but V has only 3 vertices (valid indices 0..2)
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 
 import numpy as np
+
+from geomlib import topology
+from geomlib.errors import MeshError, to_int64
+from geomlib.errors import fmt_row as _fmt_row
+from geomlib.errors import prefix as _prefix
 
 __all__ = [
     "MeshError",
@@ -35,18 +40,6 @@ __all__ = [
     "check_float",
     "check_choice",
 ]
-
-
-class MeshError(ValueError):
-    """Invalid mesh, array, image or parameter. The message names the problem and the place."""
-
-
-def _prefix(where: str | None) -> str:
-    return f"{where}: " if where else ""
-
-
-def _fmt_row(row: np.ndarray) -> str:
-    return "(" + ", ".join(f"{x:.6g}" if isinstance(x, float | np.floating) else str(x) for x in row) + ")"
 
 
 def as_array(
@@ -91,15 +84,7 @@ def as_array(
             raise MeshError(f"{p}{name} has shape {a.shape}, expected {exp}")
     target = np.dtype(dtype)
     if target.kind in "iu":
-        if a.dtype.kind == "b" or a.dtype.kind not in "iuf":
-            raise MeshError(f"{p}{name} has dtype {a.dtype}, expected integers")
-        if a.dtype.kind == "f":
-            if a.size and not np.all(np.isfinite(a)):
-                raise MeshError(f"{p}{name} holds NaN or inf, expected integers")
-            if a.size and not np.all(a == np.round(a)):
-                bad = np.argwhere(a != np.round(a))[0]
-                raise MeshError(f"{p}{name} holds a non-integer value {a[tuple(bad)]} at {tuple(int(i) for i in bad)}")
-        a = np.ascontiguousarray(a, dtype=target)
+        a = to_int64(a, name, where)
     else:
         if a.dtype.kind not in "biuf":
             raise MeshError(f"{p}{name} has dtype {a.dtype}, expected numbers")
@@ -135,7 +120,11 @@ def as_faces(
     rejected unless allowed.
     """
     p = _prefix(where)
-    F = as_array(F, name, shape=(None, k) if k else (None, None), dtype=np.int64, where=where)
+    raw = F if isinstance(F, np.ndarray) else None
+    if raw is not None and raw.dtype.kind == "u":
+        F = _unsigned_faces(raw, n_vertices, name, k, where)
+    else:
+        F = as_array(F, name, shape=(None, k) if k else (None, None), dtype=np.int64, where=where)
     if F.shape[0] == 0:
         return F
     if F.min() < 0:
@@ -178,64 +167,29 @@ def as_faces(
     return F
 
 
+def _unsigned_faces(F: np.ndarray, n_vertices: int, name: str, k: int | None, where: str | None) -> np.ndarray:
+    """Unsigned indices are compared before the int64 cast, so ``2**63`` is named, not wrapped to negative."""
+    if F.ndim != 2 or (k is not None and F.shape[1] != k):
+        raise MeshError(f"{_prefix(where)}{name} has shape {F.shape}, expected (n, {k if k else 'n'})")
+    if F.size and F.max() >= n_vertices:
+        f = int(np.flatnonzero((F >= n_vertices).any(axis=1))[0])
+        bad = int(F[f][F[f] >= n_vertices][0])
+        raise MeshError(
+            f"{_prefix(where)}{name}: face {f} uses vertex {bad}, but V has only {n_vertices} vertices "
+            f"(valid indices 0..{n_vertices - 1})"
+        )
+    return F.astype(np.int64)
+
+
 def check_manifold(F, n_vertices: int, *, name: str = "F", where: str | None = None) -> None:
     """Raise unless the triangle or polygon mesh is edge- and vertex-manifold and consistently oriented.
 
     ``F`` is an ``(m, k)`` int array or a ``(indices, offsets)`` ragged pair (see :func:`as_polygons`).
 
-    Notes
-    -----
-    One argsort of the undirected half-edge keys ``min * n + max`` answers all three questions:
-    group sizes (edges in more than two faces), directions within a group (orientation), and the
-    corner links across interior edges whose connected components are the fans around each vertex.
+    The checks are those of :func:`geomlib.topology.halfedge_mesh` with ``manifold=True``: one
+    structure, one set of messages for every caller.
     """
-    from geomlib import topology
-
-    p = _prefix(where)
-    idx, off = topology.to_ragged(F)
-    h, n = len(idx), int(n_vertices)
-    if h == 0:
-        return
-    lens = np.diff(off)
-    he_face = np.repeat(np.arange(len(lens)), lens)
-    base = np.repeat(off[:-1], lens)
-    nxt = base + (np.arange(h) - base + 1) % lens[he_face]
-    b = idx[nxt]
-    keys = np.minimum(idx, b) * n + np.maximum(idx, b)
-    order = np.argsort(keys, kind="stable")
-    sk = keys[order]
-    new = np.r_[True, sk[1:] != sk[:-1]]
-    first = np.flatnonzero(new)
-    counts = np.diff(np.r_[first, h])
-    if (counts > 2).any():
-        i = int(np.flatnonzero(counts > 2)[0])
-        hs = order[first[i] : first[i] + counts[i]]
-        faces = tuple(sorted(set(he_face[hs].tolist())))
-        u, v = int(sk[first[i]] // n), int(sk[first[i]] % n)
-        raise MeshError(
-            f"{p}{name}: edge ({u}, {v}) is shared by {counts[i]} faces {faces}; "
-            f"this needs an edge-manifold mesh (each edge in at most 2 faces)"
-        )
-    pair = first[counts == 2]
-    h0, h1 = order[pair], order[pair + 1]
-    same_dir = idx[h0] == idx[h1]
-    if same_dir.any():
-        j = int(np.flatnonzero(same_dir)[0])
-        f0, f1 = sorted((int(he_face[h0[j]]), int(he_face[h1[j]])))
-        raise MeshError(
-            f"{p}{name}: faces {f0} and {f1} both traverse edge ({idx[h0[j]]}, {b[h0[j]]}) in the same direction; "
-            f"the mesh is not consistently oriented (or the two faces are duplicates)"
-        )
-    # Across an interior edge a->b (face f, half-edge h0) / b->a (face g, h1): the corners at a are
-    # h0 and nxt[h1], the corners at b are nxt[h0] and h1. Linked corners belong to one fan.
-    _, owner = topology.corner_fans(idx, np.r_[h0, nxt[h0]], np.r_[nxt[h1], h1])
-    fans = np.bincount(owner, minlength=n)
-    if (fans > 1).any():
-        v = int(np.flatnonzero(fans > 1)[0])
-        raise MeshError(
-            f"{p}{name}: vertex {v} is non-manifold (its faces form {int(fans[v])} separate fans); "
-            f"this needs a vertex-manifold mesh"
-        )
+    topology.halfedge_mesh(F, n_vertices, manifold=True, name=name, where=where)
 
 
 def check_mesh(
@@ -283,15 +237,13 @@ def check_mesh(
     F = as_faces(F, len(V), where=where, allow_degenerate=allow_degenerate, allow_duplicate=allow_duplicate)
     if len(F) < min_faces:
         raise MeshError(f"{p}F has {len(F)} faces, expected at least {min_faces}")
-    if manifold:
-        check_manifold(F, len(V), where=where)
-    if closed:
-        from geomlib import topology
-
-        b = topology.boundary_edges(F)
+    if manifold or closed:
+        H = topology.halfedge_mesh(F, len(V), manifold=manifold, checked=True, name="F", where=where)
+        b = np.flatnonzero(H.edge_size[H.he_edge] == 1) if closed else ()
         if len(b):
             raise MeshError(
-                f"{p}mesh has {len(b)} boundary edges (e.g. {tuple(int(i) for i in b[0])}); expected a closed mesh"
+                f"{p}mesh has {len(b)} boundary edges (e.g. ({H.idx[b[0]]}, {H.idx[H.nxt[b[0]]]})); "
+                f"expected a closed mesh"
             )
     return V, F
 
@@ -301,56 +253,21 @@ def as_polygons(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Polygon faces as a ragged ``(indices, offsets)`` pair of int64 arrays.
 
-    ``faces`` is an int ``(m, k)`` array or a list of index sequences of any lengths >= 3.
-    Face ``f`` is ``indices[offsets[f]:offsets[f + 1]]``.
+    ``faces`` is an int ``(m, k)`` array, a list of index sequences of any lengths >= 3, or a
+    ragged pair (see :func:`geomlib.topology.to_ragged`, which makes every check but the repeated
+    vertex). Face ``f`` is ``indices[offsets[f]:offsets[f + 1]]``.
     """
-    p = _prefix(where)
-    if faces is None:
-        raise MeshError(f"{p}{name} is missing (got None)")
-    if isinstance(faces, np.ndarray) and faces.dtype != object:
-        arr = as_array(faces, name, shape=(None, None), dtype=np.int64, where=where)
-        lens = np.full(len(arr), arr.shape[1], dtype=np.int64)
-        idx = arr.ravel()
-    else:
-        if not isinstance(faces, Iterable):
-            raise MeshError(f"{p}{name} must be an (m, k) array or a list of polygons")
-        polys = []
-        for i, f in enumerate(faces):
-            try:
-                a = np.asarray(f)
-            except Exception:
-                raise MeshError(f"{p}{name}: face {i} is not a sequence of indices") from None
-            if a.ndim != 1 or a.dtype.kind not in "iu":
-                if a.ndim == 1 and a.dtype.kind == "f" and np.all(a == np.round(a)):
-                    a = a.astype(np.int64)
-                else:
-                    raise MeshError(f"{p}{name}: face {i} is not a flat sequence of integer indices")
-            polys.append(a.astype(np.int64))
-        lens = np.array([len(a) for a in polys], dtype=np.int64)
-        idx = np.concatenate(polys) if polys else np.zeros(0, np.int64)
-    if len(lens) and lens.min() < 3:
-        f = int(np.flatnonzero(lens < 3)[0])
-        raise MeshError(f"{p}{name}: face {f} has {lens[f]} vertices, a polygon needs at least 3")
-    off = np.concatenate([[0], np.cumsum(lens)]).astype(np.int64)
-    if idx.size:
-        face_of = np.repeat(np.arange(len(lens)), lens)
-        if idx.min() < 0:
-            f = int(face_of[np.flatnonzero(idx < 0)[0]])
-            raise MeshError(f"{p}{name}: face {f} has a negative index")
-        if idx.max() >= n_vertices:
-            j = int(np.flatnonzero(idx >= n_vertices)[0])
-            raise MeshError(
-                f"{p}{name}: face {int(face_of[j])} uses vertex {int(idx[j])}, but V has only {n_vertices} "
-                f"vertices (valid indices 0..{n_vertices - 1})"
-            )
-        # A polygon that repeats a vertex is degenerate.
+    idx, off = topology.to_ragged(faces, n_vertices, name=name, where=where)
+    if idx.size:  # a polygon that repeats a vertex is degenerate
+        face_of = np.repeat(np.arange(len(off) - 1), np.diff(off))
         order = np.lexsort((idx, face_of))
         s_idx, s_face = idx[order], face_of[order]
         rep = (s_idx[1:] == s_idx[:-1]) & (s_face[1:] == s_face[:-1])
         if rep.any():
             f = int(s_face[1:][rep][0])
             raise MeshError(
-                f"{p}{name}: face {f} {_fmt_row(idx[off[f] : off[f + 1]])} is degenerate (repeats a vertex)"
+                f"{_prefix(where)}{name}: face {f} {_fmt_row(idx[off[f] : off[f + 1]])} is degenerate "
+                f"(repeats a vertex)"
             )
     return idx, off
 
