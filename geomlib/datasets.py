@@ -657,8 +657,8 @@ def split_nonmanifold_vertices(V, F) -> tuple[np.ndarray, np.ndarray]:
     """
     V, F = check_mesh(V, F, where="split_nonmanifold_vertices")
     # Every fan of the half-edge structure becomes one vertex.
-    H = topology.halfedge_mesh(F, len(V), checked=True)
-    return V[H.fan_vertex], H.corner_fan.reshape(-1, 3)
+    label, owner = topology.halfedge_mesh(F, len(V), checked=True).fans()
+    return V[owner], label.reshape(-1, 3)
 
 
 # --------------------------------------------------------------------------------------------

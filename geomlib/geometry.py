@@ -23,6 +23,7 @@ Spatial queries:
 from __future__ import annotations
 
 import hashlib
+import os
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -30,7 +31,8 @@ import igl
 import numpy as np
 
 from geomlib import topology
-from geomlib.validate import MeshError, as_faces, as_vertices, check_choice, check_float, check_int
+from geomlib.validate import MeshError, as_vertices, check_choice, check_float, check_int, check_mesh
+from geomlib.vectors import normalize_rows
 
 __all__ = [
     "face_normals",
@@ -41,7 +43,7 @@ __all__ = [
     "mean_edge_length",
     "closest_points",
     "ray_cast",
-    "sample_surface",
+    "random_points_on_mesh",
     "mesh_distance",
     "hausdorff_distance",
     "chamfer_distance",
@@ -53,30 +55,9 @@ __all__ = [
 # validation helpers
 
 
-def _mesh(V, F, where: str, vname: str = "V", fname: str = "F", min_faces: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """A triangle soup: finite float64 ``(n, 3)`` and int64 ``(m, 3)`` with indices in range."""
-    V = as_vertices(V, name=vname, where=where)
-    Fa = np.asarray(F) if F is not None and not isinstance(F, np.ndarray) and _is_rect(F) else F
-    if isinstance(Fa, np.ndarray) and Fa.ndim == 2 and Fa.shape[1] != 3:
-        raise MeshError(
-            f"{where}: {fname} has shape {Fa.shape}: this function needs triangles (m, 3); "
-            f"triangulate polygon faces first"
-        )
-    if F is not None and not isinstance(Fa, np.ndarray):
-        raise MeshError(
-            f"{where}: {fname} must be an (m, 3) integer array of triangles; got a ragged or polygonal list"
-        )
-    F = as_faces(Fa, len(V), name=fname, where=where, allow_degenerate=True, allow_duplicate=True)
-    if len(F) < min_faces:
-        raise MeshError(f"{where}: {fname} has {len(F)} faces, expected at least {min_faces}")
-    return V, F
-
-
-def _is_rect(x) -> bool:
-    try:
-        return np.asarray(x).ndim == 2
-    except Exception:  # ragged nested lists
-        return False
+def _mesh(V, F, where: str, vname: str = "V", fname: str = "F") -> tuple[np.ndarray, np.ndarray]:
+    """A triangle soup (degenerate and duplicate faces allowed), checked by :func:`geomlib.validate.check_mesh`."""
+    return check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True, vname=vname, fname=fname)
 
 
 def _points(P, name: str, where: str) -> np.ndarray:
@@ -91,12 +72,6 @@ def _face_cross(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     """``(b - a) x (c - a)`` per face: direction = normal, length = twice the area."""
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     return np.cross(b - a, c - a)
-
-
-def _normalize_rows(X: np.ndarray) -> np.ndarray:
-    """Unit rows; rows of zero length stay zero (no NaN)."""
-    n = np.linalg.norm(X, axis=1, keepdims=True)
-    return np.divide(X, n, out=np.zeros_like(X), where=n > 0)
 
 
 def face_normals(V, F) -> np.ndarray:
@@ -115,7 +90,7 @@ def face_normals(V, F) -> np.ndarray:
         Unit normals; zero rows for degenerate (zero-area) triangles.
     """
     V, F = _mesh(V, F, "face_normals")
-    return _normalize_rows(_face_cross(V, F))
+    return normalize_rows(_face_cross(V, F))
 
 
 def face_areas(V, F) -> np.ndarray:
@@ -164,13 +139,13 @@ def vertex_normals(V, F, weighting: str = "area") -> np.ndarray:
     if weighting == "area":
         W = np.repeat(C[:, None, :], 3, axis=1)  # |C| = 2 * area, so C itself is area-weighted
     else:
-        Nf = _normalize_rows(C)
+        Nf = normalize_rows(C)
         w = _corner_angles(V, F) if weighting == "angle" else np.ones(F.shape)
         W = w[:, :, None] * Nf[:, None, :]
     idx = F.ravel()
     W = W.reshape(-1, 3)
     N = np.stack([np.bincount(idx, weights=W[:, k], minlength=len(V)) for k in range(3)], axis=1)
-    return _normalize_rows(N)
+    return normalize_rows(N)
 
 
 def dihedral_angles(V, F, *, signed: bool = False, include_boundary: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -197,9 +172,10 @@ def dihedral_angles(V, F, *, signed: bool = False, include_boundary: bool = Fals
     """
     where = "dihedral_angles"
     V, F = _mesh(V, F, where)
-    E, EF = topology.edge_faces(F)
+    H = topology.halfedge_mesh(F, len(V), checked=True)  # F was checked above
+    E, EF = H.E, H.EF
     interior = (EF >= 0).all(axis=1)
-    N = _normalize_rows(_face_cross(V, F))
+    N = normalize_rows(_face_cross(V, F))
     n0, n1 = N[EF[interior, 0]], N[EF[interior, 1]]
     cr = np.cross(n0, n1)
     # atan2 stays accurate near 0 and pi, where arccos of a dot product does not.
@@ -226,7 +202,7 @@ def bbox_diagonal(V) -> float:
 def mean_edge_length(V, F) -> float:
     """Mean length of the unique (undirected) edges of the mesh, in units of ``V``."""
     V, F = _mesh(V, F, "mean_edge_length")
-    E = topology.unique_edges(F)
+    E = topology.halfedge_mesh(F, len(V), checked=True).E
     return float(np.linalg.norm(V[E[:, 1]] - V[E[:, 0]], axis=1).mean())
 
 
@@ -565,10 +541,36 @@ def _rng(seed, where: str) -> np.random.Generator:
     return np.random.default_rng(check_int(seed, "seed", minimum=0, where=where))
 
 
-def sample_surface(
+#: Bytes one random surface sample takes while it is drawn (uniforms, face id, weights, point).
+_BYTES_PER_SAMPLE = 8 * (3 + 1 + 3 + 3 + 1)
+
+
+def _memory_bytes() -> int:
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):  # not POSIX: assume a 16 GiB machine
+        return 16 * 2**30
+
+
+def _sample_count(n, name: str, minimum: int, where: str) -> int:
+    """A sample count that fits in memory: half the machine's RAM at most, else a clear error."""
+    n = check_int(n, name, minimum=minimum, where=where)
+    need, have = n * _BYTES_PER_SAMPLE, _memory_bytes()
+    if need > have // 2:
+        raise MeshError(
+            f"{where}: {name} = {n:,} samples would need about {need / 2**30:,.3g} GiB of memory and this "
+            f"machine has {have / 2**30:,.3g} GiB; ask for fewer samples"
+        )
+    return n
+
+
+def random_points_on_mesh(
     V, F, n: int, seed: int | np.random.Generator = 0, *, return_barycentric: bool = False
 ) -> tuple[np.ndarray, np.ndarray] | tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Area-uniform random points on the surface (seeded, deterministic).
+
+    Named as in gpytoolbox; not to be confused with the VDM lab's ``sample_surface``, which
+    evaluates the surface at given texture coordinates.
 
     A face is chosen with probability proportional to its area, then a point uniformly inside
     it: with ``r1, r2 ~ U(0, 1)`` and ``s = sqrt(r1)``, the barycentric weights are
@@ -591,9 +593,9 @@ def sample_surface(
     face_ids : (n,) int64
     bary : (n, 3) float64, optional
     """
-    where = "sample_surface"
+    where = "random_points_on_mesh"
     V, F = _mesh(V, F, where)
-    n = check_int(n, "n", minimum=0, where=where)
+    n = _sample_count(n, "n", 0, where)
     P, fid, B = _sample(V, F, n, _rng(seed, where), where)
     return (P, fid, B) if return_barycentric else (P, fid)
 
@@ -665,7 +667,7 @@ def mesh_distance(V1, F1, V2, F2, *, n_samples: int = 50_000, seed: int = 0, rel
 def _mesh_distance(V1, F1, V2, F2, n_samples, seed, relative, where: str) -> dict[str, float]:
     V1, F1 = _mesh(V1, F1, where, "V1", "F1")
     V2, F2 = _mesh(V2, F2, where, "V2", "F2")
-    n_samples = check_int(n_samples, "n_samples", minimum=1, where=where)
+    n_samples = _sample_count(n_samples, "n_samples", 1, where)
     seed = check_int(seed, "seed", minimum=0, where=where)
     r1, r2 = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     d12, v12 = _one_sided(V1, F1, V2, F2, n_samples, r1, where)

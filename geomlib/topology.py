@@ -86,7 +86,7 @@ def _ragged(faces) -> tuple[np.ndarray, np.ndarray]:
         return np.asarray(faces[0], np.int64), np.asarray(faces[1], np.int64)
     if isinstance(faces, np.ndarray) and faces.dtype != object and faces.ndim == 2:
         m, k = faces.shape
-        return faces.astype(np.int64).ravel(), np.arange(0, m * k + 1, max(k, 1), dtype=np.int64)[: m + 1]
+        return np.asarray(faces, np.int64).ravel(), np.arange(0, m * k + 1, max(k, 1), dtype=np.int64)[: m + 1]
     polys = [np.asarray(f, dtype=np.int64).ravel() for f in faces]
     lens = np.array([len(p) for p in polys], dtype=np.int64)
     idx = np.concatenate(polys) if polys else np.zeros(0, np.int64)
@@ -198,8 +198,9 @@ class HalfEdgeMesh:
     """Corner / half-edge connectivity of a polygon mesh (``n`` vertices, ``m`` faces, ``e`` edges, ``h`` corners).
 
     Corner ``j`` is entry ``j`` of the ragged faces; half-edge ``j`` runs from it to the next corner
-    of its face. Build it with :func:`halfedge_mesh`; the fields below are computed on first use
-    and then kept (``cached_property``), so a caller pays only for what it reads.
+    of its face. Build it with :func:`halfedge_mesh`. The fields up to ``n_vertices`` are stored;
+    the others are derived from them on first use and then kept (``cached_property``), so a
+    caller pays only for what it reads.
 
     Attributes
     ----------
@@ -207,25 +208,25 @@ class HalfEdgeMesh:
         Ragged faces: face ``f`` is ``idx[off[f]:off[f + 1]]``; ``idx[j]`` is the vertex of corner ``j``.
     nxt : (h,) int64
         Next corner in the same face (half-edge ``j`` is ``idx[j] -> idx[nxt[j]]``).
-    twin : (h,) int64
-        The half-edge running the other way along the same edge; ``-1`` on a boundary edge, and
-        also on edges that are not a proper pair (more than two faces, or two faces running the
-        same way) — :attr:`edge_size` tells those apart.
     he_edge : (h,) int64
         Undirected edge of every half-edge (row of ``E``).
     E : (e, 2) int64
         Unique undirected edges, smaller index first, sorted lexicographically
         (the order of :func:`unique_edges`).
+    EH : (e, 2) int64
+        ``EH[i, 0]`` the half-edge running ``E[i, 0] -> E[i, 1]``, ``EH[i, 1]`` the one running back;
+        ``-1`` where there is none (on a non-manifold edge the last one of each direction).
     n_vertices : int
+    twin : (h,) int64
+        The half-edge running the other way along the same edge; ``-1`` on a boundary edge, and
+        also on edges that are not a proper pair (more than two faces, or two faces running the
+        same way) — :attr:`edge_size` tells those apart.
     prv : (h,) int64
         Previous corner in the same face.
     he_face : (h,) int64
         Face of every corner.
     edge_size : (e,) int64
         Half-edges on every edge: 1 boundary, 2 interior, more = non-manifold edge.
-    EH : (e, 2) int64
-        ``EH[i, 0]`` the half-edge running ``E[i, 0] -> E[i, 1]``, ``EH[i, 1]`` the one running back;
-        ``-1`` where there is none (on a non-manifold edge the last one of each direction).
     EF : (e, 2) int64
         The faces of those half-edges (``-1`` where none).
     boundary_edge : (e,) bool
@@ -236,9 +237,10 @@ class HalfEdgeMesh:
         Number of edges at every vertex (0 for a vertex no face uses).
     vertex_corner : (n,) int64
         One outgoing half-edge of every vertex (its boundary half-edge on the boundary), ``-1`` if unused.
-    corner_fan, fan_vertex, vertex_fans : (h,), (k,), (n,) int64
-        Fan of every corner (corners linked across shared edges around one vertex), vertex of every
-        fan, and number of fans at every vertex (1 at a manifold vertex, 0 at an unused one).
+    vertex_fans : (n,) int64
+        Number of fans at every vertex (1 at a manifold vertex, 0 at an unused one); a fan is a set
+        of corners of one vertex linked across shared edges. :meth:`fans` gives the fan of every
+        corner.
 
     Invariants
     ----------
@@ -246,12 +248,14 @@ class HalfEdgeMesh:
 
     1. ``off`` starts at 0, rises by >= 3 per face and ends at ``h``; ``nxt`` cycles through each
        face's corners in order, ``prv`` is its inverse.
-    2. ``twin`` is an involution without fixed points: ``twin[twin[j]] == j``, and twins run in
-       opposite directions: ``idx[twin[j]] == idx[nxt[j]]``, ``idx[nxt[twin[j]]] == idx[j]``.
-    3. ``E[he_edge[j]]`` is ``(idx[j], idx[nxt[j]])`` sorted; rows of ``E`` are distinct with
-       ``E[:, 0] < E[:, 1]``; twins share their edge.
-    4. On a manifold, oriented mesh every edge has one or two half-edges and ``twin[j] == -1``
-       exactly on one-half-edge (boundary) edges; every used vertex has one fan.
+    2. ``E[he_edge[j]]`` is ``(idx[j], idx[nxt[j]])`` sorted; rows of ``E`` are distinct, used,
+       with ``E[:, 0] < E[:, 1]``.
+    3. ``EH[i, 0]`` (when not -1) is a half-edge of edge ``i`` running ``E[i, 0] -> E[i, 1]``,
+       ``EH[i, 1]`` one running back. ``twin`` pairs the two, so it is an involution without fixed
+       points whose pairs run opposite ways.
+    4. On a manifold, oriented mesh every edge has one or two half-edges, ``EH`` lists every
+       half-edge once (so ``twin[j] == -1`` exactly on boundary edges) and every used vertex has
+       one fan.
 
     The structure is frozen: an editing operation builds new arrays and a new ``HalfEdgeMesh``
     (``dataclasses.replace``), never writes into these, so the cached fields cannot go stale.
@@ -260,9 +264,9 @@ class HalfEdgeMesh:
     idx: np.ndarray
     off: np.ndarray
     nxt: np.ndarray
-    twin: np.ndarray
     he_edge: np.ndarray
     E: np.ndarray
+    EH: np.ndarray
     n_vertices: int
 
     @property
@@ -293,16 +297,17 @@ class HalfEdgeMesh:
     def he_face(self) -> np.ndarray:
         return np.repeat(np.arange(self.n_faces, dtype=np.int64), np.diff(self.off))
 
-    @cached_property
-    def edge_size(self) -> np.ndarray:
+    @property
+    def edge_size(self) -> np.ndarray:  # not cached: one bincount, and this runs on huge meshes
         return np.bincount(self.he_edge, minlength=self.n_edges).astype(np.int64)
 
     @cached_property
-    def EH(self) -> np.ndarray:
-        EH = np.full((self.n_edges, 2), -1, dtype=np.int64)
-        back = (self.idx >= self.idx[self.nxt]).astype(np.int64)  # not from the smaller to the larger index
-        EH[self.he_edge, back] = np.arange(len(self.idx))
-        return EH
+    def twin(self) -> np.ndarray:
+        twin = np.full(len(self.idx), -1, dtype=np.int64)
+        e = np.flatnonzero((self.EH >= 0).all(axis=1) & (self.edge_size == 2))
+        twin[self.EH[e, 0]] = self.EH[e, 1]
+        twin[self.EH[e, 1]] = self.EH[e, 0]
+        return twin
 
     @cached_property
     def EF(self) -> np.ndarray:
@@ -330,17 +335,24 @@ class HalfEdgeMesh:
         vc[self.idx[bh]] = bh
         return vc
 
-    @cached_property
-    def _fans(self) -> tuple[np.ndarray, np.ndarray]:
-        idx, nxt, twin = self.idx, self.nxt, self.twin
-        paired = twin >= 0
-        if (paired | (self.edge_size[self.he_edge] == 1)).all():
-            # Every edge is a boundary or a proper pair: corner j and the corner after its twin sit
-            # at the same vertex in faces sharing an edge; each corner has at most one such link.
-            j = np.flatnonzero(paired)
-            return corner_fans(idx, j, nxt[twin[j]], one_per_row=True)
+    def fans(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(corner_fan, fan_vertex)``: the fan of every corner and the vertex of every fan.
+
+        Computed on each call (a connected-components pass) and not kept: most callers need only
+        :attr:`vertex_fans`, and the labels are as long as the corners.
+        """
+        idx, nxt, EH = self.idx, self.nxt, self.EH
+        size = self.edge_size
+        pair = (EH >= 0).all(axis=1)
+        if (size <= 2).all() and np.array_equal(pair, size == 2):
+            # Every edge is a boundary or a proper pair a -> b, b -> a: each half-edge's corner and
+            # the corner after its twin sit at the same vertex in faces sharing an edge; each corner
+            # has at most one such link.
+            h0, h1 = EH[pair, 0], EH[pair, 1]
+            return corner_fans(idx, np.concatenate([h0, h1]), np.concatenate([nxt[h1], nxt[h0]]), one_per_row=True)
         # General case: chain the half-edges of every edge in order and link, for each consecutive
         # pair, their corners at the smaller endpoint and their corners at the larger one.
+        del size
         order = np.argsort(self.he_edge, kind="stable")
         same = np.flatnonzero(self.he_edge[order[1:]] == self.he_edge[order[:-1]])
         h1, h2 = order[same], order[same + 1]
@@ -349,17 +361,9 @@ class HalfEdgeMesh:
         lo2, hi2 = np.where(up2, h2, nxt[h2]), np.where(up2, nxt[h2], h2)
         return corner_fans(idx, np.r_[lo1, hi1], np.r_[lo2, hi2])
 
-    @property
-    def corner_fan(self) -> np.ndarray:
-        return self._fans[0]
-
-    @property
-    def fan_vertex(self) -> np.ndarray:
-        return self._fans[1]
-
     @cached_property
     def vertex_fans(self) -> np.ndarray:
-        return np.bincount(self.fan_vertex, minlength=self.n_vertices).astype(np.int64)
+        return np.bincount(self.fans()[1], minlength=self.n_vertices).astype(np.int64)
 
 
 def halfedge_mesh(
@@ -390,8 +394,8 @@ def halfedge_mesh(
     Notes
     -----
     One stable ``argsort`` of the undirected keys ``min * n + max`` groups the half-edges of every
-    edge: the first of each group gives ``E``, the group number ``he_edge``, groups of two running
-    opposite ways give ``twin``. Cost O(h log h); temporaries are freed early because this runs
+    edge: the first of each group gives ``E``, the group number ``he_edge``, the direction of each
+    half-edge its column of ``EH``. Cost O(h log h); temporaries are freed early because this runs
     on meshes of millions of half-edges.
     """
     if checked:
@@ -423,18 +427,14 @@ def halfedge_mesh(
     he_edge = np.empty(h, dtype=np.int64)
     he_edge[order] = np.cumsum(new) - 1
     del new
-    size = np.diff(np.append(first, h))
-    pair = first[size == 2]
-    h0, h1 = order[pair], order[pair + 1]
-    del order, first, pair
-    opposite = idx[h0] != idx[h1]
-    h0, h1 = h0[opposite], h1[opposite]
-    twin = np.full(h, -1, dtype=np.int64)
-    twin[h0] = h1
-    twin[h1] = h0
-    del h0, h1, opposite
-    H = HalfEdgeMesh(idx, off, nxt, twin, he_edge, E, n)
-    H.__dict__["edge_size"] = size  # computed anyway: saves a bincount
+    del order, first
+    EH = np.full((len(E), 2), -1, dtype=np.int64)
+    j = np.flatnonzero(idx < idx[nxt])  # runs from the smaller to the larger index
+    EH[he_edge[j], 0] = j
+    j = np.flatnonzero(idx >= idx[nxt])
+    EH[he_edge[j], 1] = j
+    del j
+    H = HalfEdgeMesh(idx, off, nxt, he_edge, E, EH, n)
     if manifold:
         _require_manifold(H, name, where)
     return H
@@ -457,10 +457,9 @@ def _require_manifold(H: HalfEdgeMesh, name: str, where: str | None) -> None:
             f"{p}{name}: edge ({H.E[i, 0]}, {H.E[i, 1]}) is shared by {size[i]} faces {tuple(fs)}{why}; "
             f"this needs an edge-manifold mesh (each edge in at most 2 faces)"
         )
-    unpaired = (H.twin < 0) & (size[H.he_edge] == 2)  # two faces running the same way along an edge
-    if unpaired.any():
-        j = int(np.flatnonzero(unpaired)[0])
-        hs = np.flatnonzero(H.he_edge == H.he_edge[j])
+    same_way = (size == 2) & (H.EH < 0).any(axis=1)  # two faces running the same way along an edge
+    if same_way.any():
+        hs = np.flatnonzero(H.he_edge == np.flatnonzero(same_way)[0])
         f0, f1 = sorted(H.he_face[hs].tolist())
         u, v = int(H.idx[hs[0]]), int(H.idx[H.nxt[hs[0]]])
         raise MeshError(
@@ -481,15 +480,16 @@ def _require_manifold(H: HalfEdgeMesh, name: str, where: str | None) -> None:
 def check_halfedges(H: HalfEdgeMesh, *, manifold: bool = True) -> None:
     """Raise :class:`MeshError` naming the first broken invariant of a :class:`HalfEdgeMesh`.
 
-    Checks invariants 1-3 of :class:`HalfEdgeMesh` always and 4 with ``manifold``. Meant for code
+    Checks invariants 1-3 of :class:`HalfEdgeMesh` always and 4 with ``manifold``; ``twin`` and the
+    other derived fields follow from them. Meant for code
     that edits the structure (edge split, collapse, flip): call it after each operation in tests.
     Cost O(h log h).
     """
     p = "check_halfedges: "
-    idx, off, nxt, twin, he_edge, E = H.idx, H.off, H.nxt, H.twin, H.he_edge, H.E
+    idx, off, nxt, he_edge, E, EH = H.idx, H.off, H.nxt, H.he_edge, H.E, H.EH
     h, e, n = len(idx), len(E), H.n_vertices
-    for nm, a, shape in (("idx", idx, (h,)), ("nxt", nxt, (h,)), ("twin", twin, (h,)), ("he_edge", he_edge, (h,)),
-                         ("E", E, (e, 2))):  # fmt: skip
+    for nm, a, shape in (("idx", idx, (h,)), ("nxt", nxt, (h,)), ("he_edge", he_edge, (h,)), ("E", E, (e, 2)),
+                         ("EH", EH, (e, 2))):  # fmt: skip
         if a.shape != shape or a.dtype != np.int64:
             raise MeshError(f"{p}{nm} has shape {a.shape} and dtype {a.dtype}, expected {shape} int64")
     lens = np.diff(off)
@@ -500,19 +500,6 @@ def check_halfedges(H: HalfEdgeMesh, *, manifold: bool = True) -> None:
     bad = np.flatnonzero(nxt != next_corners(off))
     if len(bad):
         raise MeshError(f"{p}nxt[{bad[0]}] is {nxt[bad[0]]}, not the next corner of its face")
-    paired = np.flatnonzero(twin >= 0)
-    if len(paired) and twin.max() >= h:
-        raise MeshError(f"{p}twin holds a half-edge past {h - 1}")
-    t = twin[paired]
-    for cond, what in (
-        (twin[t] != paired, "is not an involution (twin[twin[j]] != j)"),
-        (t == paired, "maps a half-edge to itself"),
-        ((idx[t] != idx[nxt[paired]]) | (idx[nxt[t]] != idx[paired]), "pairs half-edges that do not run opposite ways"),
-        (he_edge[t] != he_edge[paired], "pairs half-edges of different edges"),
-    ):
-        if cond.any():
-            j = int(paired[np.flatnonzero(cond)[0]])
-            raise MeshError(f"{p}twin {what}: half-edge {j} -> {int(twin[j])}")
     if h and (he_edge.min() < 0 or he_edge.max() >= e):
         raise MeshError(f"{p}he_edge holds an edge outside 0..{e - 1}")
     ends = np.sort(np.stack([idx, idx[nxt]], axis=1), axis=1)
@@ -520,16 +507,27 @@ def check_halfedges(H: HalfEdgeMesh, *, manifold: bool = True) -> None:
     if len(wrong):
         j = int(wrong[0])
         raise MeshError(f"{p}half-edge {j} runs {fmt_row(ends[j])} but he_edge names edge {fmt_row(E[he_edge[j]])}")
-    if e and ((E[:, 0] >= E[:, 1]).any() or len(unique_rows(E)) != e or np.bincount(he_edge, minlength=e).min() < 1):
+    size = np.bincount(he_edge, minlength=e)
+    if e and ((E[:, 0] >= E[:, 1]).any() or len(unique_rows(E)) != e or size.min() < 1):
         raise MeshError(f"{p}E must hold distinct used edges, smaller index first")
+    for col in (0, 1):
+        has = np.flatnonzero(EH[:, col] >= 0)
+        j = EH[has, col]
+        if len(j) and j.max() >= h:
+            raise MeshError(f"{p}EH[:, {col}] holds a half-edge past {h - 1}")
+        wrong = (he_edge[j] != has) | (idx[j] != E[has, col]) | (idx[nxt[j]] != E[has, 1 - col])
+        if wrong.any():
+            k = int(np.flatnonzero(wrong)[0])
+            raise MeshError(
+                f"{p}EH[{has[k]}, {col}] = {j[k]} is not a half-edge running "
+                f"{E[has[k], col]} -> {E[has[k], 1 - col]} along edge {has[k]}"
+            )
     if manifold:
-        size = np.bincount(he_edge, minlength=e)
         if (size > 2).any():
             raise MeshError(f"{p}edge {int(np.flatnonzero(size > 2)[0])} has more than two half-edges")
-        lone = (twin < 0) != (size[he_edge] == 1)
-        if lone.any():
-            raise MeshError(f"{p}half-edge {int(np.flatnonzero(lone)[0])} has no twin but its edge has two half-edges")
-        fans = HalfEdgeMesh(idx, off, nxt, twin, he_edge, E, n).vertex_fans  # fresh: no stale cache
+        if np.count_nonzero(EH >= 0) != h:
+            raise MeshError(f"{p}EH does not list every half-edge (two half-edges of an edge run the same way)")
+        fans = HalfEdgeMesh(idx, off, nxt, he_edge, E, EH, n).vertex_fans  # fresh: no stale cache
         if (fans > 1).any():
             raise MeshError(f"{p}vertex {int(np.flatnonzero(fans > 1)[0])} has {int(fans.max())} fans (non-manifold)")
 

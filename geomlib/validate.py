@@ -35,6 +35,7 @@ __all__ = [
     "as_image",
     "check_mesh",
     "check_polygon_mesh",
+    "check_uv",
     "check_manifold",
     "check_int",
     "check_float",
@@ -202,6 +203,8 @@ def check_mesh(
     allow_degenerate: bool = False,
     allow_duplicate: bool = False,
     min_faces: int = 1,
+    vname: str = "V",
+    fname: str = "F",
 ) -> tuple[np.ndarray, np.ndarray]:
     """Validate a triangle mesh and return it as ``(V float64 (n, 3), F int64 (m, 3))``.
 
@@ -219,24 +222,26 @@ def check_mesh(
         Accept faces that repeat a vertex / that repeat another face.
     min_faces : int
         Fewest faces accepted.
+    vname, fname : str
+        Names of the two arguments in messages (e.g. ``"V1"``, ``"F1"``).
     """
     p = _prefix(where)
-    V = as_vertices(V, where=where)
+    V = as_vertices(V, name=vname, where=where)
     if F is not None and not isinstance(F, np.ndarray):
         try:
-            shape_ok = np.asarray(F).ndim == 2
+            F = np.asarray(F)
+            shape_ok = F.ndim == 2 and F.dtype != object
         except Exception:
             shape_ok = False
         if not shape_ok:
-            raise MeshError(f"{p}F must be an (m, 3) integer array of triangles; got a ragged or polygonal list")
-    if F is not None and np.asarray(F).ndim == 2 and np.asarray(F).shape[1] != 3:
+            raise MeshError(f"{p}{fname} must be an (m, 3) integer array of triangles; got a ragged or polygonal list")
+    if F is not None and F.ndim == 2 and F.shape[1] != 3:
         raise MeshError(
-            f"{p}F has shape {np.asarray(F).shape}: this function needs triangles (m, 3); "
-            f"triangulate polygon faces first"
+            f"{p}{fname} has shape {F.shape}: this function needs triangles (m, 3); triangulate polygon faces first"
         )
-    F = as_faces(F, len(V), where=where, allow_degenerate=allow_degenerate, allow_duplicate=allow_duplicate)
+    F = as_faces(F, len(V), name=fname, where=where, allow_degenerate=allow_degenerate, allow_duplicate=allow_duplicate)
     if len(F) < min_faces:
-        raise MeshError(f"{p}F has {len(F)} faces, expected at least {min_faces}")
+        raise MeshError(f"{p}{fname} has {len(F)} faces, expected at least {min_faces}")
     if manifold or closed:
         H = topology.halfedge_mesh(F, len(V), manifold=manifold, checked=True, name="F", where=where)
         b = np.flatnonzero(H.edge_size[H.he_edge] == 1) if closed else ()
@@ -283,6 +288,40 @@ def check_polygon_mesh(
     if manifold:
         check_manifold((idx, off), len(V), name="faces", where=where)
     return V, idx, off
+
+
+#: UV values this far outside [0, 1] still count as inside (round-off of exporters).
+UV_SLACK = 1e-9
+
+
+def check_uv(UV, n: int, where: str | None = None, *, in_range: bool = False, name: str = "UV") -> np.ndarray:
+    """Texture coordinates ``(n, 2)`` float64, one ``(u, v)`` row per vertex.
+
+    Parameters
+    ----------
+    UV : (n, 2) array_like
+    n : int
+        Number of vertices.
+    where, name : str
+        Function and argument names for error messages.
+    in_range : bool
+        Also require every row inside the texture square ``[0, 1]^2`` (up to :data:`UV_SLACK`).
+    """
+    p = _prefix(where)
+    if UV is None:
+        raise MeshError(f"{p}{name} is missing; this function needs texture coordinates, one (u, v) row per vertex")
+    UV = as_array(UV, name, shape=(None, 2), where=where)
+    if len(UV) != n:
+        raise MeshError(f"{p}{name} has {len(UV)} rows but V has {n}; expected one (u, v) per vertex")
+    if in_range:
+        bad = ((UV < -UV_SLACK) | (UV > 1 + UV_SLACK)).any(axis=1)
+        if bad.any():
+            r = int(np.flatnonzero(bad)[0])
+            raise MeshError(
+                f"{p}{name} row {r} is ({UV[r, 0]:.6g}, {UV[r, 1]:.6g}), outside the texture square [0, 1]^2 "
+                f"({int(bad.sum())} rows are out of range)"
+            )
+    return UV
 
 
 def check_int(

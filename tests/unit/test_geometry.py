@@ -124,7 +124,7 @@ def test_dihedral_angle_sign_and_boundary_nan():
 
 def test_closest_points_on_surface_are_zero(sphere4):
     V, F = sphere4
-    P, fid = geometry.sample_surface(V, F, 500, seed=1)
+    P, fid = geometry.random_points_on_mesh(V, F, 500, seed=1)
     d, face, C = geometry.closest_points(V, F, P)
     assert d.max() < 1e-20
     np.testing.assert_allclose(C, P, atol=1e-10)
@@ -272,19 +272,19 @@ def test_ray_cast_small_chunks_give_the_same_answer(sphere4):
 # sampling and distances
 
 
-def test_sample_surface_is_area_uniform_and_seeded():
+def test_random_points_on_mesh_is_area_uniform_and_seeded():
     # two triangles of areas 1 and 3 (a 1x2 and a 3x2 right triangle)
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 2, 0], [10, 0, 0], [13, 0, 0], [10, 2, 0.0]])
     F = np.array([[0, 1, 2], [3, 4, 5]])
-    P, fid, B = geometry.sample_surface(V, F, 40000, seed=3, return_barycentric=True)
+    P, fid, B = geometry.random_points_on_mesh(V, F, 40000, seed=3, return_barycentric=True)
     assert abs((fid == 1).mean() - 0.75) < 0.01
     np.testing.assert_allclose(np.einsum("ij,ijk->ik", B, V[F[fid]]), P)
     assert (B >= 0).all()
     # uniform inside a triangle: the mean is the centroid
     np.testing.assert_allclose(P[fid == 0].mean(0), V[:3].mean(0), atol=0.01)
-    P2, fid2 = geometry.sample_surface(V, F, 40000, seed=3)
+    P2, fid2 = geometry.random_points_on_mesh(V, F, 40000, seed=3)
     np.testing.assert_array_equal(P, P2)
-    assert not np.array_equal(P, geometry.sample_surface(V, F, 40000, seed=4)[0])
+    assert not np.array_equal(P, geometry.random_points_on_mesh(V, F, 40000, seed=4)[0])
 
 
 def test_mesh_distance_to_itself_is_zero(sphere4):
@@ -379,8 +379,11 @@ def test_hausdorff_sees_what_vertex_based_hausdorff_misses():
         (lambda: geometry.ray_cast(TRI_V, TRI_F, [[0, 0, np.inf]], [[0, 0, 1.0]]), r"^ray_cast: origins: row 0"),
         (lambda: geometry.ray_cast(TRI_V, TRI_F, [[0, 0, 1]], [[0, 0, 1]], t_max=-1), r"^ray_cast: t_max must be >="),
         (lambda: geometry.ray_cast(TRI_V, TRI_F, [[0, 0, 1]], [[0, 0, 1]], method="embree"), r"^ray_cast: method must"),
-        (lambda: geometry.sample_surface(TRI_V, TRI_F, -1), r"^sample_surface: n must be >= 0"),
-        (lambda: geometry.sample_surface(TRI_V * 0, TRI_F, 5), r"^sample_surface: the mesh has zero total area"),
+        (lambda: geometry.random_points_on_mesh(TRI_V, TRI_F, -1), r"^random_points_on_mesh: n must be >= 0"),
+        (
+            lambda: geometry.random_points_on_mesh(TRI_V * 0, TRI_F, 5),
+            r"^random_points_on_mesh: the mesh has zero total area",
+        ),
         (lambda: geometry.mesh_distance(TRI_V, TRI_F, TRI_V, [[0, 1, 5]]), r"^mesh_distance: F2: face 0 uses vertex 5"),
         (lambda: geometry.hausdorff_distance(TRI_V, TRI_F, None, TRI_F), r"^hausdorff_distance: V2 is missing"),
         (
@@ -400,3 +403,10 @@ def test_degenerate_and_duplicate_faces_are_accepted_as_a_soup():
     np.testing.assert_allclose(geometry.face_areas(TRI_V, F), [1, 1, 0])
     hit, t, face, _ = geometry.ray_cast(TRI_V, F, [[0.2, 0.2, 1.0]], [[0, 0, -1.0]])
     assert hit[0] and t[0] == pytest.approx(1.0) and face[0] == 0  # lowest index on the tie
+
+
+def test_sample_counts_that_cannot_fit_in_memory_are_refused_clearly():
+    with pytest.raises(MeshError, match=r"^random_points_on_mesh: n = 1,000,000,000,000 samples would need about"):
+        geometry.random_points_on_mesh(TRI_V, TRI_F, 10**12)
+    with pytest.raises(MeshError, match=r"^mesh_distance: n_samples = .* would need about .* GiB of memory"):
+        geometry.mesh_distance(TRI_V, TRI_F, TRI_V, TRI_F, n_samples=10**12)

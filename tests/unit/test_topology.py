@@ -226,3 +226,129 @@ def test_corner_fans_split_a_bowtie_vertex_into_two_fans(one_per_row):
     assert fans[0] == 2  # the bowtie vertex
     assert fans[2] == 1 and fans[5] == 1
     assert labels[0] == labels[3] and labels[6] == labels[9] and labels[0] != labels[6]
+
+
+# --------------------------------------------------------------------------------------------
+# the half-edge structure
+
+
+def test_halfedge_mesh_of_the_square_by_hand():
+    # corners 0..5 = F.ravel() = 0 1 2 | 0 2 3; half-edges 0->1, 1->2, 2->0, 0->2, 2->3, 3->0
+    H = tp.halfedge_mesh(SQUARE)
+    np.testing.assert_array_equal(H.nxt, [1, 2, 0, 4, 5, 3])
+    np.testing.assert_array_equal(H.prv, [2, 0, 1, 5, 3, 4])
+    np.testing.assert_array_equal(H.he_face, [0, 0, 0, 1, 1, 1])
+    # edges sorted: (0,1) (0,2) (0,3) (1,2) (2,3)
+    np.testing.assert_array_equal(H.E, [[0, 1], [0, 2], [0, 3], [1, 2], [2, 3]])
+    np.testing.assert_array_equal(H.he_edge, [0, 3, 1, 1, 4, 2])
+    # the diagonal 0-2: half-edge 3 runs 0->2 (face 1), half-edge 2 runs 2->0 (face 0)
+    np.testing.assert_array_equal(H.EH[1], [3, 2])
+    np.testing.assert_array_equal(H.EF[1], [1, 0])
+    np.testing.assert_array_equal(H.twin, [-1, -1, 3, 2, -1, -1])
+    np.testing.assert_array_equal(H.boundary_edge, [True, False, True, True, True])
+    np.testing.assert_array_equal(H.valence, [3, 2, 3, 2])
+    np.testing.assert_array_equal(H.vertex_fans, [1, 1, 1, 1])
+    # every vertex is on the boundary: its outgoing corner is its boundary half-edge
+    np.testing.assert_array_equal(H.vertex_corner, [0, 1, 4, 5])
+    tp.check_halfedges(H)
+
+
+def test_halfedge_mesh_on_closed_meshes_and_polygons():
+    for faces, n in ((TETRA, 4), (CUBE_Q, 8), ([[0, 1, 2, 3], [3, 2, 4]], 5)):
+        H = tp.halfedge_mesh(faces, n, manifold=True)
+        tp.check_halfedges(H)
+        paired = H.twin >= 0
+        np.testing.assert_array_equal(H.twin[H.twin[paired]], np.flatnonzero(paired))
+        np.testing.assert_array_equal(H.idx[H.twin[paired]], H.idx[H.nxt[paired]])
+    assert (tp.halfedge_mesh(TETRA).twin >= 0).all()  # closed: every half-edge has a twin
+
+
+def test_check_halfedges_names_a_broken_invariant():
+    import dataclasses
+
+    H = tp.halfedge_mesh(TETRA)
+    bad_nxt = H.nxt.copy()
+    bad_nxt[[0, 1]] = bad_nxt[[1, 0]]
+    with pytest.raises(MeshError, match=r"nxt\[0\] is 2, not the next corner"):
+        tp.check_halfedges(dataclasses.replace(H, nxt=bad_nxt))
+    bad_EH = H.EH.copy()
+    bad_EH[0] = bad_EH[0, ::-1]  # swap the directions of edge 0
+    with pytest.raises(MeshError, match=r"EH\[0, 0\] = .* is not a half-edge running 0 -> 1"):
+        tp.check_halfedges(dataclasses.replace(H, EH=bad_EH))
+    bad_edge = H.he_edge.copy()
+    bad_edge[0] = (bad_edge[0] + 1) % H.n_edges
+    with pytest.raises(MeshError, match="half-edge 0 runs"):
+        tp.check_halfedges(dataclasses.replace(H, he_edge=bad_edge))
+    with pytest.raises(MeshError, match="vertex 0 has 2 fans"):
+        tp.check_halfedges(tp.halfedge_mesh(BOWTIE))
+    tp.check_halfedges(tp.halfedge_mesh(BOWTIE), manifold=False)
+
+
+def test_manifold_build_reports_duplicates_and_orientation():
+    with pytest.raises(MeshError, match=r"f: F: faces 0 and 1 are duplicates \(same corners\)"):
+        tp.halfedge_mesh([[0, 1, 2], [0, 1, 2]], manifold=True, where="f", name="F")
+    with pytest.raises(MeshError, match=r"faces 0 and 1 both traverse edge \(0, 1\).*not consistently oriented"):
+        tp.halfedge_mesh([[0, 1, 2], [0, 1, 3]], manifold=True)
+    # a third face on an edge is named with the edge, and a duplicate among them as the likely cause
+    with pytest.raises(MeshError, match=r"edge \(0, 1\) is shared by 3 faces \(0, 1, 2\) \(faces 0 and 2 are dup"):
+        tp.halfedge_mesh([[0, 1, 2], [1, 0, 3], [2, 1, 0]], manifold=True)
+
+
+def test_fans_on_a_non_manifold_edge_match_the_general_rule():
+    # three triangles on edge (0, 1): all their corners at 0 form one fan, and all at 1
+    F = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4]])
+    np.testing.assert_array_equal(tp.vertex_fan_counts(F), [1, 1, 1, 1, 1])
+    labels, owner = tp.halfedge_mesh(F).fans()
+    assert len(set(labels[[0, 4, 6]].tolist())) == 1  # the corners at vertex 0
+    assert (owner[labels] == F.ravel()).all()
+
+
+# --------------------------------------------------------------------------------------------
+# bad input to the public functions
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: tp.valence([[0, 1, -1]]), r"^valence: faces: face 0 \(0, 1, -1\) has a negative index"),
+        (lambda: tp.valence(TRIANGLE, n_vertices=2), r"^valence: faces: face 0 uses vertex 2, but V has only 2"),
+        (lambda: tp.valence(TRIANGLE, n_vertices=-1), r"^valence: n_vertices must be an integer >= 0"),
+        (lambda: tp.is_closed([[0, 1]]), r"^is_closed: faces: face 0 has 2 vertices, a polygon needs at least 3"),
+        (lambda: tp.is_closed(np.array([0, 1, 2])), r"^is_closed: faces has shape \(3,\)"),
+        (lambda: tp.euler_characteristic([[0, 1.5, 2]]), r"^euler_characteristic: faces: face 0 holds a non-integer"),
+        (lambda: tp.euler_characteristic(np.array([[0, 1, 2.5]])), r"holds a non-integer value 2.5"),
+        (lambda: tp.triangulate_polygons([[0, 1, 2], [3, 4]]), r"^triangulate_polygons: faces: face 1 has 2 vertices"),
+        (lambda: tp.triangulate_polygons(np.array([["a", "b", "c"]])), r"faces has dtype <U1, expected integers"),
+        (lambda: tp.boundary_loops(None), r"^boundary_loops: faces is missing"),
+        (lambda: tp.boundary_loops(5), r"^boundary_loops: faces must be an \(m, k\) int array or a list"),
+        (lambda: tp.boundary_loops([[0, 1, 2], [0, 1, 3]]), r"^boundary_loops: boundary vertex 1 has 2 outgoing"),
+        (lambda: tp.valence(np.array([[0, 1, 2**63]], np.uint64)), r"2\*\*63|9223372036854775808 .*too large"),
+    ],
+)
+def test_public_functions_reject_bad_faces_clearly(call, message):
+    with pytest.raises(MeshError, match=message):
+        call()
+
+
+def test_boundary_loops_of_a_flipped_face_is_an_error_not_a_hang():
+    # face 1 is flipped: the boundary half-edges do not chain into loops
+    F = [[0, 1, 2], [0, 3, 2], [0, 3, 4]]
+    with pytest.raises(MeshError, match="boundary_loops: "):
+        tp.boundary_loops(F)
+
+
+def test_to_ragged_does_not_misread_two_triangles_as_offsets():
+    a, b = np.array([1, 2, 3]), np.array([0, 2, 3])  # b looks like offsets of faces of sizes 2 and 1
+    idx, off = tp.to_ragged((a, b))
+    np.testing.assert_array_equal(idx, [1, 2, 3, 0, 2, 3])
+    np.testing.assert_array_equal(off, [0, 3, 6])
+    assert tp.face_sizes((a, b)).tolist() == [3, 3]
+
+
+def test_topology_and_validate_do_not_import_each_other():
+    import subprocess
+    import sys
+
+    code = "import sys, geomlib.topology; print('geomlib.validate' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "False"

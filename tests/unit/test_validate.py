@@ -144,3 +144,34 @@ def test_duplicate_faces_are_found_with_either_sort(n_vertices, k):
     with pytest.raises(MeshError, match="faces 1 and 3 are duplicates"):
         as_faces(F, n_vertices, k=k)
     as_faces(F[:3], n_vertices, k=k)  # without the copy: accepted
+
+
+def test_uint64_index_past_int64_is_named_not_wrapped_to_negative():
+    F = np.array([[0, 1, 2**63]], dtype=np.uint64)
+    with pytest.raises(MeshError, match=r"f: F: face 0 uses vertex 9223372036854775808, but V has only 3"):
+        check_mesh(TRI, F, where="f")
+    with pytest.raises(MeshError, match=r"faces holds 9223372036854775808 at \(0, 2\), too large for an index"):
+        as_polygons(F, 3)
+    with pytest.raises(MeshError, match=r"F holds 10000000000000000000 at \(0, 2\), too large"):
+        check_mesh(TRI, np.array([[0, 1, 1e19]]))
+    V2, F2 = check_mesh(TRI, np.array([[0, 1, 2]], dtype=np.uint64))  # small unsigned indices are fine
+    assert F2.dtype == np.int64 and F2.tolist() == [[0, 1, 2]]
+
+
+def test_check_uv():
+    from geomlib.validate import check_uv
+
+    UV = np.array([[0.0, 0.5], [1, 1], [0.25, 0]])
+    assert check_uv(UV, 3).dtype == np.float64
+    with pytest.raises(MeshError, match="f: UV is missing; this function needs texture coordinates"):
+        check_uv(None, 3, "f")
+    with pytest.raises(MeshError, match="f: UV has 3 rows but V has 4; expected one"):
+        check_uv(UV, 4, "f")
+    check_uv(UV + 0.5, 3)  # outside the square is fine unless asked
+    with pytest.raises(MeshError, match=r"f: UV_lo row 1 is \(1.5, 1.5\), outside the texture square .*\(1 rows"):
+        check_uv(UV + 0.5, 3, "f", in_range=True, name="UV_lo")
+
+
+def test_meshes_as_ragged_pairs_are_accepted():
+    idx, off = as_polygons((np.array([0, 1, 2, 3, 3, 2, 4]), np.array([0, 4, 7])), 5)
+    assert off.tolist() == [0, 4, 7]
