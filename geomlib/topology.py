@@ -361,8 +361,8 @@ class HalfEdgeMesh:
         lo2, hi2 = np.where(up2, h2, nxt[h2]), np.where(up2, nxt[h2], h2)
         return corner_fans(idx, np.r_[lo1, hi1], np.r_[lo2, hi2])
 
-    @cached_property
-    def vertex_fans(self) -> np.ndarray:
+    @property
+    def vertex_fans(self) -> np.ndarray:  # not cached: the manifold check reads it once
         return np.bincount(self.fans()[1], minlength=self.n_vertices).astype(np.int64)
 
 

@@ -17,7 +17,9 @@ geomlib.errors.MeshError: loop_subdivide: F: face 0 uses vertex 3, but V has onl
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
 
 import numpy as np
 
@@ -34,6 +36,7 @@ __all__ = [
     "as_polygons",
     "as_image",
     "check_mesh",
+    "checked",
     "check_polygon_mesh",
     "check_uv",
     "check_manifold",
@@ -193,6 +196,33 @@ def check_manifold(F, n_vertices: int, *, name: str = "F", where: str | None = N
     topology.halfedge_mesh(F, n_vertices, manifold=True, name=name, where=where)
 
 
+#: Meshes a public entry point has validated, for the calls it makes (see :func:`checked`).
+_CHECKED: ContextVar[tuple] = ContextVar("geomlib_checked_meshes", default=())
+
+
+@contextmanager
+def checked(V: np.ndarray, F: np.ndarray, *, manifold: bool = False, closed: bool = False) -> Iterator[None]:
+    """Validate once per public entry: inside the block, ``check_mesh`` passes these arrays through.
+
+    A public function validates its mesh with :func:`check_mesh`, then runs its internal calls
+    (which are public functions too, and validate) inside ``with checked(V, F):``. There,
+    ``check_mesh`` called on these very array objects returns them at once, unless it asks for
+    more than was checked (``manifold``/``closed``). Other arrays, and calls outside the block,
+    are validated as always.
+
+    Examples
+    --------
+    >>> V, F = check_mesh(V, F, where="bake_vdm")  # doctest: +SKIP
+    >>> with checked(V, F):  # doctest: +SKIP
+    ...     UV = parameterize_square(V, F)  # its check_mesh(V, F) costs nothing now
+    """
+    token = _CHECKED.set((*_CHECKED.get(), (V, F, manifold, closed)))
+    try:
+        yield
+    finally:
+        _CHECKED.reset(token)
+
+
 def check_mesh(
     V,
     F,
@@ -225,6 +255,15 @@ def check_mesh(
     vname, fname : str
         Names of the two arguments in messages (e.g. ``"V1"``, ``"F1"``).
     """
+    for V0, F0, was_manifold, was_closed in _CHECKED.get():
+        if (
+            V is V0
+            and F is F0
+            and (was_manifold or not manifold)
+            and (was_closed or not closed)
+            and len(F) >= min_faces
+        ):
+            return V, F
     p = _prefix(where)
     V = as_vertices(V, name=vname, where=where)
     if F is not None and not isinstance(F, np.ndarray):

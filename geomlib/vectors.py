@@ -34,7 +34,7 @@ def normalize_rows(X, fallback=None) -> np.ndarray:
     X = np.asarray(X)
     if X.dtype.kind != "f":
         X = X.astype(np.float64)
-    n = np.sqrt(np.einsum("...i,...i->...", X, X))[..., None]
+    n = np.linalg.norm(X, axis=-1, keepdims=True)
     zero = n == 0
     out = X / np.where(zero, 1.0, n)
     if fallback is not None and zero.any():

@@ -7,13 +7,19 @@ Conventions of the lab (the texture convention is the one of :mod:`geomlib.textu
 * UV space is ``[0, 1]^2``, ``u`` right, ``v`` up; image row 0 is ``v = 1``.
 * Offset maps are SQUARE single-channel images ``(s, s)``: ``uint8`` (8 bits), ``uint16``
   (16 bits) or floats in ``[0, 1]``. A texel value ``h`` stands for the offset ``bias + scale h``.
+
+``normalize_rows`` and ``as_unit_normals`` are :func:`geomlib.vectors.normalize_rows` and
+:func:`geomlib.vectors.as_unit_vectors`, ``check_uv`` is :func:`geomlib.validate.check_uv`
+(``in_range=True``: offset maps are baked inside the texture square); all shared with the other labs.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, as_array, as_image, check_choice
+from geomlib.validate import MeshError, as_array, as_image, check_choice, check_uv
+from geomlib.vectors import as_unit_vectors as as_unit_normals
+from geomlib.vectors import normalize_rows
 
 __all__ = [
     "WEIGHTS",
@@ -35,31 +41,6 @@ WEIGHTS = ("uniform", "cotan")
 #: Bit depths of a baked offset map.
 BITS = (8, 16)
 
-#: UV values this far outside [0, 1] still count as inside (round-off of exporters).
-UV_SLACK = 1e-9
-
-
-def normalize_rows(X: np.ndarray) -> np.ndarray:
-    """Rows of ``X`` scaled to unit length; zero rows stay zero (never NaN)."""
-    X = np.asarray(X, dtype=np.float64)
-    n = np.linalg.norm(X, axis=-1, keepdims=True)
-    return X / np.where(n > 0, n, 1.0)
-
-
-def as_unit_normals(N, n: int, where: str, name: str = "N", ref: str = "V") -> np.ndarray:
-    """One normal per vertex, ``(n, 3)`` float64, normalised; a zero row is an error."""
-    N = as_array(N, name, shape=(None, 3), where=where)
-    if len(N) != n:
-        raise MeshError(f"{where}: {name} has {len(N)} rows but {ref} has {n}; expected one normal per vertex")
-    length = np.linalg.norm(N, axis=1)
-    if (length == 0).any():
-        r = int(np.flatnonzero(length == 0)[0])
-        raise MeshError(
-            f"{where}: {name} row {r} is the zero vector; every vertex needs a normal to move along "
-            f"({int((length == 0).sum())} zero rows)"
-        )
-    return N / length[:, None]
-
 
 def as_offsets(delta, where: str, name: str = "delta") -> np.ndarray:
     """Laplacian offsets ``(n, 3)`` float64, finite."""
@@ -72,23 +53,6 @@ def as_scalars(s, n: int, where: str, name: str = "s") -> np.ndarray:
     if len(s) != n:
         raise MeshError(f"{where}: {name} has {len(s)} values but V has {n}; expected one value per vertex")
     return s
-
-
-def check_uv(UV, n: int, where: str, name: str = "UV") -> np.ndarray:
-    """Texture coordinates ``(n, 2)`` float64 inside ``[0, 1]^2``, one row per vertex."""
-    if UV is None:
-        raise MeshError(f"{where}: {name} is missing; this function needs texture coordinates, one (u, v) per vertex")
-    UV = as_array(UV, name, shape=(None, 2), where=where)
-    if len(UV) != n:
-        raise MeshError(f"{where}: {name} has {len(UV)} rows but V has {n}; expected one (u, v) per vertex")
-    bad = ((UV < -UV_SLACK) | (UV > 1 + UV_SLACK)).any(axis=1)
-    if bad.any():
-        r = int(np.flatnonzero(bad)[0])
-        raise MeshError(
-            f"{where}: {name} row {r} is ({UV[r, 0]:.6g}, {UV[r, 1]:.6g}), outside the texture square [0, 1]^2 "
-            f"({int(bad.sum())} rows are out of range)"
-        )
-    return UV
 
 
 def check_bits(bits, where: str) -> int:

@@ -77,7 +77,7 @@ def bake_offset_map(V, F, UV, s, size: int, bits: int = 16, *, padding: int | No
     """
     where = "bake_offset_map"
     V, F = check_mesh(V, F, where=where)
-    UV = check_uv(UV, len(V), where)
+    UV = check_uv(UV, len(V), where, in_range=True)
     s = as_scalars(s, len(V), where)
     size = check_int(size, "size", minimum=2, maximum=8192, where=where)
     bits = check_bits(bits, where)
@@ -136,7 +136,7 @@ def denoise_with_map(
     """
     where = "denoise_with_map"
     V, F = check_mesh(V, F, where=where)
-    UV = check_uv(UV, len(V), where)
+    UV = check_uv(UV, len(V), where, in_range=True)
     N = as_unit_normals(N, len(V), where)
     H = as_offset_image(image, where)
     bias = check_float(bias, "bias", where=where)

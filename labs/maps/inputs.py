@@ -9,13 +9,17 @@ Conventions of the whole lab (see ``geomlib.textures`` for the UV/image conventi
   (direction of increasing ``u``), ``y`` along the bitangent ``B`` (increasing ``v``), ``z`` along
   the surface normal ``N``; an undisturbed surface is ``(0, 0, 1)``.
 * Tangents follow glTF / pyrender: an ``(n, 4)`` array ``[T, w]`` with ``B = w (N x T)``.
+
+``check_uv`` (:func:`geomlib.validate.check_uv`), ``as_unit_vectors`` and ``normalize_rows``
+(:mod:`geomlib.vectors`) come from geomlib, shared with the other labs.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float
+from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float, check_uv
+from geomlib.vectors import as_unit_vectors, normalize_rows
 
 __all__ = [
     "check_uv",
@@ -29,25 +33,6 @@ __all__ = [
     "fallback_perpendicular",
 ]
 
-#: UV values this far outside [0, 1] still count as inside (round-off of exporters).
-UV_SLACK = 1e-9
-
-
-def normalize_rows(X: np.ndarray, fallback=None) -> np.ndarray:
-    """Unit vectors along the last axis; zero-length rows become ``fallback`` (or stay zero).
-
-    Never divides by zero, so no NaN.
-    """
-    X = np.asarray(X)
-    if X.dtype.kind != "f":
-        X = X.astype(np.float64)
-    n = np.sqrt(np.einsum("...i,...i->...", X, X))[..., None]
-    zero = n == 0
-    out = X / np.where(zero, 1.0, n)
-    if fallback is not None and zero.any():
-        out[zero[..., 0]] = np.asarray(fallback, dtype=X.dtype)
-    return out
-
 
 def fallback_perpendicular(N: np.ndarray) -> np.ndarray:
     """A unit vector perpendicular to each unit row of ``N`` (deterministic).
@@ -59,37 +44,6 @@ def fallback_perpendicular(N: np.ndarray) -> np.ndarray:
     np.put_along_axis(E, axis[..., None], 1.0, axis=-1)
     T = E - np.sum(N * E, axis=-1, keepdims=True) * N
     return normalize_rows(T, fallback=(1.0, 0.0, 0.0))
-
-
-def check_uv(UV, n: int, where: str, *, in_range: bool = False, name: str = "UV") -> np.ndarray:
-    """Texture coordinates ``(n, 2)`` float64, one row per vertex; optionally inside ``[0, 1]^2``."""
-    if UV is None:
-        raise MeshError(
-            f"{where}: {name} is missing; this function needs texture coordinates, one (u, v) row per vertex"
-        )
-    UV = as_array(UV, name, shape=(None, 2), where=where)
-    if len(UV) != n:
-        raise MeshError(f"{where}: {name} has {len(UV)} rows but V has {n}; expected one (u, v) per vertex")
-    if in_range:
-        bad = (UV < -UV_SLACK) | (UV > 1 + UV_SLACK)
-        if bad.any():
-            r = int(np.flatnonzero(bad.any(axis=1))[0])
-            raise MeshError(
-                f"{where}: {name} row {r} is ({UV[r, 0]:.6g}, {UV[r, 1]:.6g}), outside the texture square [0, 1]^2 "
-                f"({int(bad.any(axis=1).sum())} rows are out of range)"
-            )
-    return UV
-
-
-def as_unit_vectors(N, n: int, where: str, name: str = "N") -> np.ndarray:
-    """Per-vertex directions ``(n, 3)``, normalised; zero rows are an error."""
-    N = as_array(N, name, shape=(None, 3), where=where)
-    if len(N) != n:
-        raise MeshError(f"{where}: {name} has {len(N)} rows but V has {n}; expected one normal per vertex")
-    length = np.linalg.norm(N, axis=1)
-    if (length == 0).any():
-        raise MeshError(f"{where}: {name} row {int(np.flatnonzero(length == 0)[0])} is the zero vector")
-    return N / length[:, None]
 
 
 def _square(img: np.ndarray, name: str, where: str) -> None:

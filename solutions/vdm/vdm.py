@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh, checked
 
 from .diagonals import choose_diagonals
 from .features import align_to_features, sharp_features
@@ -170,20 +170,21 @@ def bake_vdm(
     method = check_choice(method, "method", ("harmonic", "tutte", "lscm"), where=where)
     angle = check_float(angle, "angle", minimum=1e-9, maximum=180 - 1e-9, where=where)
     field_res = max(64, res) if field_res is None else check_int(field_res, "field_res", minimum=4, where=where)
-    UV = parameterize_square(V, F, method) if UV is None else as_array(UV, "UV", shape=(len(V), 2), where=where)
-    G = uniform_grid(res)
-    info: dict = {"optimize": optimize, "align": align, "diagonals": diagonals}
-    if optimize:
-        imp = vertex_importance(V, F)
-        dens = area_density(V, F, UV, field_res) if area_weighted else None
-        fld = importance_field(UV, imp, field_res, background=background, sigma=sigma, density=dens)
-        G = transport_grid(fld, res, boundary=boundary)
-    edges, corners = sharp_features(V, F, angle)
-    if align:
-        G = align_to_features(G, V, F, UV, edges, corners)
-    diag = choose_diagonals(G, V, F, UV, edges) if diagonals else valid_diagonals(G)
-    D = naive_vdm(V, F, UV, res, grid_uv=G)
-    return VDM(displacement=D, grid_uv=G, diagonals=diag, info=info)
+    with checked(V, F):  # every call below gets the mesh validated above: no re-validation
+        UV = parameterize_square(V, F, method) if UV is None else as_array(UV, "UV", shape=(len(V), 2), where=where)
+        G = uniform_grid(res)
+        info: dict = {"optimize": optimize, "align": align, "diagonals": diagonals}
+        if optimize:
+            imp = vertex_importance(V, F)
+            dens = area_density(V, F, UV, field_res) if area_weighted else None
+            fld = importance_field(UV, imp, field_res, background=background, sigma=sigma, density=dens)
+            G = transport_grid(fld, res, boundary=boundary)
+        edges, corners = sharp_features(V, F, angle)
+        if align:
+            G = align_to_features(G, V, F, UV, edges, corners)
+        diag = choose_diagonals(G, V, F, UV, edges) if diagonals else valid_diagonals(G)
+        D = naive_vdm(V, F, UV, res, grid_uv=G)
+        return VDM(displacement=D, grid_uv=G, diagonals=diag, info=info)
 
 
 def save_vdm(path, vdm: VDM) -> tuple[Path, Path]:

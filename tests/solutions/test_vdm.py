@@ -590,3 +590,18 @@ def test_boundary_to_square_rejects_bad_corners():
         boundary_to_square(V, np.arange(6), [0, 3, 2, 5])
     with pytest.raises(MeshError, match="loop"):
         boundary_to_square(V, [0, 1, 7, 3], [0, 1, 2, 3])
+
+
+def test_bake_vdm_validates_its_mesh_once(monkeypatch):
+    """Issue 15: a bake used to re-validate the same mesh ~15 times; now at the entry and once for the
+    manifold check of the parameterization (which asks for more than the entry checked)."""
+    import geomlib.validate as gv
+    from solutions.vdm import bake_vdm
+
+    V, F = datasets.rock_on_plinth(24)
+    wheres = []
+    real = gv.as_vertices
+    monkeypatch.setattr(gv, "as_vertices", lambda *a, **k: wheres.append(k.get("where")) or real(*a, **k))
+    bake_vdm(V, F, 16)
+    # closest_points checks its query points (not the mesh) when features are aligned
+    assert [w for w in wheres if w != "closest_points"] == ["bake_vdm", "parameterize_square"], wheres

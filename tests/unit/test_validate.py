@@ -175,3 +175,22 @@ def test_check_uv():
 def test_meshes_as_ragged_pairs_are_accepted():
     idx, off = as_polygons((np.array([0, 1, 2, 3, 3, 2, 4]), np.array([0, 4, 7])), 5)
     assert off.tolist() == [0, 4, 7]
+
+
+def test_checked_meshes_are_not_validated_again_inside_the_block(monkeypatch):
+    import geomlib.validate as gv
+
+    V, F = check_mesh(*datasets.icosphere(0))
+    calls = []
+    real = gv.as_vertices
+    monkeypatch.setattr(gv, "as_vertices", lambda *a, **k: calls.append(1) or real(*a, **k))
+    with gv.checked(V, F):
+        assert check_mesh(V, F, allow_degenerate=True)[0] is V  # weaker demands: passed through
+        assert not calls
+        check_mesh(V, F, manifold=True)  # more than was checked: validated
+        check_mesh(V.copy(), F)  # other arrays: validated
+        assert len(calls) == 2
+    check_mesh(V, F)  # outside the block: validated again
+    assert len(calls) == 3
+    with gv.checked(V, F), pytest.raises(MeshError, match="at least 30"):
+        check_mesh(V, F, min_faces=30)
