@@ -85,8 +85,9 @@ def to_ragged(
     elif isinstance(faces, np.ndarray) and faces.dtype != object:
         if faces.ndim != 2:
             raise MeshError(f"{p}{name} has shape {faces.shape}, expected (m, k) faces or a list of polygons")
-        arr = to_int64(faces, name, where)
-        idx, off = _ragged(arr)
+        if len(faces) and faces.shape[1] < 3:
+            raise MeshError(f"{p}{name}: face 0 has {faces.shape[1]} vertices, a polygon needs at least 3")
+        idx, off = _ragged(to_int64(faces, name, where))
     else:
         try:
             polys = [np.asarray(f) for f in faces]

@@ -315,6 +315,7 @@ def test_fans_on_a_non_manifold_edge_match_the_general_rule():
         (lambda: tp.valence(TRIANGLE, n_vertices=-1), r"^valence: n_vertices must be an integer >= 0"),
         (lambda: tp.is_closed([[0, 1]]), r"^is_closed: faces: face 0 has 2 vertices, a polygon needs at least 3"),
         (lambda: tp.is_closed(np.array([0, 1, 2])), r"^is_closed: faces has shape \(3,\)"),
+        (lambda: tp.is_closed(np.zeros((2, 0), int)), r"^is_closed: faces: face 0 has 0 vertices"),
         (lambda: tp.euler_characteristic([[0, 1.5, 2]]), r"^euler_characteristic: faces: face 0 holds a non-integer"),
         (lambda: tp.euler_characteristic(np.array([[0, 1, 2.5]])), r"holds a non-integer value 2.5"),
         (lambda: tp.triangulate_polygons([[0, 1, 2], [3, 4]]), r"^triangulate_polygons: faces: face 1 has 2 vertices"),
