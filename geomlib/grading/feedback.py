@@ -72,3 +72,29 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
         return _relpath(path)
     except Exception:
         return None
+
+
+def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str = "") -> str | None:
+    """The input mesh with ``points`` ((k, 3) positions: the wrong vertices, edge midpoints, ...)
+    marked in red, for failures that are about rows of a matrix rather than a drawn result."""
+    path = ctx.feedback_path(suffix)
+    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        return None
+    try:
+        from geomlib import plot, render
+        from geomlib.topology import triangulate_polygons
+
+        V = np.asarray(V, float)
+        F = np.asarray(F)
+        T = F if F.ndim == 2 and F.shape[1] == 3 else triangulate_polygons(F)[0]
+        P = np.asarray(points, float).reshape(-1, 3)
+        size = (480, 400)
+        views = [
+            render.render(V, T, wireframe=len(T) < 5000, highlight_points=P, point_radius=5.0, size=size, camera=cam)
+            for cam in ("three_quarter", "top")
+        ]
+        img = plot.panels(views, [caption, "seen from above"], title=ctx.label)
+        plot.save_png(path, img)
+        return _relpath(path)
+    except Exception:
+        return None

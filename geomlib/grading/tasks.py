@@ -71,7 +71,7 @@ class TaskTable:
         return None
 
     def describe(self, n: int) -> str:
-        return f"Task {n} ({self.titles[n]})" if n in self.titles else f"Task {n}"
+        return f"Task {n}: {self.titles[n]}" if n in self.titles else f"Task {n}"
 
 
 def _norm(s: str) -> str:
