@@ -114,13 +114,48 @@ def _run_probe(lab, probe, mod, feedback_dir):
 
 
 def _picture(mod, function, ctx, inputs, expected, got):
-    fn = getattr(mod, "PICTURES", {}).get(function)
-    if fn is None or ctx.feedback_dir is None:
+    if ctx.feedback_dir is None:
         return None
+    fn = getattr(mod, "PICTURES", {}).get(function, _rows_on_mesh)
     try:
         return fn(ctx, inputs, expected, got)
     except Exception:
         return None
+
+
+def _rows_on_mesh(ctx, inputs, expected, got):
+    """Default picture for a wrong array of points or per-vertex values on an input mesh: the mesh
+    with the wrong rows marked (at the vertex for per-vertex rows, else where the point should be)."""
+    import numpy as np
+
+    from geomlib.grading import feedback
+
+    V = inputs.get("V")
+    F = next((inputs[k] for k in ("F", "faces", "Q") if k in inputs), None)
+    if V is None or F is None:
+        return None
+    V = np.asarray(V, float)
+    if V.ndim != 2 or V.shape[1] != 3:
+        return None
+    for name, e in expected.items():
+        e = np.asarray(e)
+        try:
+            g = np.asarray(got.get(name), dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if e.dtype.kind != "f" or e.ndim != 2 or g.shape != e.shape:
+            continue
+        bad = ~np.isclose(g, e, rtol=0.0, atol=1e-8).all(axis=1)
+        if not bad.any():
+            continue
+        if len(e) == len(V):
+            points, what = V[bad], f"{int(bad.sum())} vertices where {name} is wrong"
+        elif e.shape[1] == 3:
+            points, what = e[bad], f"where the {int(bad.sum())} wrong rows of {name} should be"
+        else:
+            continue
+        return feedback.highlight_picture(ctx, V, F, points, what)
+    return None
 
 
 def explain(lab, case, *, feedback_dir=None) -> str | None:

@@ -160,7 +160,7 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
     return (keep or lines)[-limit:]
 
 
-_SEE = re.compile(r" \(see ([^()]+\.png)\)$")
+_SEE = re.compile(r"\(see ([^()]+?\.png)\)")
 
 
 def report_lines(
@@ -189,9 +189,9 @@ def report_lines(
     seen: set[str] = set()
     for r in failed:
         msg = " ".join(r.message.split())  # one line, whatever the message
-        m = _SEE.search(msg)
-        if m:
-            pictures.append(m.group(1))
+        for pic in _SEE.findall(msg):
+            if pic not in pictures:
+                pictures.append(pic)
         if r.not_implemented:
             todo.setdefault(msg, []).append(r)
             continue
