@@ -29,3 +29,20 @@ def test_one_task_only(sample_course):
     assert "Task 1" in text and "Task 2" not in text, text
     none = _report(sample_course, "--impl", "labs", "--task", "99")
     assert any("no graded test of task 99" in ln for ln in none), none
+
+
+def test_check_in_a_notebook_returns_the_cli_lines(sample_course, monkeypatch):
+    """``check("sample", task=1)`` in a Jupyter kernel gives the lines ``geomlib grade --task 1`` prints."""
+    import nbformat
+    from nbclient import NotebookClient
+
+    cli = _report(sample_course, "--impl", "labs", "--lab", "sample", "--task", "1")
+    monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
+    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
+    code = 'from geomlib.grading import check\nr = check("sample", task=1, impl="labs")\nprint(str(r))'
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(code)])
+    NotebookClient(
+        nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(sample_course)}}
+    ).execute()
+    printed = "".join(o.get("text", "") for o in nb.cells[0].outputs if o.get("output_type") == "stream")
+    assert printed.splitlines() == cli
