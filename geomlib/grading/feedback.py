@@ -88,6 +88,11 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
                 x = np.repeat(x[..., None], 3, axis=2)
             return (x[..., :3] * 255).round().astype(np.uint8)
 
+        k = max(1, 256 // max(per_pixel.shape[:2]))  # small images: blow up, nearest texel
+        if k > 1:
+            expected, got, per_pixel = (
+                np.repeat(np.repeat(x, k, axis=0), k, axis=1) for x in (expected, got, per_pixel)
+            )
         vmax = max(float(per_pixel.max()), 1e-12)
         heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=vmax)
         bar = plot.colorbar(0.0, vmax, cmap="inferno", label="|difference|", height=max(128, heat.shape[0]))
@@ -119,6 +124,27 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
             for cam in ("three_quarter", "top")
         ]
         img = plot.panels(views, [caption, "seen from above"], title=ctx.label)
+        plot.save_png(path, img)
+        return _relpath(path)
+    except Exception:
+        return None
+
+
+def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -> str | None:
+    """The mesh coloured by a per-vertex error, with its colour bar beside it (two views)."""
+    path = ctx.feedback_path()
+    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        return None
+    try:
+        from geomlib import plot
+
+        values = np.asarray(values, float)
+        vmax = max(float(np.nanmax(values)), 1e-12)
+        colors = plot.heat_colors(np.nan_to_num(values, nan=vmax), vmin=0.0, vmax=vmax)
+        size = (440, 380)
+        views = [_draw(V, F, colors=colors, size=size, camera=cam) for cam in ("three_quarter", "top")]
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
+        img = plot.panels([views[0], _beside(views[1], bar)], [caption, "seen from above"], title=ctx.label)
         plot.save_png(path, img)
         return _relpath(path)
     except Exception:

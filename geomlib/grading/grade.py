@@ -196,8 +196,7 @@ def report_lines(
             todo.setdefault(msg, []).append(r)
             continue
         t = tasks.get(r.nodeid, ())
-        where = f"Task {', '.join(map(str, t))}" if t else r.part
-        line = f"  ✗ {where} · {r.part}: {msg}" if t else f"  ✗ {r.part}: {msg}"
+        line = f"  ✗ {_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {r.part}: {msg}"
         if line in seen:
             continue
         seen.add(line)
@@ -223,6 +222,16 @@ def report_lines(
     elif feedback_dir and any(not r.not_implemented for r in failed):
         lines += ["", "No feedback pictures for these failures."]
     return lines
+
+
+def _tasks_text(t) -> str:
+    """``Task 2``, ``Tasks 3, 5``, ``Tasks 1-8``."""
+    t = sorted(t)
+    if len(t) == 1:
+        return f"Task {t[0]}"
+    if len(t) > 2 and t == list(range(t[0], t[-1] + 1)):
+        return f"Tasks {t[0]}-{t[-1]}"
+    return "Tasks " + ", ".join(map(str, t))
 
 
 class Report(list):
