@@ -183,8 +183,10 @@ def report_lines(
     if not failed and not skipped:
         lines += ["", f"All {len(records)} graded tests pass."]
         return lines
-    todo: dict[str, list] = {}
-    fix: list[str] = []
+    labs = list(dict.fromkeys(r.lab for r in records))
+    several = len(labs) > 1  # then every line says which lab it is about
+    todo: dict[tuple, list] = {}
+    fix: dict[str, list[str]] = {lab: [] for lab in labs}
     pictures: list[str] = []
     seen: set[str] = set()
     for r in failed:
@@ -193,15 +195,16 @@ def report_lines(
             if pic not in pictures:
                 pictures.append(pic)
         if r.not_implemented:
-            todo.setdefault(msg, []).append(r)
+            todo.setdefault((r.lab, msg), []).append(r)
             continue
         t = tasks.get(r.nodeid, ())
-        line = f"  ✗ {_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {r.part}: {msg}"
+        where = f"{r.lab} · " if several else ""
+        line = f"  ✗ {where}{_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {where}{r.part}: {msg}"
         if line in seen:
             continue
         seen.add(line)
-        fix.append(line)
-    if todo or fix:
+        fix[r.lab].append(line)
+    if failed:
         n_tests = len(failed)
         lines += ["", f"What to fix ({n_tests} failing test{'s' if n_tests != 1 else ''}):"]
 
@@ -209,10 +212,14 @@ def report_lines(
             m = re.search(r"Task (\d+)", msg)
             return int(m.group(1)) if m else 1_000
 
-        for msg, rs in sorted(todo.items(), key=lambda kv: task_no(kv[0])):
-            n = len(rs)
-            lines.append(f"  ✗ {msg}" + (f" — {n} tests" if n != 1 else ""))
-        lines += fix
+        for lab in labs:  # per lab: tasks not started (in task order), then wrong results
+            for (_, msg), rs in sorted(
+                ((k, v) for k, v in todo.items() if k[0] == lab), key=lambda kv: task_no(kv[0][1])
+            ):
+                n = len(rs)
+                where = f"{lab} · " if several else ""
+                lines.append(f"  ✗ {where}{msg}" + (f" — {n} tests" if n != 1 else ""))
+            lines += fix[lab]
     for r in skipped:
         lines.append(f"  - {r.part}: {r.name}: {r.message}")
     if pictures:

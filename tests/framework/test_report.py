@@ -27,6 +27,8 @@ def test_one_task_only(sample_course):
     lines = _report(sample_course, "--impl", "labs", "--task", "1")
     text = "\n".join(lines)
     assert "Task 1" in text and "Task 2" not in text, text
+    part = "\n".join(_report(sample_course, "--impl", "labs", "--part", "Midpoints"))
+    assert "midpoints" in part and "scaling" not in part, part
     none = _report(sample_course, "--impl", "labs", "--task", "99")
     assert any("no graded test of task 99" in ln for ln in none), none
 
