@@ -222,24 +222,33 @@ def explain(lab, case, *, feedback_dir=None) -> str | None:
     if not probes:
         return None
     mod = _module(lab.name)
+    same_input = set(getattr(mod, "PROBES", {}).get(case.id, ()))
     t0 = time.time()
-    for p in probes:
-        if time.time() - t0 > BUDGET_S:
-            break
-        res = _run_probe(lab, p, mod, feedback_dir)
-        if res is None:
-            continue
-        what, detail = res
-        task = tab.describe(tab.tasks[p.function][0]) if p.function in tab.tasks else "a building block"
-        return f"{case.function} is off because {p.function} ({task}) {what}" + (f": {detail}" if detail else "")
-    else:
-        blocks = ", ".join(tab.composites.get(case.function, ()))
-        own = tab.tasks.get(case.function)
-        if own:
+    # First the probes on this case's own input: a wrong block there explains the result. Then the
+    # block's other cases: a multi-level composite meets inputs its first level does not show.
+    for own_input in (True, False):
+        for p in probes:
+            if (p.id in same_input) != own_input or time.time() - t0 > BUDGET_S:
+                continue
+            res = _run_probe(lab, p, mod, feedback_dir)
+            if res is None:
+                continue
+            what, detail = res
+            task = tab.describe(tab.tasks[p.function][0]) if p.function in tab.tasks else "a building block"
+            detail = f": {detail}" if detail else ""
+            if own_input or not same_input:
+                return f"{case.function} is off because {p.function} ({task}) {what}{detail}"
             return (
-                f"its building blocks ({blocks}) agree with the references, so look at {case.function} "
-                f"itself ({tab.describe(own[0])})" + (f": {case.hint}" if case.hint else "")
+                f"{case.function} is off; its building blocks agree on this input, but {p.function} ({task}) "
+                f"{what} on another mesh (later steps meet cases the input does not have){detail}"
             )
+    blocks = ", ".join(tab.composites.get(case.function, ()))
+    own = tab.tasks.get(case.function)
+    if own:
+        return (
+            f"its building blocks ({blocks}) agree with the references, so look at {case.function} "
+            f"itself ({tab.describe(own[0])})" + (f": {case.hint}" if case.hint else "")
+        )
     return None
 
 

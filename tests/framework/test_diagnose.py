@@ -135,6 +135,21 @@ PLANTS = {
 }
 
 
+def test_error_beyond_the_first_level_is_named():
+    """The icosahedron has only valence-5 vertices; valence 6 appears at level 1. The blocks agree on
+    the input, so the grader looks at their other cases and still names the wrong rows."""
+    src = """
+    _true_loop_even_matrix = loop_even_matrix
+
+    def loop_even_matrix(V, F, weights="warren", topo=None):
+        S = sp.csr_matrix(_true_loop_even_matrix(V, F, weights, topo=topo))
+        per_row = np.diff(S.indptr)  # an interior vertex of valence k has k + 1 weights
+        return sp.diags(np.where(per_row == 7, 1.1, 1.0)) @ S
+    """
+    msg = _message("subdivision", _plant("subdivision", "loop", src), "loop-icosahedron-3-warren")
+    assert "agree on this input, but loop_even_matrix (Task 2:" in msg and "valence-6 vertices" in msg, msg
+
+
 @pytest.mark.parametrize("name", list(PLANTS))
 def test_planted_error_is_named(name):
     lab, module, source, case_id, words = PLANTS[name]
