@@ -16,6 +16,7 @@ EPILOG = """\
 examples:
   geomlib figures --out build/figures          regenerate every figure + index.html (instructors)
   geomlib grade --impl labs --lab subdivision  grade your work in labs/ (students)
+  geomlib grade --impl labs --lab subdivision --task 2     only Task 2
   geomlib grade --impl path/to/submission --results results.json
   geomlib refs build --lab subdivision         store reference outputs from solutions/
   geomlib stubs build                          regenerate labs/ from solutions/
@@ -97,14 +98,16 @@ def _cmd_stubs(a) -> int:
 def _cmd_grade(a) -> int:
     from geomlib.grading.grade import grade
 
-    data = grade(a.impl, [a.lab] if a.lab else None, results=a.results, feedback_dir=a.feedback, verbose=a.verbose)
-    failed = [t for t in data["tests"] if t["status"] == "failed"]
-    if failed:
-        print("\nWhat to fix:")
-        for t in failed:
-            print(f"  ✗ {t['name']}\n      {t['output']}")
-    print()
-    print(data["output"])
+    data = grade(
+        a.impl,
+        [a.lab] if a.lab else None,
+        results=a.results,
+        feedback_dir=a.feedback,
+        verbose=a.verbose,
+        task=a.task,
+        part=a.part,
+    )
+    print("\n".join(data["report"]))
     if a.results:
         print(f"\nwrote {a.results}")
     return 0
@@ -170,6 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="'solutions', 'labs' (your work) or a submission folder (default: solutions if present, else labs)",
     )
     g.add_argument("--lab", help="only this lab")
+    g.add_argument("--task", type=int, help="only the tests of this task (the 'Task N' of the stubs)")
+    g.add_argument("--part", help='only the tests of this part, as named in the score table ("boundary rules")')
     g.add_argument("--results", help="write Gradescope results.json here")
     g.add_argument("--feedback", default="feedback", help="folder for feedback pictures (default: feedback/)")
     g.add_argument("-v", "--verbose", action="store_true")

@@ -20,7 +20,21 @@ from geomlib.grading.errors import (
 )
 from geomlib.grading.impl import course_root, lab_names, load_lab, resolve_impl
 
+
+def check(lab: str, task: int | None = None, part: str | None = None, **kwargs):
+    """Grade one lab, or one task or part of it, and return the report's lines (for notebooks).
+
+    ``check("subdivision", task=2)`` runs what ``geomlib grade --lab subdivision --task 2`` runs;
+    see :func:`geomlib.grading.grade.check`.
+    """
+    # Imported here: the grade module loads the pytest plugin, which pytest must import itself.
+    from geomlib.grading.grade import check as _check
+
+    return _check(lab, task, part, **kwargs)
+
+
 __all__ = [
+    "check",
     "Case",
     "checks",
     "tolerances",

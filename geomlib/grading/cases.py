@@ -175,14 +175,26 @@ def inputs_digest(inputs: dict, params: dict) -> str:
     return h.hexdigest()
 
 
-def run_case(lab, case: Case, *, feedback_dir: Path | None = None) -> None:
-    """Call the case's function on the lab under test and compare with the stored reference."""
+def run_case(lab, case: Case, *, feedback_dir: Path | None = None, diagnose_composites: bool = True) -> None:
+    """Call the case's function on the lab under test and compare with the stored reference.
+
+    A mismatch gets the case's hint, or, for a composite function, the name of the first of the
+    student's building blocks that is wrong (:mod:`geomlib.grading.diagnose`).
+    """
     kwargs = {**case.inputs(), **case.params}
     result = lab.call(case.function, **kwargs)
     got = case.name_outputs(result)
     expected = load_reference(lab.name, case)  # loaded only after the student's call has returned
-    ctx = Context(label=case.label, lab=lab.name, case_id=case.id, hint=case.hint, feedback_dir=feedback_dir)
-    case.check(expected, got, ctx)
+    ctx = Context(label=case.label, lab=lab.name, case_id=case.id, feedback_dir=feedback_dir)
+    try:
+        case.check(expected, got, ctx)
+    except Mismatch as e:
+        # The hint, or for a composite the building block that is wrong (geomlib.grading.diagnose).
+        from geomlib.grading import diagnose
+
+        if not diagnose_composites:
+            raise type(e)(e.message + (f" — {case.hint}" if case.hint else ""), e.feedback) from None
+        raise diagnose.enrich(e, lab, case, kwargs, expected, got, ctx) from None
 
 
 def reference_tests(cases: list[Case]):
@@ -241,18 +253,20 @@ def expect_raises(
     raise Mismatch(f"{label} should raise {exception} for this input, but it returned normally")
 
 
-def load_cases(lab: str, *, hidden: bool = True) -> list[Case]:
-    """All cases a lab declares (``tests/graded/<lab>/cases.py`` and, if present and wanted, ``cases_hidden.py``)."""
+def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Case]:
+    """All cases a lab declares (``tests/graded/<lab>/cases.py`` and, if present and wanted,
+    ``cases_hidden.py`` and the probe-only cases of ``diagnose.py``, which need references but are
+    never graded)."""
     tests = str(_impl.tests_dir())
     if tests not in sys.path:
         sys.path.insert(0, tests)
     cases: list[Case] = []
     folder = _impl.tests_dir() / "graded" / lab
-    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True)):
-        if is_hidden and not hidden:
+    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True), ("diagnose", False)):
+        if (is_hidden and not hidden) or (mod_name == "diagnose" and not probes):
             continue
         if not (folder / f"{mod_name}.py").is_file():
             continue
         mod = importlib.import_module(f"graded.{lab}.{mod_name}")
-        cases.extend(mod.CASES)
+        cases.extend(getattr(mod, "CASES", []))
     return cases

@@ -20,6 +20,32 @@ def _relpath(p) -> str:
         return str(p)
 
 
+def _beside(img: np.ndarray, bar: np.ndarray, gap: int = 8) -> np.ndarray:
+    """``bar`` (a colour bar) right next to ``img`` (its heat map), as one picture on white."""
+    from geomlib import plot
+
+    a, b = plot.to_rgb8(img), plot.to_rgb8(bar)
+    h = max(a.shape[0], b.shape[0])
+
+    def pad(x):
+        top = (h - x.shape[0]) // 2
+        out = np.full((h, x.shape[1], 3), 255, np.uint8)
+        out[top : top + x.shape[0]] = x
+        return out
+
+    return np.hstack([pad(a), np.full((h, gap, 3), 255, np.uint8), pad(b)])
+
+
+def _draw(V, F, **options):
+    """Render triangles, or polygons with their true edges."""
+    from geomlib import render
+
+    F = np.asarray(F) if not isinstance(F, list) else F
+    if isinstance(F, np.ndarray) and F.ndim == 2 and F.shape[1] == 3:
+        return render.render(V, F, **options)
+    return render.render_polygons(V, F, **options)
+
+
 def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
     """Render expected and submitted meshes side by side with a distance heat map on the submission."""
     path = ctx.feedback_path()
@@ -28,21 +54,20 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
     try:
         from scipy.spatial import cKDTree
 
-        from geomlib import plot, render
-        from geomlib.topology import triangulate_polygons
+        from geomlib import plot
 
         Vg = np.asarray(Vg, float)
-        Fe_t = triangulate_polygons(np.asarray(Fe))[0] if np.asarray(Fe).shape[1] != 3 else np.asarray(Fe)
-        Fg_t = triangulate_polygons(np.asarray(Fg))[0] if np.asarray(Fg).shape[1] != 3 else np.asarray(Fg)
+        n_faces = len(Fe)
         d, _ = cKDTree(Ve).query(Vg)
-        colors = plot.heat_colors(d, vmin=0.0, vmax=max(float(d.max()), 1e-12))
+        vmax = max(float(d.max()), 1e-12)
+        colors = plot.heat_colors(d, vmin=0.0, vmax=vmax)
         size = (360, 300)
-        a = render.render(Ve, Fe_t, wireframe=len(Fe_t) < 5000, size=size)
-        b = render.render(Vg, Fg_t, wireframe=len(Fg_t) < 5000, size=size)
-        c = render.render(Vg, Fg_t, colors=colors, size=size)
-        bar = plot.colorbar(0.0, max(float(d.max()), 1e-12), cmap="inferno", label="distance", height=size[1])
-        captions = ["expected", "submitted", f"distance to nearest expected vertex (max {d.max():.3g})", ""]
-        img = plot.panels([a, b, c, bar], captions, title=ctx.label)
+        a = _draw(Ve, Fe, wireframe=n_faces < 5000, size=size)
+        b = _draw(Vg, Fg, wireframe=len(Fg) < 5000, size=size)
+        c = _draw(Vg, Fg, colors=colors, size=size)
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label="distance", height=size[1])
+        captions = ["expected", "submitted", f"distance to the nearest expected vertex (max {d.max():.3g})"]
+        img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
         return _relpath(path)
     except Exception:
@@ -63,11 +88,63 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
                 x = np.repeat(x[..., None], 3, axis=2)
             return (x[..., :3] * 255).round().astype(np.uint8)
 
+        k = max(1, 256 // max(per_pixel.shape[:2]))  # small images: blow up, nearest texel
+        if k > 1:
+            expected, got, per_pixel = (
+                np.repeat(np.repeat(x, k, axis=0), k, axis=1) for x in (expected, got, per_pixel)
+            )
         vmax = max(float(per_pixel.max()), 1e-12)
         heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=vmax)
         bar = plot.colorbar(0.0, vmax, cmap="inferno", label="|difference|", height=max(128, heat.shape[0]))
-        captions = ["expected", "submitted", "|difference|", ""]
-        img = plot.panels([to_rgb(expected), to_rgb(got), heat, bar], captions, title=ctx.label)
+        captions = ["expected", "submitted", "|difference| per pixel"]
+        img = plot.panels([to_rgb(expected), to_rgb(got), _beside(heat, bar)], captions, title=ctx.label)
+        plot.save_png(path, img)
+        return _relpath(path)
+    except Exception:
+        return None
+
+
+def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str = "") -> str | None:
+    """The input mesh with ``points`` ((k, 3) positions: the wrong vertices, edge midpoints, ...)
+    marked in red, for failures that are about rows of a matrix rather than a drawn result."""
+    path = ctx.feedback_path(suffix)
+    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        return None
+    try:
+        from geomlib import plot
+
+        V = np.asarray(V, float)
+        P = np.asarray(points, float).reshape(-1, 3)
+        # Marked points are drawn by index: append them as extra (unreferenced) vertices.
+        W = np.vstack([V, P])
+        idx = np.arange(len(V), len(W))
+        size = (480, 400)
+        views = [
+            _draw(W, F, wireframe=len(F) < 5000, highlight_points=idx, point_radius=5.0, size=size, camera=cam)
+            for cam in ("three_quarter", "top")
+        ]
+        img = plot.panels(views, [caption, "seen from above"], title=ctx.label)
+        plot.save_png(path, img)
+        return _relpath(path)
+    except Exception:
+        return None
+
+
+def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -> str | None:
+    """The mesh coloured by a per-vertex error, with its colour bar beside it (two views)."""
+    path = ctx.feedback_path()
+    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        return None
+    try:
+        from geomlib import plot
+
+        values = np.asarray(values, float)
+        vmax = max(float(np.nanmax(values)), 1e-12)
+        colors = plot.heat_colors(np.nan_to_num(values, nan=vmax), vmin=0.0, vmax=vmax)
+        size = (440, 380)
+        views = [_draw(V, F, colors=colors, size=size, camera=cam) for cam in ("three_quarter", "top")]
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
+        img = plot.panels([views[0], _beside(views[1], bar)], [caption, "seen from above"], title=ctx.label)
         plot.save_png(path, img)
         return _relpath(path)
     except Exception:

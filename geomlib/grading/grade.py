@@ -1,20 +1,71 @@
-"""``geomlib grade``: run the graded tests against an implementation and report the score.
+"""``geomlib grade`` and ``check``: run the graded tests against an implementation and report.
 
 Student code only ever runs inside sandboxed worker processes; this process runs the checks,
 computes the scores and writes ``results.json`` itself after the workers have returned.
+
+The report a student reads is short and always in the same order: the per-part score table, then
+"What to fix" (one line per failing test, tasks not started yet summed up in one line each), then
+where the feedback pictures are. pytest's own output (progress dots, tracebacks, warnings) is
+kept out of it; ``verbose=True`` shows it.
 """
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import re
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.results import build_results, write_results
 
-__all__ = ["grade"]
+__all__ = ["grade", "check", "Report", "report_lines"]
+
+
+@dataclass
+class _Selection:
+    """A pytest plugin (passed to ``pytest.main``): keeps the graded tests of one task or part,
+    and remembers the task of every graded test."""
+
+    task: int | None = None
+    part: str | None = None
+    tasks: dict = field(default_factory=dict)  # nodeid -> tuple of task numbers
+    titles: dict = field(default_factory=dict)  # lab -> TaskTable
+    deselected: int = 0
+
+    def pytest_collection_modifyitems(self, session, config, items):
+        from geomlib.grading import tasks as _tasks
+
+        keep, drop = [], []
+        for item in items:
+            marker = item.get_closest_marker("graded")
+            lab = plugin._lab_of(item.path)
+            if marker is None or lab is None:
+                keep.append(item)
+                continue
+            if lab not in self.titles:
+                try:
+                    self.titles[lab] = _tasks.table(lab)
+                except Exception:  # a broken table must not stop grading
+                    self.titles[lab] = _tasks.TaskTable()
+            part = marker.kwargs.get("part", "other")
+            try:
+                t = _tasks.test_tasks(item, self.titles[lab], part)
+            except Exception:
+                t = ()
+            self.tasks[item.nodeid] = t
+            ok = (self.task is None or self.task in t) and (
+                self.part is None or part.strip().lower() == self.part.strip().lower()
+            )
+            (keep if ok else drop).append(item)
+        if drop:
+            config.hook.pytest_deselected(items=drop)
+            items[:] = keep
+            self.deselected = len(drop)
 
 
 def grade(
@@ -25,10 +76,26 @@ def grade(
     feedback_dir: str | Path = "feedback",
     verbose: bool = False,
     extra_args: list[str] | None = None,
+    task: int | None = None,
+    part: str | None = None,
 ) -> dict:
     """Grade ``impl`` (``solutions``, ``labs`` or a submission path) on ``labs`` (default: all).
 
-    Returns the ``results.json`` dict (also written to ``results`` when given).
+    Parameters
+    ----------
+    task : int, optional
+        Only the graded tests of this task (``Task 2`` in the stubs).
+    part : str, optional
+        Only the graded tests of this part (``"boundary rules"``), as in the score table.
+    verbose : bool
+        Show pytest's own output as well.
+
+    Returns
+    -------
+    dict
+        The ``results.json`` dict (also written to ``results`` when given), plus an entry
+        ``"report"``: the lines of the student report (see :func:`report_lines`). The entry is not
+        part of what is written to ``results``.
     """
     import pytest
 
@@ -46,22 +113,174 @@ def grade(
         f"--feedback-dir={feedback_dir}",
         "-p",
         "no:cacheprovider",
+        # A student's segfault is reported by the sandbox; the fault handler would dump the
+        # grader's own stack on top.
+        "-p",
+        "no:faulthandler",
+        "-W",
+        "ignore::pytest.PytestAssertRewriteWarning",
         f"--rootdir={_impl.course_root()}",
         "-q" if not verbose else "-v",
-        "--tb=line",
+        "--tb=line" if verbose else "--tb=no",
         "-o",
         "console_output_style=classic",
     ]
     args += extra_args or []
     os.environ.setdefault("GEOMLIB_IMPL", str(impl))
+    selection = _Selection(task=task, part=part)
     t0 = time.time()
-    code = pytest.main(args)
+    captured = io.StringIO()
+    if verbose:
+        code = pytest.main(args, plugins=[selection])
+    else:
+        with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+            code = pytest.main(args, plugins=[selection])
     elapsed = time.time() - t0
     records = list(plugin.RECORDS)
     note = ""
-    if code not in (0, 1):  # 0: all passed, 1: some failed; anything else is a grader problem
+    if code == 5 or (code == 0 and not records):
+        what = f"task {task}" if task is not None else f'part "{part}"' if part else "these labs"
+        note = f"no graded test of {what} in {', '.join(names)}"
+    elif code not in (0, 1):  # 0: all passed, 1: some failed; anything else is a grader problem
         note = f"warning: the test run ended with pytest exit code {int(code)}; some tests may not have run"
+        tail = _problem_lines(captured.getvalue())
+        if tail:
+            note += ":\n" + "\n".join(tail)
     data = build_results(records, elapsed, note)
     if results:
         write_results(data, results)
+    data["report"] = report_lines(records, feedback_dir=feedback_dir, note=note, tasks=selection.tasks)
     return data
+
+
+def _problem_lines(text: str, limit: int = 12) -> list[str]:
+    """The lines of pytest's output that say why a run could not go ahead (collection errors)."""
+    lines = [ln.rstrip() for ln in text.splitlines() if ln.strip()]
+    keep = [ln for ln in lines if re.match(r"^(E |ERROR|[A-Za-z]*Error)", ln)]
+    return (keep or lines)[-limit:]
+
+
+_SEE = re.compile(r"\(see ([^()]+?\.png)\)")
+
+
+def report_lines(
+    records: list, *, feedback_dir: str | Path | None = "feedback", note: str = "", tasks: dict | None = None
+) -> list[str]:
+    """The student report: score table, "What to fix", feedback pictures.
+
+    One line per failing test, in the order the tests ran; tests that fail only because a function
+    is not implemented yet are summed up in one line per function (they all say the same).
+    """
+    tasks = tasks or {}
+    lines: list[str] = []
+    if note:
+        lines += [note, ""]
+    if not records:
+        return lines or ["no graded tests ran"]
+    lines += plugin.score_table(records).splitlines()
+    failed = [r for r in records if not r.passed and not r.message.startswith("skipped")]
+    skipped = [r for r in records if not r.passed and r.message.startswith("skipped")]
+    if not failed and not skipped:
+        lines += ["", f"All {len(records)} graded tests pass."]
+        return lines
+    labs = list(dict.fromkeys(r.lab for r in records))
+    several = len(labs) > 1  # then every line says which lab it is about
+    todo: dict[tuple, list] = {}
+    fix: dict[str, list[str]] = {lab: [] for lab in labs}
+    pictures: list[str] = []
+    seen: set[str] = set()
+    for r in failed:
+        msg = " ".join(r.message.split())  # one line, whatever the message
+        for pic in _SEE.findall(msg):
+            if pic not in pictures:
+                pictures.append(pic)
+        if r.not_implemented:
+            todo.setdefault((r.lab, msg), []).append(r)
+            continue
+        t = tasks.get(r.nodeid, ())
+        where = f"{r.lab} · " if several else ""
+        line = f"  ✗ {where}{_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {where}{r.part}: {msg}"
+        if line in seen:
+            continue
+        seen.add(line)
+        fix[r.lab].append(line)
+    if failed:
+        n_tests = len(failed)
+        lines += ["", f"What to fix ({n_tests} failing test{'s' if n_tests != 1 else ''}):"]
+
+        def task_no(msg):
+            m = re.search(r"Task (\d+)", msg)
+            return int(m.group(1)) if m else 1_000
+
+        for lab in labs:  # per lab: tasks not started (in task order), then wrong results
+            for (_, msg), rs in sorted(
+                ((k, v) for k, v in todo.items() if k[0] == lab), key=lambda kv: task_no(kv[0][1])
+            ):
+                n = len(rs)
+                where = f"{lab} · " if several else ""
+                lines.append(f"  ✗ {where}{msg}" + (f" — {n} tests" if n != 1 else ""))
+            lines += fix[lab]
+    for r in skipped:
+        lines.append(f"  - {r.part}: {r.name}: {r.message}")
+    if pictures:
+        folders = sorted({str(Path(p).parent) for p in pictures})
+        lines += ["", f"Feedback pictures ({len(pictures)}) in {', '.join(f + '/' for f in folders)}:"]
+        lines += [f"  {p}" for p in pictures]
+    elif feedback_dir and any(not r.not_implemented for r in failed):
+        lines += ["", "No feedback pictures for these failures."]
+    return lines
+
+
+def _tasks_text(t) -> str:
+    """``Task 2``, ``Tasks 3, 5``, ``Tasks 1-8``."""
+    t = sorted(t)
+    if len(t) == 1:
+        return f"Task {t[0]}"
+    if len(t) > 2 and t == list(range(t[0], t[-1] + 1)):
+        return f"Tasks {t[0]}-{t[-1]}"
+    return "Tasks " + ", ".join(map(str, t))
+
+
+class Report(list):
+    """The lines of a grading report; shows as plain text in a notebook or at the prompt."""
+
+    def __init__(self, lines, results: dict | None = None):
+        super().__init__(lines)
+        self.results = results or {}
+
+    @property
+    def score(self) -> float:
+        return float(self.results.get("score", 0.0))
+
+    def __str__(self) -> str:
+        return "\n".join(self)
+
+    __repr__ = __str__
+
+    def _repr_pretty_(self, p, cycle):  # IPython
+        p.text(str(self))
+
+
+def check(
+    lab: str,
+    task: int | None = None,
+    part: str | None = None,
+    *,
+    impl: str | None = None,
+    feedback_dir: str | Path = "feedback",
+) -> Report:
+    """Grade one lab (optionally one task or part) and return the report's lines.
+
+    The same check as ``geomlib grade --lab LAB [--task N] [--part NAME]``, for a notebook cell::
+
+        from geomlib.grading import check
+        check("subdivision", task=2)
+
+    Returns
+    -------
+    Report
+        A list of the report's lines (it prints as the report); ``.score`` and ``.results`` hold
+        the numbers.
+    """
+    data = grade(impl, [lab], feedback_dir=feedback_dir, task=task, part=part)
+    return Report(data.pop("report"), data)

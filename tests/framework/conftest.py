@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import faulthandler
 import os
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 
@@ -30,3 +32,27 @@ def sample_course() -> Path:
     run_geomlib(root, "stubs", "build")
     yield root
     shutil.rmtree(base, ignore_errors=True)
+
+
+@pytest.fixture(autouse=True)
+def _quiet_worker_crashes(request):
+    """Keep the hostile-code tests' deliberate segfaults off the terminal.
+
+    Sandbox workers are forked from the test process and inherit pytest's faulthandler, which
+    writes a full "Fatal Python error: Segmentation fault" dump to a duplicate of the real stderr
+    (past pytest's capture) when a worker crashes on purpose. The grader reports the crash itself.
+    """
+    if not faulthandler.is_enabled():
+        yield
+        return
+    try:
+        from _pytest.faulthandler import fault_handler_stderr_fd_key
+
+        fd = request.config.stash.get(fault_handler_stderr_fd_key, None)
+    except ImportError:  # pytest moved it: fall back to the process's stderr
+        fd = None
+    faulthandler.disable()
+    try:
+        yield
+    finally:
+        faulthandler.enable(file=fd if fd is not None else sys.__stderr__)

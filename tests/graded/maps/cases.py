@@ -432,4 +432,15 @@ CASES = [
         points=2,
         hint="the frame at a texel comes from the interpolated N_lo and [T, w] (surface_frames), as in shade",
     ),
+    Case(
+        id="bake-height-field-own-frames",
+        function="bake_normal_map",
+        inputs=lambda: {k: v for k, v in bake_flat_inputs().items() if k != "tangents"},
+        params={"size": 32},
+        outputs=("normal_map",),
+        check=MapClose("normal_map", atol=1e-5, display="normals"),
+        part="baking",
+        points=1,
+        hint="without given tangents the frames come from tangent_frames of the low mesh (Task 1)",
+    ),
 ]

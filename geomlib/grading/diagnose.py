@@ -1,0 +1,264 @@
+"""Hints that diagnose: when a composite result is wrong, find the building block that makes it so.
+
+A *composite* is a lab function that calls other task functions (``loop_subdivide`` calls
+``loop_odd_matrix``, ``loop_even_matrix`` and ``loop_faces``; see :mod:`geomlib.grading.tasks`).
+When a graded case of a composite fails, :func:`enrich` runs the student's own building blocks on
+*probe* cases, each compared with a reference stored by ``geomlib refs build``, in task order, and
+names the first that is wrong::
+
+    loop_subdivide on "loop-torus-2-loop": expected a vertex at ... — loop_subdivide is off because
+    loop_even_matrix (Task 2 (even vertices)) differs at valence-6 vertices: ...
+
+When every block agrees, the composite's own task is named instead. Probes are the lab's graded
+cases of the building blocks plus the probe-only cases a lab declares in
+``tests/graded/<lab>/diagnose.py`` (``CASES``: same inputs as the composite cases, zero points,
+never graded themselves). That module may also declare
+
+- ``PROBES``: ``{composite case id: [probe case ids to try first]}`` (the same input);
+- ``WHERE``: ``{function: where(inputs, expected, got) -> " at valence-3 vertices" or ""}``;
+- ``PICTURES``: ``{function: picture(ctx, inputs, expected, got) -> path or None}``, a feedback
+  picture for outputs the generic checks cannot draw (a subdivision matrix: the mesh with the
+  vertices whose rows are wrong highlighted).
+
+Everything here is a help: any problem while diagnosing leaves the original message as it was.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from geomlib.grading import tasks as _tasks
+from geomlib.grading.errors import GradingFailure, Mismatch, NotImplementedYet
+
+__all__ = ["enrich", "explain", "probes_for"]
+
+#: Probe outcomes, keyed by (implementation folder, its files' modification times, probe id).
+_CACHE: dict = {}
+#: Seconds one explanation may spend on probes.
+BUDGET_S = 60.0
+
+
+def _stamp(folder: Path) -> tuple:
+    try:
+        return tuple(sorted((p.name, p.stat().st_mtime_ns) for p in Path(folder).glob("*.py")))
+    except OSError:
+        return ()
+
+
+def _module(lab: str):
+    try:
+        return _tasks._declared(lab)
+    except Exception:
+        return None
+
+
+def probes_for(lab: str, case) -> list:
+    """Probe cases for a composite case, in the order they are tried (task, same input first)."""
+    from geomlib.grading.cases import load_cases
+
+    tab = _tasks.table(lab)
+    blocks = tab.composites.get(case.function, ())
+    if not blocks:
+        return []
+    mod = _module(lab)
+    pool = {}
+    for c in [*getattr(mod, "CASES", []), *load_cases(lab, hidden=False, probes=False)]:
+        if c.function in blocks and not c.hidden:
+            pool.setdefault(c.id, c)
+    first = list(getattr(mod, "PROBES", {}).get(case.id, ()))
+
+    def key(c):
+        return (
+            tab.tasks.get(c.function, (99,))[0],
+            blocks.index(c.function),
+            first.index(c.id) if c.id in first else len(first),
+        )
+
+    return sorted(pool.values(), key=key)
+
+
+def _run_probe(lab, probe, mod, feedback_dir):
+    """None when the student's block matches the probe's reference, else (what, message)."""
+    from geomlib.grading.cases import load_reference
+    from geomlib.grading.checks import Context
+
+    key = (str(lab.lab_dir), _stamp(lab.lab_dir), probe.id)
+    if key in _CACHE:
+        return _CACHE[key]
+    out = None
+    inputs = {**probe.inputs(), **probe.params}
+    try:
+        got = probe.name_outputs(lab.call(probe.function, **inputs))
+        expected = load_reference(lab.name, probe)
+        ctx = Context(label=probe.label, lab=lab.name, case_id=probe.id, feedback_dir=feedback_dir)
+        try:
+            probe.check(expected, got, ctx)
+        except Mismatch as e:
+            where = ""
+            fn = getattr(mod, "WHERE", {}).get(probe.function)
+            if fn is not None:
+                try:
+                    where = fn(inputs, expected, got) or ""
+                except Exception:
+                    where = ""
+            pic = e.feedback or _picture(mod, probe.function, ctx, inputs, expected, got)
+            msg = e.message + (f" — {probe.hint}" if probe.hint else "")
+            out = (f"differs{where}", msg + (f" (see {pic})" if pic else ""))
+    except NotImplementedYet:
+        out = ("is not implemented yet", "")
+    except GradingFailure as e:
+        out = ("fails", str(e))
+    _CACHE[key] = out
+    return out
+
+
+def _picture(mod, function, ctx, inputs, expected, got):
+    if ctx.feedback_dir is None:
+        return None
+    fn = getattr(mod, "PICTURES", {}).get(function, _default_picture)
+    try:
+        return fn(ctx, inputs, expected, got)
+    except Exception:
+        return None
+
+
+def _default_picture(ctx, inputs, expected, got):
+    """A picture for a wrong array: rows on the input mesh, or a grid output as an image."""
+    return _rows_on_mesh(ctx, inputs, expected, got) or _grid_image(ctx, expected, got)
+
+
+def _grid_image(ctx, expected, got):
+    """Expected and submitted (h, w, c) grids (displacements, positions, maps) as images, with the
+    per-texel error as a heat map; channels are scaled by the expected values' range."""
+    import numpy as np
+
+    from geomlib.grading import feedback
+
+    for name, e in expected.items():
+        e = np.asarray(e)
+        try:
+            g = np.asarray(got.get(name), dtype=float)
+        except (TypeError, ValueError):
+            continue
+        # (h, w, c) grids, or (h, w) scalar images; an (n, 3) list of points is not an image.
+        if (
+            e.dtype.kind != "f"
+            or e.ndim not in (2, 3)
+            or g.shape != e.shape
+            or min(e.shape[:2]) < (2 if e.ndim == 3 else 8)
+        ):
+            continue
+        if e.ndim == 3 and e.shape[2] not in (1, 2, 3, 4):
+            continue
+        e3 = e if e.ndim == 3 else e[..., None]
+        g3 = g if g.ndim == 3 else g[..., None]
+        err = np.abs(g3 - e3).max(axis=2)
+        if not (err > 1e-12).any():
+            continue
+        lo = e3.min(axis=(0, 1))
+        span = np.maximum(e3.max(axis=(0, 1)) - lo, 1e-12)
+
+        def show(x, lo=lo, span=span):
+            x = np.clip((x - lo) / span, 0, 1)
+            if x.shape[2] == 2:
+                x = np.concatenate([x, np.zeros_like(x[..., :1])], axis=2)
+            return x[..., :3] if x.shape[2] >= 3 else x[..., 0]
+
+        k = max(1, 256 // max(e.shape[:2]))  # small grids: one block of k x k pixels per texel
+
+        def up(x, k=k):
+            return np.repeat(np.repeat(x, k, axis=0), k, axis=1)
+
+        return feedback.image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))))
+    return None
+
+
+def _rows_on_mesh(ctx, inputs, expected, got):
+    """Default picture for a wrong array of points or per-vertex values on an input mesh: the mesh
+    with the wrong rows marked (at the vertex for per-vertex rows, else where the point should be)."""
+    import numpy as np
+
+    from geomlib.grading import feedback
+
+    V = inputs.get("V")
+    F = next((inputs[k] for k in ("F", "faces", "Q") if k in inputs), None)
+    if V is None or F is None:
+        return None
+    V = np.asarray(V, float)
+    if V.ndim != 2 or V.shape[1] != 3:
+        return None
+    for name, e in expected.items():
+        e = np.asarray(e)
+        try:
+            g = np.asarray(got.get(name), dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if e.dtype.kind != "f" or e.ndim != 2 or g.shape != e.shape:
+            continue
+        bad = ~np.isclose(g, e, rtol=0.0, atol=1e-8).all(axis=1)
+        if not bad.any():
+            continue
+        if len(e) == len(V) and bad.sum() > 20:
+            err = np.linalg.norm(np.nan_to_num(g - e, nan=np.inf), axis=1)
+            err[~np.isfinite(err)] = np.nan
+            return feedback.heat_on_mesh_picture(
+                ctx, V, F, err, f"{int(bad.sum())} of {len(e)} rows of {name} are wrong", f"|{name} error|"
+            )
+        if len(e) == len(V):
+            points, what = V[bad], f"{int(bad.sum())} vertices where {name} is wrong"
+        elif e.shape[1] == 3:
+            points, what = e[bad], f"where the {int(bad.sum())} wrong rows of {name} should be"
+        else:
+            continue
+        return feedback.highlight_picture(ctx, V, F, points, what)
+    return None
+
+
+def explain(lab, case, *, feedback_dir=None) -> str | None:
+    """Why the composite ``case`` fails on ``lab`` (a sandboxed lab proxy), or None if not a composite."""
+    tab = _tasks.table(lab.name)
+    probes = probes_for(lab.name, case)
+    if not probes:
+        return None
+    mod = _module(lab.name)
+    same_input = set(getattr(mod, "PROBES", {}).get(case.id, ()))
+    t0 = time.time()
+    # First the probes on this case's own input: a wrong block there explains the result. Then the
+    # block's other cases: a multi-level composite meets inputs its first level does not show.
+    for own_input in (True, False):
+        for p in probes:
+            if (p.id in same_input) != own_input or time.time() - t0 > BUDGET_S:
+                continue
+            res = _run_probe(lab, p, mod, feedback_dir)
+            if res is None:
+                continue
+            what, detail = res
+            task = tab.describe(tab.tasks[p.function][0]) if p.function in tab.tasks else "a building block"
+            detail = f": {detail}" if detail else ""
+            if own_input or not same_input:
+                return f"{case.function} is off because {p.function} ({task}) {what}{detail}"
+            return (
+                f"{case.function} is off; its building blocks agree on this input, but {p.function} ({task}) "
+                f"{what} on another mesh (later steps meet cases the input does not have){detail}"
+            )
+    blocks = ", ".join(tab.composites.get(case.function, ()))
+    own = tab.tasks.get(case.function)
+    if own:
+        return (
+            f"its building blocks ({blocks}) agree with the references, so look at {case.function} "
+            f"itself ({tab.describe(own[0])})" + (f": {case.hint}" if case.hint else "")
+        )
+    return None
+
+
+def enrich(error: Mismatch, lab, case, inputs: dict, expected: dict, got: dict, ctx) -> Mismatch:
+    """``error`` with a picture if it has none, and the diagnosis (or the case's hint) appended."""
+    try:
+        mod = _module(lab.name)
+        pic = error.feedback or _picture(mod, case.function, ctx, inputs, expected, got)
+        why = explain(lab, case, feedback_dir=ctx.feedback_dir)
+    except Exception:
+        pic, why = error.feedback, None
+    extra = why or case.hint
+    return type(error)(error.message + (f" — {extra}" if extra else ""), pic)

@@ -1,0 +1,220 @@
+"""Which task of a lab each function, case and graded test belongs to.
+
+A lab's tasks are marked in its source: ``# BEGIN SOLUTION: Task 2 (even vertices): ...`` in the
+solutions, ``raise NotImplementedError("Task 2 (even vertices): ...")`` in the stubs. A function's
+tasks are the markers inside it, the first one being its main task (``loop_odd_matrix`` is Task 1,
+with Task 4's boundary rule inside). A function without markers that calls task functions (a
+*composite*, such as ``catmull_clark``) belongs to the tasks of what it calls.
+
+Students edit the stubs, so the markers disappear as they work: each lab therefore *declares* its
+table in ``tests/graded/<lab>/diagnose.py`` (``TASKS``, ``TITLES``, ``COMPOSITES``), and a framework
+test checks that the declaration matches what :func:`derive` reads from the solutions.
+
+A graded test's task: the task whose title is the test's part ("boundary rules" is Task 4), else
+the main tasks of the lab functions it calls (``Case.function``, or ``lab.<name>(...)`` in a
+hand-written test).
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import re
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from geomlib.grading import impl as _impl
+
+__all__ = ["TaskTable", "derive", "table", "test_tasks"]
+
+_MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
+
+
+@dataclass
+class TaskTable:
+    """A lab's tasks.
+
+    Attributes
+    ----------
+    tasks : dict
+        ``{function: (main task, other tasks...)}`` for functions that hold a student part.
+    titles : dict
+        ``{task number: title}`` (the first title a task is marked with).
+    composites : dict
+        ``{function: (building-block functions...)}``, blocks in task order, for functions that call
+        task functions (whether or not they hold a part themselves).
+    """
+
+    tasks: dict = field(default_factory=dict)
+    titles: dict = field(default_factory=dict)
+    composites: dict = field(default_factory=dict)
+
+    def of_function(self, name: str) -> tuple[int, ...]:
+        """The tasks a call of ``name`` exercises: its main task, else its blocks' main tasks."""
+        if name in self.tasks:
+            return self.tasks[name][:1]
+        out = []
+        for b in self.composites.get(name, ()):
+            for t in self.tasks.get(b, ())[:1]:
+                if t not in out:
+                    out.append(t)
+        return tuple(sorted(out))
+
+    def of_part(self, part: str) -> int | None:
+        """The task whose title is ``part`` (case and a leading "the" ignored), else None."""
+        key = _norm(part)
+        for n, title in self.titles.items():
+            if _norm(title) == key:
+                return n
+        return None
+
+    def describe(self, n: int) -> str:
+        return f"Task {n}: {self.titles[n]}" if n in self.titles else f"Task {n}"
+
+
+def _norm(s: str) -> str:
+    s = s.strip().lower()
+    return s[4:] if s.startswith("the ") else s
+
+
+def derive(lab_dir: str | Path) -> TaskTable:
+    """Read the task table from a lab's source (solutions or untouched stubs)."""
+    funcs: dict[str, tuple[list, set]] = {}
+    for path in sorted(Path(lab_dir).glob("*.py")):
+        if path.name == "figures.py":
+            continue
+        src = path.read_text()
+        lines = src.splitlines()
+        for node in ast.parse(src).body:
+            if not isinstance(node, ast.FunctionDef):
+                continue
+            marks = []
+            for line in lines[node.lineno - 1 : node.end_lineno]:
+                m = _MARK.search(line)
+                if m and ("BEGIN SOLUTION" in line or "NotImplementedError" in line):
+                    marks.append((int(m.group(1)), m.group(2).strip()))
+            calls = {n.func.id for n in ast.walk(node) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+            funcs[node.name] = (marks, calls)
+    t = TaskTable()
+    for name, (marks, _) in funcs.items():
+        if marks:
+            nums = []
+            for n, title in marks:
+                if n not in nums:
+                    nums.append(n)
+                t.titles.setdefault(n, title)
+            t.tasks[name] = tuple(nums)
+
+    def blocks(name, seen):
+        out = set()
+        for c in funcs.get(name, ((), set()))[1]:
+            if c in seen or c not in funcs:
+                continue
+            seen.add(c)
+            if c in t.tasks:
+                out.add(c)
+            out |= blocks(c, seen)
+        return out
+
+    for name in funcs:
+        b = blocks(name, {name})
+        if b:
+            t.composites[name] = tuple(sorted(b, key=lambda f: (t.tasks[f][0], f)))
+    t.titles = dict(sorted(t.titles.items()))
+    return t
+
+
+def _declared(lab: str):
+    tests = str(_impl.tests_dir())
+    if tests not in sys.path:
+        sys.path.insert(0, tests)
+    if not (_impl.tests_dir() / "graded" / lab / "diagnose.py").is_file():
+        return None
+    return importlib.import_module(f"graded.{lab}.diagnose")
+
+
+def table(lab: str) -> TaskTable:
+    """The lab's declared task table, else the one derived from its solutions or stubs."""
+    mod = _declared(lab)
+    if mod is not None and hasattr(mod, "TASKS"):
+        return TaskTable(dict(mod.TASKS), dict(mod.TITLES), dict(getattr(mod, "COMPOSITES", {})))
+    for impl in ("solutions", "labs"):
+        d = _impl.course_root() / impl / lab
+        if d.is_dir():
+            return derive(d)
+    return TaskTable()
+
+
+def _lab_calls(fn) -> list[str]:
+    """Lab functions a hand-written test calls: ``lab.name(...)`` and ``lab.call("name", ...)``,
+    directly or through a helper defined in the same test module."""
+    try:
+        tree = ast.parse(_dedent(fn))
+    except (OSError, TypeError, SyntaxError):
+        return []
+    out: list[str] = []
+    helpers = []
+    for n in ast.walk(tree):
+        if not isinstance(n, ast.Call):
+            continue
+        f = n.func
+        if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "lab":
+            if f.attr == "call" and n.args and isinstance(n.args[0], ast.Constant):
+                name = str(n.args[0].value)
+            else:
+                name = f.attr
+            if name not in out:
+                out.append(name)
+        elif isinstance(f, ast.Name):
+            helpers.append(f.id)
+    module = sys.modules.get(getattr(fn, "__module__", ""), None)
+    for h in helpers:
+        g = getattr(module, h, None)
+        if inspect.isfunction(g) and g.__module__ == fn.__module__ and g is not fn:
+            for name in _lab_calls_direct(g):
+                if name not in out:
+                    out.append(name)
+    return out
+
+
+def _dedent(fn) -> str:
+    import textwrap
+
+    return textwrap.dedent(inspect.getsource(fn))
+
+
+def _lab_calls_direct(fn) -> list[str]:
+    try:
+        tree = ast.parse(_dedent(fn))
+    except (OSError, TypeError, SyntaxError):
+        return []
+    out = []
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute):
+            f = n.func
+            if isinstance(f.value, ast.Name) and f.value.id == "lab" and f.attr != "call" and f.attr not in out:
+                out.append(f.attr)
+    return out
+
+
+def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
+    """The tasks of a collected graded pytest item (see the module docstring)."""
+    n = tab.of_part(part)
+    if n is not None:
+        return (n,)
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    if case is not None and getattr(case, "task", None):
+        return (int(case.task),)
+    names = [case.function] if case is not None and hasattr(case, "function") else _lab_calls(item.function)
+    out: list[int] = []
+    for name in names:
+        for t in tab.of_function(name):
+            if t not in out:
+                out.append(t)
+    return tuple(sorted(out))
+
+
+test_tasks.__test__ = False  # not a pytest test, despite the name

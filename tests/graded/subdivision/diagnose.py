@@ -1,0 +1,239 @@
+"""Diagnosis table of the subdivision lab (see ``geomlib.grading.diagnose`` and ``geomlib.grading.tasks``).
+
+``TASKS``, ``TITLES`` and ``COMPOSITES`` declare which task each function belongs to (the stubs'
+"Task N" markers vanish as students fill them in; ``tests/framework`` checks this table against
+the solutions). ``CASES`` are probe-only cases: the building blocks on the inputs of the composite
+cases, with references stored by ``geomlib refs build``, run only to explain a wrong composite.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import topology
+from geomlib.grading import Case, checks
+
+from .cases import (
+    BOUNDARY_HINT,
+    EVEN_HINT,
+    FACES_HINT,
+    ODD_HINT,
+    bumpy_cube,
+    cage,
+    height_field,
+    ico,
+    no_vertices,
+    torus,
+    with_face_points,
+)
+from .support import as_dense, faces_check, matrix_check
+
+TASKS = {
+    "loop_odd_matrix": (1, 4),
+    "loop_weight": (2,),
+    "loop_even_matrix": (2, 4),
+    "loop_faces": (3,),
+    "loop_subdivide": (5,),
+    "cc_face_points": (6,),
+    "cc_edge_points": (7, 4),
+    "cc_vertex_points": (8, 4),
+    "cc_quads": (9,),
+}
+TITLES = {
+    1: "odd vertices",
+    2: "even vertices",
+    3: "connectivity",
+    4: "boundary rules",
+    5: "several levels",
+    6: "face points",
+    7: "edge points",
+    8: "vertex points",
+    9: "quads",
+}
+_LOOP = ("loop_odd_matrix", "loop_even_matrix", "loop_weight", "loop_faces")
+_CC = ("cc_face_points", "cc_edge_points", "cc_vertex_points", "cc_quads")
+COMPOSITES = {
+    "loop_even_matrix": ("loop_weight",),
+    "loop_matrix": _LOOP,
+    "loop_subdivide": _LOOP,
+    "cc_edge_points": ("cc_face_points",),
+    "cc_vertex_points": ("cc_face_points",),
+    "catmull_clark_step": _CC,
+    "catmull_clark": _CC,
+}
+
+
+def _odd(id, inputs, hint=ODD_HINT):
+    return Case(
+        id=id,
+        function="loop_odd_matrix",
+        inputs=inputs,
+        outputs=("S_odd",),
+        check=matrix_check("S_odd", what_row="row (edge)"),
+        part="diagnosis",
+        points=0,
+        hint=hint,
+    )
+
+
+def _even(id, inputs, weights, hint=EVEN_HINT):
+    return Case(
+        id=id,
+        function="loop_even_matrix",
+        inputs=inputs,
+        params={"weights": weights},
+        outputs=("S_even",),
+        check=matrix_check("S_even", what_row="row (vertex)"),
+        part="diagnosis",
+        points=0,
+        hint=hint,
+    )
+
+
+def _faces(id, inputs):
+    return Case(
+        id=id,
+        function="loop_faces",
+        inputs=no_vertices(inputs),
+        outputs=("F",),
+        check=faces_check("F"),
+        part="diagnosis",
+        points=0,
+        hint=FACES_HINT,
+    )
+
+
+def _cc(id, function, inputs, outputs, check, hint):
+    return Case(
+        id=id, function=function, inputs=inputs, outputs=outputs, check=check, part="diagnosis", points=0, hint=hint
+    )
+
+
+CASES = [
+    _odd("probe-odd-icosahedron", ico(0)),
+    _even("probe-even-icosahedron-warren", ico(0), "warren"),
+    _faces("probe-faces-icosahedron", ico(0)),
+    _odd("probe-odd-torus", torus),
+    _even("probe-even-torus-loop", torus, "loop"),
+    _even("probe-even-height-field-loop", height_field, "loop", EVEN_HINT + "; " + BOUNDARY_HINT),
+    _faces("probe-faces-height-field", height_field),
+    _cc(
+        "probe-cc-faces-cube",
+        "cc_face_points",
+        bumpy_cube,
+        ("FP",),
+        checks.Allclose(),
+        "face point = mean of the corners",
+    ),
+    _cc(
+        "probe-cc-edges-cube",
+        "cc_edge_points",
+        with_face_points(bumpy_cube),
+        ("EP",),
+        checks.Allclose(),
+        "edge point = (a + b + FP[f0] + FP[f1]) / 4",
+    ),
+    _cc(
+        "probe-cc-quads-cube",
+        "cc_quads",
+        no_vertices(bumpy_cube),
+        ("Q",),
+        faces_check("Q"),
+        "one quad per corner j: (idx[j], n + he_edge[j], n + e + he_face[j], n + he_edge[prv[j]])",
+    ),
+    _cc(
+        "probe-cc-edges-cage",
+        "cc_edge_points",
+        with_face_points(cage),
+        ("EP",),
+        checks.Allclose(),
+        "edge point = (a + b + FP[f0] + FP[f1]) / 4",
+    ),
+]
+
+#: Probes on the composite case's own input, tried first.
+PROBES = {
+    "loop-icosahedron-3-warren": [
+        "probe-odd-icosahedron",
+        "probe-even-icosahedron-warren",
+        "weights-warren",
+        "probe-faces-icosahedron",
+    ],
+    "loop-torus-2-loop": ["probe-odd-torus", "probe-even-torus-loop", "weights-loop", "faces-torus"],
+    "loop-height-field-2-loop": [
+        "odd-height-field",
+        "probe-even-height-field-loop",
+        "weights-loop",
+        "probe-faces-height-field",
+    ],
+    "cc-cube-2": ["probe-cc-faces-cube", "probe-cc-edges-cube", "cc-vertices-cube", "probe-cc-quads-cube"],
+    "cc-cage-1": ["cc-faces-cage", "probe-cc-edges-cage", "cc-vertices-cage", "cc-quads-cage"],
+    "cc-cage-3": ["cc-faces-cage", "probe-cc-edges-cage", "cc-vertices-cage", "cc-quads-cage"],
+}
+
+
+def _bad_rows(expected, got, name):
+    E = as_dense(expected[name], name)
+    G = as_dense(got[name], name)
+    if G.shape != E.shape:
+        return None
+    return np.flatnonzero((np.abs(G - E) > 1e-12).any(axis=1))
+
+
+def _kinds(labels) -> str:
+    kinds = sorted(set(labels), key=lambda s: (not s.startswith("valence"), s))
+    if len(kinds) > 3:
+        return ""
+    return " at " + " and ".join(kinds)
+
+
+def _where_even(inputs, expected, got) -> str:
+    rows = _bad_rows(expected, got, "S_even")
+    if rows is None or not len(rows):
+        return ""
+    F = np.asarray(inputs["F"])
+    val = topology.valence(F, len(inputs["V"]))
+    on_boundary = np.zeros(len(inputs["V"]), bool)
+    on_boundary[topology.boundary_edges(F).ravel()] = True
+    labels = ["boundary vertices" if on_boundary[r] else f"valence-{int(val[r])} vertices" for r in rows]
+    return _kinds(labels)
+
+
+def _where_odd(inputs, expected, got) -> str:
+    rows = _bad_rows(expected, got, "S_odd")
+    if rows is None or not len(rows):
+        return ""
+    F = np.asarray(inputs["F"])
+    E = topology.unique_edges(F)
+    B = {tuple(e) for e in np.sort(topology.boundary_edges(F), axis=1).tolist()}
+    labels = ["boundary edges" if tuple(E[r]) in B else "interior edges" for r in rows if r < len(E)]
+    return _kinds(labels)
+
+
+WHERE = {"loop_even_matrix": _where_even, "loop_odd_matrix": _where_odd}
+
+
+def _picture_even(ctx, inputs, expected, got):
+    from geomlib.grading import feedback
+
+    rows = _bad_rows(expected, got, "S_even")
+    if rows is None or not len(rows):
+        return None
+    V = np.asarray(inputs["V"], float)
+    return feedback.highlight_picture(ctx, V, inputs["F"], V[rows], f"{len(rows)} vertices whose S_even rows are wrong")
+
+
+def _picture_odd(ctx, inputs, expected, got):
+    from geomlib.grading import feedback
+
+    rows = _bad_rows(expected, got, "S_odd")
+    if rows is None or not len(rows):
+        return None
+    V = np.asarray(inputs["V"], float)
+    E = topology.unique_edges(np.asarray(inputs["F"]))
+    rows = rows[rows < len(E)]
+    mid = (V[E[rows, 0]] + V[E[rows, 1]]) / 2
+    return feedback.highlight_picture(ctx, V, inputs["F"], mid, f"{len(rows)} edges whose S_odd rows are wrong")
+
+
+PICTURES = {"loop_even_matrix": _picture_even, "loop_odd_matrix": _picture_odd}
