@@ -209,13 +209,12 @@ def _parse_obj_faces(src: _Source, rows: _Rows):
     code[(s == 1) & (d == 0)] = 1
     code[(s == 2) & (d == 1)] = 2
     code[(s == 2) & (d == 0)] = 3
-    # Each number is one run of digits: a token like '+' or '1_0' has the wrong count (NumPy would
-    # read '+' as 0).
-    isdig = (b >= 48) & (b <= 57)
-    run = isdig.copy()
-    run[1:] &= ~isdig[:-1]
-    runs = np.bincount(token_id[run], minlength=ntok)
-    code[runs != np.array([1, 2, 2, 3, 0])[code]] = -1
+    # A sign must precede a digit: NumPy would read a lone '+' or '-' as 0 (other bad tokens make
+    # NumPy stop early, which the count check below catches).
+    sign = np.flatnonzero((b == 43) | (b == 45))
+    nxt = b[np.minimum(sign + 1, len(b) - 1)]
+    lone = sign[(sign + 1 >= len(b)) | (nxt < 48) | (nxt > 57)]
+    code[token_id[lone]] = -1
     if (code < 0).any():
         _obj_bad_corner(src, rows, k, int(np.flatnonzero(code < 0)[0]))
     raw_v = np.zeros(ntok, np.int64)

@@ -361,7 +361,8 @@ def _ply_binary_walk(src, el, data, pos, order, truncated):
                 if q + cs.size > end:
                     raise truncated(r)
                 c = cs.unpack_from(data, q)[0]
-                _check_list_length(src, el, p, r, c, end - q - cs.size, truncated)
+                if c < 0 or q + cs.size + c * sizes[j] > end:
+                    _check_list_length(src, el, p, r, c, end - q - cs.size, truncated)
                 q += cs.size
                 starts[j].append(q)
                 lens[j].append(c)
