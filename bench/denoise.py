@@ -45,7 +45,7 @@ sys.path.insert(0, str(ROOT))
 
 import igl  # noqa: E402
 
-from geomlib import datasets, io  # noqa: E402
+from geomlib import datasets, mesh_io  # noqa: E402
 from geomlib.textures import rasterize_uv, triangle_atlas  # noqa: E402
 from solutions.denoise import (  # noqa: E402
     bake_offset_map,
@@ -70,7 +70,7 @@ REAL_QUICK = ["spot_triangulated.obj", "fandisk.obj"]
 
 def obj_with_uvs(path: Path):
     """An OBJ with texture coordinates as a seam-split triangle mesh ``(V, F, UV)``; UVs scaled into [0, 1]^2."""
-    d = io.read_obj(path, triangulate=True)
+    d = mesh_io.read_obj(path, triangulate=True)
     pairs = np.stack([np.asarray(d.faces).ravel(), np.asarray(d.face_uv).ravel()], axis=1)
     keys, inv = np.unique(pairs, axis=0, return_inverse=True)
     V, UV = d.V[keys[:, 0]], d.UV[keys[:, 1]]
@@ -91,10 +91,10 @@ def load(name: str):
     if name == "uv_torus":
         return datasets.uv_torus()
     path = SHARED / name
-    d = io.read_obj(path, triangulate=True) if path.suffix == ".obj" else None
+    d = mesh_io.read_obj(path, triangulate=True) if path.suffix == ".obj" else None
     if d is not None and d.face_uv is not None:
         return obj_with_uvs(path)
-    V, F = io.read_mesh(path, triangulate=True)
+    V, F = mesh_io.read_mesh(path, triangulate=True)
     return V, np.asarray(F, np.int64), None
 
 

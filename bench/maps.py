@@ -228,7 +228,7 @@ def bench_bake(quick: bool, repeat: int) -> None:
         return
     import fast_simplification
 
-    from geomlib.io import read_mesh
+    from geomlib.mesh_io import read_mesh
 
     for fname in ("armadillo.obj", "igea.ply"):
         path = SHARED / fname

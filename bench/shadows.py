@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from geomlib.io import read_mesh
+from geomlib.mesh_io import read_mesh
 from solutions.shadows import (
     CLASSIC_CAMERA,
     CLASSIC_LIGHT,

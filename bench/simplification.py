@@ -77,7 +77,7 @@ def builtin_meshes(quick: bool) -> dict:
 
 
 def shared_meshes(quick: bool) -> dict:
-    from geomlib.io import read_mesh
+    from geomlib.mesh_io import read_mesh
 
     names = (
         ["fandisk.obj", "camelhead.off"] if quick else ["bunny_hr.obj", "armadillo.obj", "fandisk.obj", "camelhead.off"]

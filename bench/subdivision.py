@@ -63,7 +63,7 @@ def quad_torus(nu: int, nv: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def shared_mesh(name: str):
-    from geomlib.io import read_mesh
+    from geomlib.mesh_io import read_mesh
 
     path = SHARED / name
     return read_mesh(path) if path.is_file() else None

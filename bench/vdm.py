@@ -39,7 +39,7 @@ import igl  # noqa: E402
 
 from geomlib import datasets  # noqa: E402
 from geomlib.geometry import mesh_distance  # noqa: E402
-from geomlib.io import read_mesh  # noqa: E402
+from geomlib.mesh_io import read_mesh  # noqa: E402
 from solutions.vdm import (  # noqa: E402
     align_to_features,
     area_density,

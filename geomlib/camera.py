@@ -32,10 +32,45 @@ import numpy as np
 
 from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int
 
-__all__ = ["look_at", "perspective", "orthographic", "viewport", "project", "camera_presets", "PRESETS"]
+__all__ = [
+    "look_at",
+    "pose_from_view",
+    "perspective",
+    "orthographic",
+    "viewport",
+    "project",
+    "view_frame",
+    "camera_presets",
+    "VIEWS",
+    "PRESETS",
+    "AXES",
+]
 
-#: Names accepted by :func:`camera_presets`.
-PRESETS = ("front", "three_quarter", "top")
+#: The one table of preset viewpoints, used by :func:`camera_presets` (rasterizer labs) and by
+#: :func:`geomlib.render.camera_pose` (figures, ``geomlib render --view``). Each entry is
+#: ``(azimuth, elevation)`` in degrees in the MODEL's frame: azimuth 0 is in front of the model
+#: (on its ``forward`` side), positive azimuth turns towards the viewer's right (the model's left),
+#: elevation lifts the camera towards ``up``. ``"side"`` is the old name of ``"right"``.
+VIEWS: dict[str, tuple[float, float]] = {
+    "front": (0.0, 0.0),
+    "three_quarter": (35.0, 25.0),
+    "three_quarter_left": (-35.0, 25.0),
+    "right": (90.0, 0.0),
+    "side": (90.0, 0.0),
+    "left": (-90.0, 0.0),
+    "back": (180.0, 0.0),
+    "three_quarter_back": (215.0, 25.0),
+    "top": (0.0, 90.0),
+    "bottom": (0.0, -90.0),
+}
+#: Names accepted by :func:`camera_presets` (every view of :data:`VIEWS`).
+PRESETS = tuple(VIEWS)
+#: Axis names accepted for ``up_axis`` / ``forward``.
+AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
+#: The model's forward axis (the way its face looks) when none is given, per up axis: y-up files
+#: follow OpenGL/glTF (the model faces +z, towards a default camera); the course's z-up datasets
+#: face -y.
+DEFAULT_FORWARD = {"y": "+z", "z": "-y"}
 
 
 def _vec3(x, name: str, where: str) -> np.ndarray:
@@ -89,6 +124,81 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     V[0, :3], V[1, :3], V[2, :3] = s, u, -f
     V[:3, 3] = -V[:3, :3] @ eye
     return V
+
+
+def pose_from_view(view) -> np.ndarray:
+    """Camera-to-world pose (the inverse of a rigid view matrix such as :func:`look_at`'s).
+
+    Renderers (pyrender, glTF) place a camera with this pose; the rasterizer uses the view matrix.
+
+    Parameters
+    ----------
+    view : (4, 4) array_like
+        Rigid world-to-eye matrix (orthonormal rotation, last row ``(0, 0, 0, 1)``).
+
+    Returns
+    -------
+    (4, 4) float64
+        ``inv(view)``, computed exactly as ``[[R.T, -R.T t], [0, 1]]``: its columns are the camera's
+        right, up and back (``+z``, away from what it looks at) axes and its position.
+    """
+    M = as_array(view, "view", shape=(4, 4), dtype=np.float64, where="pose_from_view")
+    pose = np.eye(4)
+    pose[:3, :3] = M[:3, :3].T
+    pose[:3, 3] = -M[:3, :3].T @ M[:3, 3]
+    return pose
+
+
+def _axis(name, what: str, where: str) -> np.ndarray:
+    check_choice(name, what, AXES, where=where)
+    v = np.zeros(3)
+    v["xyz".index(name[1])] = 1.0 if name[0] == "+" else -1.0
+    return v
+
+
+def view_frame(view: str, up_axis: str = "y", forward: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """World directions of a preset view: from the target towards the eye, and up in the image.
+
+    Parameters
+    ----------
+    view : str
+        A name of :data:`VIEWS`.
+    up_axis : {"y", "z"} or one of :data:`AXES`
+        World axis that points up (``"y"`` = ``"+y"``).
+    forward : one of :data:`AXES`, optional
+        World axis the model faces (its front); default :data:`DEFAULT_FORWARD`: ``+z`` when y is
+        up, ``-y`` when z is up. Must be perpendicular to ``up_axis``.
+
+    Returns
+    -------
+    back, image_up : (3,) float64 each
+        Unit vectors: ``back`` points from the target to the camera, ``image_up`` is up in the image.
+        ``top`` looks down ``-up`` with the model's back at the top of the picture; ``bottom``
+        looks up with its front at the top.
+    """
+    where = "view_frame"
+    check_choice(view, "view", tuple(VIEWS), where=where)
+    up_name = {"y": "+y", "z": "+z"}.get(up_axis, up_axis)
+    up = _axis(up_name, "up_axis", where)
+    if forward is None:
+        forward = DEFAULT_FORWARD.get(up_name[1], None)
+        if forward is None or up_name[0] == "-":
+            raise MeshError(f"{where}: give forward with up_axis={up_axis!r} (no default forward axis)")
+    fwd = _axis(forward, "forward", where)
+    if abs(fwd @ up) > 0:
+        raise MeshError(f"{where}: forward {forward} must be perpendicular to up_axis {up_name}")
+    # Model frame -> world: columns are the model's x (= up x forward), up and forward axes. With
+    # signed unit axes it is a signed permutation, so mapping the model-frame vectors is exact.
+    M = np.column_stack([np.cross(up, fwd), up, fwd])
+    az, el = VIEWS[view]
+    if abs(el) == 90.0:
+        back, img_up = np.array([0.0, np.sign(el), 0.0]), np.array([0.0, 0.0, -np.sign(el)])
+    else:
+        a, e = np.radians(az), np.radians(el)
+        back = np.array([np.sin(a) * np.cos(e), np.sin(e), np.cos(a) * np.cos(e)])
+        back[np.abs(back) < 1e-12] = 0.0  # exact axes for 0/90/180 degrees
+        img_up = np.array([0.0, 1.0, 0.0])
+    return M @ back, M @ img_up
 
 
 def perspective(fov_y_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
@@ -215,16 +325,24 @@ def project(P, M, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def camera_presets(
-    name: str, bounds, *, fov_y_deg: float = 45.0, margin: float = 1.1
+    name: str,
+    bounds,
+    *,
+    fov_y_deg: float = 45.0,
+    margin: float = 1.1,
+    up_axis: str = "y",
+    forward: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fixed viewpoints that frame an axis-aligned bounding box, for reproducible figures.
 
     Parameters
     ----------
-    name : {"front", "three_quarter", "top"}
-        ``"front"`` looks along ``-z`` (from ``+z``), y up. ``"three_quarter"`` looks from azimuth 45
-        degrees (between ``+x`` and ``+z``) and elevation 30 degrees, y up. ``"top"`` looks down ``-y``
-        with ``-z`` pointing up in the image (``+x`` stays to the right).
+    name : str
+        A view of :data:`VIEWS` (see :func:`view_frame`). With the defaults (y up, model facing
+        ``+z``): ``"front"`` looks along ``-z`` (from ``+z``); ``"three_quarter"`` looks from azimuth
+        35 degrees (from ``+z`` towards ``+x``) and elevation 25 degrees; ``"top"`` looks down ``-y``
+        with ``-z`` pointing up in the image (``+x`` stays to the right). The same table frames the
+        rendered figures (:func:`geomlib.render.camera_pose`).
     bounds : array_like (2, 3)
         ``[min corner, max corner]``, e.g. ``np.array([V.min(0), V.max(0)])``.
     fov_y_deg : float
@@ -233,6 +351,8 @@ def camera_presets(
         view for aspect >= 1.
     margin : float
         Extra room, as a factor on the distance (> 0).
+    up_axis, forward : str
+        The world's up axis and the model's forward axis (see :func:`view_frame`).
 
     Returns
     -------
@@ -253,12 +373,5 @@ def camera_presets(
     if r == 0:
         r = 1.0  # a single point: any distance frames it
     dist = margin * r / np.sin(np.radians(fov) / 2)
-    up = np.array([0.0, 1.0, 0.0])
-    if name == "front":
-        d = np.array([0.0, 0.0, 1.0])
-    elif name == "three_quarter":
-        az, el = np.radians(45.0), np.radians(30.0)
-        d = np.array([np.cos(el) * np.sin(az), np.sin(el), np.cos(el) * np.cos(az)])
-    else:  # top
-        d, up = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, -1.0])
+    d, up = view_frame(name, up_axis, forward)
     return c + dist * d, c, up

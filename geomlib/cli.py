@@ -23,6 +23,7 @@ examples:
   geomlib release dist/                        student bundle + Gradescope autograder zip
   geomlib info mesh.obj                        counts, face kinds, manifoldness, genus, bbox
   geomlib render mesh.off -o mesh.png --wireframe
+  geomlib render spot.obj -o spot.png --view three_quarter --forward=-z
 """
 
 
@@ -45,9 +46,16 @@ def _cmd_info(a) -> int:
 def _cmd_render(a) -> int:
     import numpy as np
 
-    from geomlib import io, plot, render
+    from geomlib import mesh_io, plot, render
+    from geomlib.validate import MeshError
 
-    V, faces = io.read_mesh(a.file)
+    out = Path(a.output)
+    if out.suffix.lower() != ".png":
+        raise MeshError(f"-o {a.output}: the output must be a .png file")
+    if not out.parent.is_dir():
+        what = "is not a folder" if out.parent.exists() else "does not exist"
+        raise MeshError(f"-o {a.output}: the folder {out.parent} {what}; create it first")
+    V, faces = mesh_io.read_mesh(a.file)
     draw = render.render if isinstance(faces, np.ndarray) and faces.shape[1] == 3 else render.render_polygons
     img = draw(
         V,
@@ -56,8 +64,9 @@ def _cmd_render(a) -> int:
         shadows=a.shadows,
         floor=a.shadows,
         size=(a.width, a.height),
-        camera=a.camera,
+        camera=a.view,
         up_axis=a.up,
+        forward=a.forward,
     )
     plot.save_png(a.output, img)
     print(f"wrote {a.output}")
@@ -148,9 +157,26 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--output", required=True, help="PNG to write")
     r.add_argument("--wireframe", action="store_true", help="overlay the edges")
     r.add_argument("--shadows", action="store_true", help="cast shadows onto a ground plane")
-    r.add_argument("--camera", default="three_quarter", choices=["front", "three_quarter", "top", "side"])
+    from geomlib.camera import AXES, VIEWS
+
+    r.add_argument(
+        "--view",
+        "--camera",
+        dest="view",
+        default="three_quarter",
+        choices=list(VIEWS),
+        help="preset viewpoint, relative to the way the model faces (default three_quarter: front, "
+        "35 degrees to the viewer's right, 25 degrees up); --camera is the old name",
+    )
     r.add_argument(
         "--up", default="y", choices=["y", "z"], help="the mesh's up axis (default y, usual for OBJ/OFF/PLY files)"
+    )
+    r.add_argument(
+        "--forward",
+        choices=AXES,
+        metavar="{" + ",".join(AXES) + "}",
+        help="the axis the model faces (default +z when y is up, -y when z is up); e.g. --forward=-z "
+        "for spot, which looks down -z",
     )
     r.add_argument("--width", type=int, default=800)
     r.add_argument("--height", type=int, default=600)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import io, topology
+from geomlib import mesh_io, topology
 
 __all__ = ["describe", "summary"]
 
@@ -48,7 +48,7 @@ def summary(V: np.ndarray, faces) -> dict:
 
 def describe(path) -> str:
     """Human-readable :func:`summary` of the mesh in ``path`` (OBJ, OFF, PLY)."""
-    V, faces = io.read_mesh(path)
+    V, faces = mesh_io.read_mesh(path)
     s = summary(V, faces)
     names = {3: "triangles", 4: "quads"}
     kinds = ", ".join(f"{c} {names.get(k, f'{k}-gons')}" for k, c in s["face_kinds"].items())

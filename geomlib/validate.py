@@ -417,13 +417,17 @@ def as_image(
     Parameters
     ----------
     channels : int or sequence of int, optional
-        Allowed channel counts; a 2-D array counts as 1 channel.
+        Allowed channel counts; a 2-D array counts as 1 channel. Default 1 to 4 (grey, grey +
+        alpha, RGB, RGBA); pass the counts explicitly for multi-channel data maps.
     size : (h, w), optional
         Required height and width.
     square : bool
         Require ``h == w``.
     dtype : dtype, optional
         Convert to this dtype (float targets must be finite).
+
+    Float images must be finite (a NaN or infinite pixel is reported with its position), and
+    complex or non-numeric arrays are refused.
     """
     p = _prefix(where)
     if img is None:
@@ -431,19 +435,21 @@ def as_image(
     a = np.asarray(img)
     if a.ndim not in (2, 3) or a.dtype == object:
         raise MeshError(f"{p}{name} has shape {a.shape}; expected an image (h, w) or (h, w, c)")
+    if a.dtype.kind not in "biuf":
+        raise MeshError(f"{p}{name} has dtype {a.dtype}; expected numbers (bool, integer or float)")
     c = 1 if a.ndim == 2 else a.shape[2]
-    if channels is not None:
-        allowed = (channels,) if isinstance(channels, int) else tuple(channels)
-        if c not in allowed:
-            raise MeshError(
-                f"{p}{name} has {c} channel(s) (shape {a.shape}); expected {' or '.join(map(str, allowed))}"
-            )
+    allowed = (1, 2, 3, 4) if channels is None else (channels,) if isinstance(channels, int) else tuple(channels)
+    if c not in allowed:
+        raise MeshError(f"{p}{name} has {c} channel(s) (shape {a.shape}); expected {' or '.join(map(str, allowed))}")
     if a.shape[0] == 0 or a.shape[1] == 0:
         raise MeshError(f"{p}{name} is empty (shape {a.shape})")
     if size is not None and tuple(a.shape[:2]) != tuple(size):
         raise MeshError(f"{p}{name} is {a.shape[0]}x{a.shape[1]} pixels; expected {size[0]}x{size[1]}")
     if square and a.shape[0] != a.shape[1]:
         raise MeshError(f"{p}{name} is {a.shape[0]}x{a.shape[1]} pixels; expected a square image")
+    if a.dtype.kind == "f" and a.size and not np.isfinite(a).all():
+        px = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise MeshError(f"{p}{name} has a non-finite value ({a[px]}) at pixel {px[:2]}; images must be finite")
     if dtype is not None:
         a = as_array(a, name, dtype=dtype, where=where)
     return a

@@ -198,7 +198,7 @@ def save_vdm(path, vdm: VDM) -> tuple[Path, Path]:
     -------
     (npz_path, png_path)
     """
-    from geomlib.io import write_image
+    from geomlib.image_io import write_image
 
     path = Path(path)
     base = path.with_suffix("") if path.suffix in (".npz", ".png") else path

@@ -223,7 +223,7 @@ def test_plain_rounding_exceeds_one_code_after_renormalising():
 
 
 def test_png_round_trip_is_lossless(tmp_path):
-    from geomlib.io import read_image, write_image
+    from geomlib.image_io import read_image, write_image
 
     n = height_to_normal_map(wave(*texel_uv(32)), 0.2, border="wrap")
     enc = encode_normal_map(n)

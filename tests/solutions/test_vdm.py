@@ -15,7 +15,7 @@ import pytest
 
 from geomlib import datasets
 from geomlib.geometry import mesh_distance
-from geomlib.io import read_image
+from geomlib.image_io import read_image
 from geomlib.validate import MeshError
 from solutions.vdm import (
     VDM,

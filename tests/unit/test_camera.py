@@ -6,7 +6,18 @@ import numpy as np
 import pytest
 
 from geomlib import camera
-from geomlib.camera import PRESETS, camera_presets, look_at, orthographic, perspective, project, viewport
+from geomlib.camera import (
+    PRESETS,
+    VIEWS,
+    camera_presets,
+    look_at,
+    orthographic,
+    perspective,
+    pose_from_view,
+    project,
+    view_frame,
+    viewport,
+)
 from geomlib.validate import MeshError
 
 
@@ -179,13 +190,14 @@ def test_camera_presets_directions():
     assert eye[1] > 0 and eye[0] == eye[2] == 0
     V = look_at(eye, (0, 0, 0), up)
     assert (V[:3, :3] @ [1, 0, 0])[0] == pytest.approx(1)  # +x stays to the right in the top view
-    eye, _, _ = camera_presets("three_quarter", bounds)
-    assert eye[0] == pytest.approx(eye[2]) and eye[1] > 0
+    eye, _, _ = camera_presets("three_quarter", bounds)  # azimuth 35 degrees towards +x, elevation 25
+    d = eye / np.linalg.norm(eye)
+    assert np.degrees(np.arctan2(d[0], d[2])) == pytest.approx(35) and np.degrees(np.arcsin(d[1])) == pytest.approx(25)
 
 
 def test_camera_presets_errors():
     with pytest.raises(MeshError, match="name must be one of"):
-        camera_presets("side", np.zeros((2, 3)))
+        camera_presets("sideways", np.zeros((2, 3)))
     with pytest.raises(MeshError, match="min corner"):
         camera_presets("front", [[1, 1, 1], [0, 0, 0]])
     with pytest.raises(MeshError, match="bounds has shape"):
@@ -194,3 +206,44 @@ def test_camera_presets_errors():
 
 def test_docstring_examples():
     assert doctest.testmod(camera, raise_on_error=False).failed == 0
+
+
+# ------------------------------------------------------------------------------ one preset table
+
+
+@pytest.mark.parametrize("view", sorted(VIEWS))
+@pytest.mark.parametrize("up_axis", ["y", "z"])
+def test_rasterizer_and_renderer_share_the_view_table(view, up_axis):
+    """camera_presets (rasterizer labs) and render.camera_pose (figures) look from the same direction."""
+    from geomlib.render import camera_pose
+
+    bounds = np.array([[-1.0, -0.5, -0.2], [1.0, 0.5, 0.2]])
+    eye, target, up = camera_presets(view, bounds, up_axis=up_axis)
+    pose = camera_pose(bounds, view, up_axis=up_axis)
+    back = (eye - target) / np.linalg.norm(eye - target)
+    np.testing.assert_allclose(pose[:3, 2], back, atol=1e-12)  # the pose's +z points back at the viewer
+    # same image up, and the view matrix of the same camera is the inverse of the pose (one convention)
+    np.testing.assert_allclose(pose_from_view(look_at(eye, target, up))[:3, :3], pose[:3, :3], atol=1e-12)
+
+
+def test_view_frame_angles_and_forward():
+    az, el = VIEWS["three_quarter"]
+    back, up = view_frame("three_quarter", "y")
+    assert np.degrees(np.arctan2(back[0], back[2])) == pytest.approx(az)
+    assert np.degrees(np.arcsin(back[1])) == pytest.approx(el) and tuple(up) == (0, 1, 0)
+    # z up: the datasets face -y, so the front camera stands on -y; the top view has +y up in the image
+    assert tuple(view_frame("front", "z")[0]) == (0, -1, 0)
+    assert tuple(view_frame("top", "z")[0]) == (0, 0, 1) and tuple(view_frame("top", "z")[1]) == (0, 1, 0)
+    # a model that faces -z (spot): the front and three-quarter views stand on its -z side
+    assert tuple(view_frame("front", "y", "-z")[0]) == (0, 0, -1)
+    assert view_frame("three_quarter", "y", "-z")[0][2] < 0
+    assert tuple(view_frame("back", "y")[0]) == (0, 0, -1) and tuple(view_frame("right", "y")[0]) == (1, 0, 0)
+    with pytest.raises(MeshError, match="perpendicular"):
+        view_frame("front", "y", "-y")
+    with pytest.raises(MeshError, match="view must be one of"):
+        view_frame("diagonal")
+
+
+def test_pose_from_view_inverts_look_at():
+    V = look_at((1.0, 2.0, 3.0), (0.5, -1.0, 0.0), (0, 0, 1))
+    np.testing.assert_allclose(pose_from_view(V) @ V, np.eye(4), atol=1e-12)

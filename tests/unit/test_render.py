@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from geomlib import render as R
+from geomlib.render import shading
 from geomlib.validate import MeshError
 
 SIZE = (160, 120)  # small: OSMesa time grows with pixels (supersampled x2)
@@ -250,6 +251,9 @@ def test_egl_fallback_renders_like_osmesa(tmp_path):
         (dict(fov_deg=float("nan")), r"fov_deg must be finite"),
         (dict(light="sun"), r"light must be one of"),
         (dict(light=[{"type": "spot"}]), r"light\[0\] is a spot light and needs a 'position'"),
+        (dict(camera=((0, 0, 1), (0, 0, 1), (0, 1, 0))), r"render: camera eye .* coincide"),
+        (dict(forward="+w"), r"forward must be one of"),
+        (dict(colour=(1, 0, 0)), r"render: unknown option\(s\) \['colour'\]"),
     ],
 )
 def test_bad_input_raises_mesh_error(change, match):
@@ -261,6 +265,25 @@ def test_bad_input_raises_mesh_error(change, match):
     V_, F_ = args.pop("V"), args.pop("F")
     with pytest.raises(MeshError, match=match):
         R.render(V_, F_, **args)
+
+
+@pytest.mark.render
+def test_options_object_equals_keywords(sphere, wired):
+    """One RenderOptions object and the same names as keywords draw the same image."""
+    V, F = sphere
+    opts = R.RenderOptions(size=SIZE, wireframe=True, highlight_points=[0], point_radius=3)
+    np.testing.assert_array_equal(R.render(V, F, opts), wired)
+    np.testing.assert_array_equal(R.render(V, F, opts.replace(wireframe=False), wireframe=True), wired)
+    with pytest.raises(MeshError, match=r"unknown option\(s\) \['wire'\]"):
+        opts.replace(wire=True)
+    with pytest.raises(MeshError, match="options must be a RenderOptions"):
+        R.render(V, F, {"size": SIZE})
+
+
+def test_camera_pose_forward_axis(sphere):
+    """A model that faces -z (spot) is seen from its -z side by the front and three-quarter views."""
+    assert np.allclose(R.camera_pose(sphere[0], "front", up_axis="y", forward="-z")[:3, 2], [0, 0, -1])
+    assert R.camera_pose(sphere[0], "three_quarter", up_axis="y", forward="-z")[2, 3] < 0
 
 
 def test_render_polygons_bad_input():
@@ -278,13 +301,13 @@ def test_crease_normals_split_sharp_edges_only():
     quads = np.array([[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]])
     T = np.concatenate([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]])
     tri_n = np.cross(Vc[T[:, 1]] - Vc[T[:, 0]], Vc[T[:, 2]] - Vc[T[:, 0]])
-    vert_n = R._vertex_normals(len(Vc), T, tri_n)
-    corner = R._crease_normals(T, tri_n, vert_n, 60.0)
-    np.testing.assert_allclose(R._unit(corner), np.repeat(R._unit(tri_n), 3, axis=0), atol=1e-12)
+    vert_n = shading.vertex_normals(len(Vc), T, tri_n)
+    corner = shading.crease_normals(T, tri_n, vert_n, 60.0)
+    np.testing.assert_allclose(shading.unit(corner), np.repeat(shading.unit(tri_n), 3, axis=0), atol=1e-12)
     # Smooth sphere: neighbouring faces are ~10 degrees apart, nothing to split.
     V, F = uv_sphere(24, 48)
     tri_n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    assert R._crease_normals(F, tri_n, R._vertex_normals(len(V), F, tri_n), 60.0) is None
+    assert shading.crease_normals(F, tri_n, shading.vertex_normals(len(V), F, tri_n), 60.0) is None
 
 
 def test_auto_wire_opacity_fades_with_screen_edge_length():

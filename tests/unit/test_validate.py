@@ -132,6 +132,15 @@ def test_images():
         as_image(np.zeros((4, 4)), size=(8, 8))
     with pytest.raises(MeshError, match=r"shape \(4,\); expected an image"):
         as_image(np.zeros(4))
+    nan = np.zeros((3, 5))
+    nan[1, 2] = np.nan
+    with pytest.raises(MeshError, match=r"img has a non-finite value \(nan\) at pixel \(1, 2\); images must be finite"):
+        as_image(nan, "img")
+    with pytest.raises(MeshError, match=r"img has 7 channel\(s\) \(shape \(2, 2, 7\)\); expected 1 or 2 or 3 or 4"):
+        as_image(np.zeros((2, 2, 7)), "img")
+    assert as_image(np.zeros((2, 2, 7)), "features", channels=7).shape == (2, 2, 7)  # when asked for
+    with pytest.raises(MeshError, match="img has dtype complex128; expected numbers"):
+        as_image(np.zeros((2, 2), complex), "img")
 
 
 @pytest.mark.parametrize("n_vertices", [6, 3_000_000], ids=["packed-keys", "lexsort-fallback"])

@@ -1,19 +1,20 @@
-"""Tests for geomlib.io: mesh files (OBJ, OFF, PLY), images and float maps.
+"""Tests for geomlib.mesh_io: mesh files (OBJ, OFF, PLY).
 
 Expected values are either written out by hand next to the hand-made file they describe, or
-come from an independent reader (libigl, Pillow) on files our writers produced.
+come from an independent reader (libigl) on files our writers produced.
 """
 
 from __future__ import annotations
 
+import os
+import re
 import struct
-import zlib
 
 import numpy as np
 import pytest
-from PIL import Image
 
-from geomlib import io
+from geomlib import image_io
+from geomlib import mesh_io as io
 from geomlib.validate import MeshError
 
 # A unit square split into two triangles, and the same square as one quad.
@@ -475,8 +476,8 @@ def test_binary_ply_bad_index_names_the_face(tmp_path):
 
 
 def test_missing_file_and_unknown_extension(tmp_path):
-    for reader in (io.read_mesh, io.read_obj, io.read_off, io.read_ply, io.read_image, io.load_map):
-        missing = tmp_path / "nope" / ("x" + {io.load_map: ".npy"}.get(reader, ".obj"))
+    for reader in (io.read_mesh, io.read_obj, io.read_off, io.read_ply, image_io.read_image):
+        missing = tmp_path / "nope" / "x.obj"
         with pytest.raises(FileNotFoundError, match="nope"):
             reader(missing)
     with pytest.raises(MeshError, match=r"unsupported extension '\.stl'"):
@@ -512,138 +513,94 @@ def test_writers_reject_bad_input(tmp_path):
 
 
 # --------------------------------------------------------------------------------------------
-# Images
+# One parser per format: layouts the old fast paths sent to a slower twin
 # --------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
-@pytest.mark.parametrize("shape", [(5, 7), (5, 7, 2), (5, 7, 3), (5, 7, 4)])
-def test_png_round_trip_is_exact(tmp_path, dtype, shape):
-    img = np.random.default_rng(6).integers(0, np.iinfo(dtype).max + 1, size=shape).astype(dtype)
-    io.write_image(tmp_path / "i.png", img)
-    out = io.read_image(tmp_path / "i.png")
-    assert out.dtype == dtype and out.shape == shape
-    np.testing.assert_array_equal(out, img)
+def test_obj_corner_formats_may_mix_within_a_face(tmp_path):
+    text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 1\nvn 0 0 1\nf 1/1 2 3//1 4/2/1\n"
+    d = io.read_obj(write(tmp_path, "mix.obj", text))
+    assert d.faces.tolist() == [[0, 1, 2, 3]]
+    assert d.face_uv.tolist() == [[0, -1, -1, 1]] and d.face_normal.tolist() == [[-1, -1, 0, 0]]
 
 
-def test_16_bit_pngs_we_write_are_valid_for_pillow(tmp_path):
-    img = np.random.default_rng(7).integers(0, 65536, size=(6, 9, 3)).astype(np.uint16)
-    io.write_image(tmp_path / "rgb16.png", img)
-    with Image.open(tmp_path / "rgb16.png") as im:
-        assert im.size == (9, 6)
-        np.testing.assert_array_equal(np.asarray(im), img >> 8)  # Pillow keeps the high byte
-    io.write_image(tmp_path / "g16.png", img[:, :, 0])
-    with Image.open(tmp_path / "g16.png") as im:
-        np.testing.assert_array_equal(np.asarray(im), img[:, :, 0])
+@pytest.mark.parametrize("corner", ["1/", "/1", "1//", "1/1/", "+", "1_0", "--1"])
+def test_obj_bad_corner_tokens_are_named(tmp_path, corner):
+    path = write(tmp_path, "bad.obj", f"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\nf 1 2 3\nf 1 2 {corner}\n")
+    with pytest.raises(MeshError, match=rf"line 7: cannot read face vertex '{re.escape(corner)}'"):
+        io.read_obj(path)
 
 
-def png_encode_reference(img16, filters):
-    """Straightforward PNG encoder for 16-bit RGB with a chosen filter per row (PNG spec, sec. 9)."""
-    h, w, _ = img16.shape
-    raw = img16.astype(">u2").tobytes()
-    stride, bpp = w * 6, 6
-    out, prev = bytearray(), bytes(stride)
-    for y in range(h):
-        row = raw[y * stride : (y + 1) * stride]
-        f = filters[y]
-        out.append(f)
-        for x in range(stride):
-            a = row[x - bpp] if x >= bpp else 0
-            b = prev[x]
-            c = prev[x - bpp] if x >= bpp else 0
-            p = a + b - c
-            pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            paeth = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
-            pred = [0, a, b, (a + b) // 2, paeth][f]
-            out.append((row[x] - pred) % 256)
-        prev = row
-
-    def chunk(kind, data):
-        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
-
-    ihdr = struct.pack(">IIBBBBB", w, h, 16, 2, 0, 0, 0)
-    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(bytes(out))) + chunk(b"IEND", b"")
+def test_ply_ascii_element_with_two_lists_and_scalars_between(tmp_path):
+    head = ply_header(
+        "ascii",
+        "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n",
+        "element face 2\nproperty list uchar int vertex_indices\nproperty uchar tag\n",
+        "property list uchar float texcoord\n",
+    )
+    body = b"0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 7 6 0 0 1 0 1 1\n4 0 1 2 3 9 0\n"
+    d = io.read_ply(write(tmp_path, "two.ply", head + body))
+    assert [f.tolist() for f in d.faces] == [[0, 1, 2], [0, 1, 2, 3]]
+    bad = b"0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 7 6 0 0 1 0 1\n4 0 1 2 3 9 0\n"
+    with pytest.raises(MeshError, match=r"line 17: 'texcoord' says 6 entries, but the line has 5"):
+        io.read_ply(write(tmp_path, "bad.ply", head + bad))
 
 
-@pytest.mark.parametrize("filters", [[0] * 5, [1, 2, 1, 2, 0], [3] * 5, [4] * 5, [0, 1, 2, 3, 4]])
-def test_16_bit_png_reader_undoes_every_filter(tmp_path, filters):
-    img = np.random.default_rng(8).integers(0, 65536, size=(5, 4, 3)).astype(np.uint16)
-    img[2] = img[1]  # repeated rows and smooth parts exercise different predictor branches
-    img[:, 2] = img[:, 1] + 1
-    path = write(tmp_path, "f.png", png_encode_reference(img, filters))
-    np.testing.assert_array_equal(io.read_image(path), img)
-
-
-def test_float_images_need_bits(tmp_path):
-    img = np.linspace(0, 1, 12).reshape(3, 4)
-    with pytest.raises(MeshError, match="pass bits=8 or bits=16"):
-        io.write_image(tmp_path / "f.png", img)
-    io.write_image(tmp_path / "f8.png", img, bits=8)
-    np.testing.assert_array_equal(io.read_image(tmp_path / "f8.png"), np.round(img * 255).astype(np.uint8))
-    io.write_image(tmp_path / "f16.png", np.dstack([img] * 3), bits=16)
-    out = io.read_image(tmp_path / "f16.png", as_float=True)
-    np.testing.assert_allclose(out, np.dstack([img] * 3), atol=0.5 / 65535)
-    with pytest.raises(MeshError, match=r"value 1\.5 at pixel \(0, 0\) is outside \[0, 1\]"):
-        io.write_image(tmp_path / "f.png", img + 1.5 * (img == 0), bits=8)
-
-
-def test_write_image_rejects_bad_shapes_and_types(tmp_path):
-    p = tmp_path / "x.png"
-    with pytest.raises(MeshError, match=r"img has shape \(4,\)"):
-        io.write_image(p, np.zeros(4, np.uint8))
-    with pytest.raises(MeshError, match="img has 5 channel"):
-        io.write_image(p, np.zeros((2, 2, 5), np.uint8))
-    with pytest.raises(MeshError, match="img has dtype int64; convert it to uint8 or uint16"):
-        io.write_image(p, np.zeros((2, 2), np.int64))
-    with pytest.raises(MeshError, match="does not fit 8 bits"):
-        io.write_image(p, np.full((2, 2), 300), bits=8)
-    with pytest.raises(MeshError, match="16-bit images can only be written as .png"):
-        io.write_image(tmp_path / "x.jpg", np.zeros((2, 2), np.uint16))
-    with pytest.raises(MeshError, match="img is uint8 but bits=16"):
-        io.write_image(p, np.zeros((2, 2), np.uint8), bits=16)
-    io.write_image(p, np.full((2, 3), 200), bits=8)  # plain ints are fine once bits says how
-    assert io.read_image(p).tolist() == [[200] * 3] * 2
-
-
-def test_read_image_via_pillow_formats(tmp_path):
-    rgb = np.random.default_rng(9).integers(0, 256, size=(4, 6, 3)).astype(np.uint8)
-    io.write_image(tmp_path / "x.bmp", rgb)
-    np.testing.assert_array_equal(io.read_image(tmp_path / "x.bmp"), rgb)
-    Image.fromarray(rgb).convert("P").save(tmp_path / "pal.png")  # palette image comes back as RGB
-    assert io.read_image(tmp_path / "pal.png").shape == (4, 6, 3)
-    with pytest.raises(MeshError, match="not an image file"):
-        io.read_image(write(tmp_path, "junk.png", b"definitely not a png"))
+@pytest.mark.parametrize("count", [2**31 - 1, 2**32 - 1])
+def test_binary_ply_huge_list_count_is_a_clear_error(tmp_path, count):
+    head = ply_header(
+        "binary_little_endian",
+        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n",
+        "element face 1\nproperty list uint int vertex_indices\n",
+    )
+    body = np.zeros((3, 3), "<f4").tobytes() + struct.pack("<Iiii", count, 0, 1, 2)
+    with pytest.raises(MeshError, match=rf"'face' record 1 of 1 .*says {count} entries .* list length is corrupt"):
+        io.read_ply(write(tmp_path, "huge.ply", head + body))
 
 
 # --------------------------------------------------------------------------------------------
-# Float maps
+# Not a file: folders and FIFOs get a clear error instead of IsADirectoryError or a hang
 # --------------------------------------------------------------------------------------------
 
 
-def test_float_maps_round_trip(tmp_path):
-    rng = np.random.default_rng(10)
-    disp = rng.normal(size=(8, 8)).astype(np.float32)
-    normal = rng.normal(size=(8, 8, 3))
-    io.save_map(tmp_path / "d.npy", disp)
-    out = io.load_map(tmp_path / "d.npy")
-    assert out.dtype == np.float32
-    np.testing.assert_array_equal(out, disp)
-    io.save_map(tmp_path / "m.npz", disp=disp, normal=normal)
-    maps = io.load_map(tmp_path / "m.npz")
-    assert sorted(maps) == ["disp", "normal"]
-    np.testing.assert_array_equal(maps["normal"], normal)
-    np.testing.assert_array_equal(io.load_map(tmp_path / "m.npz", "disp"), disp)
-    io.save_map(tmp_path / "c.npz", disp, compress=True)
-    np.testing.assert_array_equal(io.load_map(tmp_path / "c.npz", "map"), disp)
+@pytest.mark.parametrize("reader", ["read_mesh", "read_obj", "read_off", "read_ply", "read_image"])
+def test_folders_and_fifos_are_refused(tmp_path, reader):
+    fn = getattr(image_io if reader == "read_image" else io, reader)
+    folder = tmp_path / "mesh.obj"
+    folder.mkdir()
+    with pytest.raises(MeshError, match=rf"{reader}: .*mesh.obj is a folder"):
+        fn(folder)
+    if not hasattr(os, "mkfifo"):
+        return
+    fifo = tmp_path / "pipe.ply"
+    os.mkfifo(fifo)
+    with pytest.raises(MeshError, match=rf"{reader}: .*pipe.ply is a FIFO"):
+        fn(fifo)  # would block forever in open() if the FIFO were opened
 
 
-def test_float_map_errors(tmp_path):
-    with pytest.raises(MeshError, match="a .npy file holds one array"):
-        io.save_map(tmp_path / "x.npy", np.zeros(2), other=np.zeros(2))
-    with pytest.raises(MeshError, match="use .npy or .npz"):
-        io.save_map(tmp_path / "x.png", np.zeros(2))
-    with pytest.raises(MeshError, match="must be a numeric array"):
-        io.save_map(tmp_path / "x.npy", np.array(["a"]))
-    io.save_map(tmp_path / "m.npz", a=np.zeros(2))
-    with pytest.raises(MeshError, match=r"has no array 'b' \(it has: a\)"):
-        io.load_map(tmp_path / "m.npz", "b")
+# --------------------------------------------------------------------------------------------
+# Why the readers are our own: what the well-kept libraries keep of the same small file
+# --------------------------------------------------------------------------------------------
+
+SEAM_OBJ = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0.5 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvt 0.5 0.5\n"
+SEAM_OBJ += "f 1/1 2/2 3/3 4/4\nf 2/5 5/2 3/1\n"  # a quad and a triangle; vertices 2 and 3 sit on a UV seam
+
+
+def test_why_not_a_library(tmp_path):
+    """We keep polygons, vertex identity and per-corner UVs; trimesh, libigl and pyvista do not.
+
+    If this test starts failing because a library now keeps all three, switch read_obj to it.
+    """
+    path = write(tmp_path, "seam.obj", SEAM_OBJ)
+    d = io.read_obj(path)
+    assert len(d.V) == 5 and [f.tolist() for f in d.faces] == [[0, 1, 2, 3], [1, 4, 2]]
+    assert [f.tolist() for f in d.face_uv] == [[0, 1, 2, 3], [4, 1, 0]]
+
+    trimesh = pytest.importorskip("trimesh")
+    t = trimesh.load(str(path), process=False, force="mesh")
+    assert t.faces.shape == (3, 3) and len(t.vertices) == 7  # triangulated, seam vertices split
+    igl = pytest.importorskip("igl")
+    assert igl.read_triangle_mesh(str(path))[1].shape == (3, 3)  # triangulated
+    pv = pytest.importorskip("pyvista")
+    m = pv.read(str(path))
+    assert m.n_points == 7  # polygons kept, but seam vertices split (per-point UVs)

@@ -1,0 +1,117 @@
+"""The headless OpenGL context: platform choice (OSMesa or Mesa EGL), pyrender import, renderer cache.
+
+Importing this module imports neither pyrender nor OpenGL; :func:`import_pyrender` does, after
+:func:`backend` has chosen a headless platform. One ``OffscreenRenderer`` is kept per image size.
+"""
+
+from __future__ import annotations
+
+import atexit
+import ctypes.util
+import os
+import sys
+
+import numpy as np
+
+__all__ = ["backend", "import_pyrender", "offscreen_renderer", "close"]
+
+_HEADLESS_FIX = (
+    "install OSMesa (`sudo apt-get install libosmesa6` on Debian/Ubuntu), or a Mesa EGL driver "
+    "(`sudo apt-get install libegl1 libgl1-mesa-dri`) and set PYOPENGL_PLATFORM=egl"
+)
+
+
+def backend() -> str:
+    """The headless OpenGL platform used for rendering: ``"osmesa"``, ``"egl"``, or the user's choice.
+
+    A ``PYOPENGL_PLATFORM`` already set in the environment is respected. Otherwise OSMesa is used
+    when ``libOSMesa`` is found, else Mesa EGL when ``libEGL`` is found, and the choice is written
+    to ``os.environ["PYOPENGL_PLATFORM"]`` (PyOpenGL reads it once, at import).
+
+    Returns
+    -------
+    str
+        The value of ``PYOPENGL_PLATFORM``.
+
+    Raises
+    ------
+    RuntimeError
+        When no headless OpenGL library is installed, or OpenGL was imported before a platform
+        was chosen. The message names the fix.
+    """
+    chosen = os.environ.get("PYOPENGL_PLATFORM")
+    if chosen:
+        return chosen
+    if "OpenGL.platform" in sys.modules:
+        raise RuntimeError(
+            "geomlib.render: PyOpenGL was imported before a headless platform was chosen, so it uses an "
+            "on-screen platform. Set the environment variable PYOPENGL_PLATFORM=osmesa (or egl) before "
+            "starting Python, or import geomlib.render before anything that imports OpenGL."
+        )
+    if ctypes.util.find_library("OSMesa"):
+        chosen = "osmesa"
+    elif ctypes.util.find_library("EGL"):
+        chosen = "egl"
+    else:
+        raise RuntimeError(
+            f"geomlib.render: no headless OpenGL library found (neither libOSMesa nor libEGL). Fix: {_HEADLESS_FIX}"
+        )
+    os.environ["PYOPENGL_PLATFORM"] = chosen
+    return chosen
+
+
+def import_pyrender():
+    """Import and return the ``pyrender`` module, after choosing the headless platform (see :func:`backend`).
+
+    Use this (never a bare ``import pyrender``) in code that builds its own pyrender scenes, e.g.
+    cross-checks against pyrender's shadow maps, so the platform and the NumPy shim are in place.
+    """
+    backend()
+    if not hasattr(np, "infty"):
+        # Compatibility shim, the only one in the project: pyrender 0.1.45 (its latest release) still
+        # uses np.infty in Mesh.bounds, an alias removed in NumPy 2.0.
+        np.infty = np.inf  # noqa: NPY201 (setting the alias, not using it)
+    import pyrender
+
+    return pyrender
+
+
+_RENDERERS: dict[tuple[int, int], object] = {}
+
+
+def offscreen_renderer(width: int, height: int):
+    """The shared ``pyrender.OffscreenRenderer`` for this framebuffer size, created on first use.
+
+    Creating an OpenGL context is costly, so one per size is kept for the whole process and freed
+    at exit (:func:`close`). Do not call ``delete()`` on it.
+
+    Raises
+    ------
+    RuntimeError
+        When no headless OpenGL context can be created (the message names the fix).
+    """
+    r = _RENDERERS.get((width, height))
+    if r is None:
+        pyrender = import_pyrender()
+        try:
+            r = pyrender.OffscreenRenderer(width, height)
+        except Exception as e:
+            raise RuntimeError(
+                f"geomlib.render: could not create a headless OpenGL context with PYOPENGL_PLATFORM="
+                f"{os.environ.get('PYOPENGL_PLATFORM')!r} ({type(e).__name__}: {e}). Fix: {_HEADLESS_FIX}"
+            ) from e
+        _RENDERERS[(width, height)] = r
+    return r
+
+
+def close() -> None:
+    """Free every cached OpenGL context (called automatically at exit)."""
+    while _RENDERERS:
+        _, r = _RENDERERS.popitem()
+        try:
+            r.delete()
+        except Exception:  # the context may already be gone at interpreter shutdown
+            pass
+
+
+atexit.register(close)
