@@ -18,6 +18,7 @@ from geomlib.render.options import RenderOptions, _as_rgb, _as_texture, check_op
 from geomlib.render.overlay import auto_wire_opacity, overlay
 from geomlib.render.scene import Surface, add_floor, add_surface, normalised_frame
 from geomlib.render.shading import vertex_normals
+from geomlib.halfedge import next_corners
 from geomlib.validate import MeshError, as_array, check_choice, check_mesh, check_polygon_mesh
 
 __all__ = ["render", "render_polygons"]
@@ -96,8 +97,7 @@ def render_polygons(V, faces, options: RenderOptions | None = None, /, **overrid
     T, src = topology.triangulate_polygons((idx, off))
     # Newell normal of each polygon (twice its vector area), robust for non-planar polygons.
     lens = np.diff(off)
-    nxt = np.arange(len(idx)) + 1
-    nxt[off[1:] - 1] = off[:-1]
+    nxt = next_corners(off)  # the one half-edge convention (geomlib.halfedge)
     a, b = V[idx], V[idx[nxt]]
     cr = np.cross(a, b)
     poly_n = np.add.reduceat(cr, off[:-1], axis=0) if m else np.zeros((0, 3))
