@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib import topology
+from geomlib.halfedge import next_corners
 from geomlib.render.cameras import resolve_camera
 from geomlib.render.context import import_pyrender, offscreen_renderer
 from geomlib.render.lights import add_lights, light_specs
@@ -18,7 +19,6 @@ from geomlib.render.options import RenderOptions, _as_rgb, _as_texture, check_op
 from geomlib.render.overlay import auto_wire_opacity, overlay
 from geomlib.render.scene import Surface, add_floor, add_surface, normalised_frame
 from geomlib.render.shading import vertex_normals
-from geomlib.halfedge import next_corners
 from geomlib.validate import MeshError, as_array, check_choice, check_mesh, check_polygon_mesh
 
 __all__ = ["render", "render_polygons"]
