@@ -42,6 +42,9 @@ __all__ = [
     "line_plot",
     "save_png",
     "write_index",
+    "lab_package",
+    "missing_task_figure",
+    "figures_or_placeholders",
 ]
 
 
@@ -52,7 +55,8 @@ class Figure:
     Attributes
     ----------
     path : Path
-        The PNG file.
+        The PNG file, or an ``.html`` interactive 3D view (:mod:`geomlib.viewer`), which the index
+        shows in a frame across the page.
     caption : str
         One or two sentences saying what the figure shows.
     lab : str
@@ -575,6 +579,96 @@ def save_png(path, image) -> Path:
 
 
 # --------------------------------------------------------------------------------------------
+# Lab figures on partial work
+# --------------------------------------------------------------------------------------------
+
+
+def lab_package(lab, package: str):
+    """The lab whose functions a ``make_figures`` draws: ``lab`` (a module) or the package ``package``.
+
+    Every lab's ``make_figures(out_dir, lab=None, quick=False)`` takes ``lab`` the same way: a module
+    that provides the lab's public functions (``solutions.<lab>``, ``labs.<lab>``, a submission
+    loaded as a module); None means the package the figures file lives in.
+    """
+    import importlib
+    import types
+
+    if lab is None:
+        return importlib.import_module(package)
+    if not isinstance(lab, types.ModuleType):
+        raise MeshError(
+            f"make_figures: lab must be a module providing the lab's functions (or None), got {type(lab).__name__}"
+        )
+    return lab
+
+
+def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "") -> Figure:
+    """A placeholder figure saying which task is missing, written where the real figure would go.
+
+    Parameters
+    ----------
+    path : str or Path
+        The PNG to write (the name the finished figure will have).
+    error : NotImplementedError
+        Raised by a stub; its message starts with the task (``"Task 2 (even vertices): ..."``).
+    lab : str
+        The lab name for the figure record.
+    what : str
+        What the figure will show once the task is done (goes into the caption).
+    """
+    import re
+
+    msg = str(error).strip() or type(error).__name__
+    m = re.search(r"Task\s+(\d+[a-z]?)", msg)
+    head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
+    blank = np.full((160, 560, 3), 244, dtype=np.uint8)
+    img = panels([blank], [msg if len(msg) <= 300 else msg[:297] + "..."], title=Path(path).stem, font_size=14)
+    # Write the head into the grey box too, so a thumbnail still says it.
+    from PIL import Image, ImageDraw
+
+    page = Image.fromarray(img)
+    draw = ImageDraw.Draw(page)
+    font = _font(22, bold=True)
+    w = draw.textlength(head, font=font)
+    top = img.shape[0] // 2 - 40
+    draw.text(((img.shape[1] - w) / 2, top), head, fill=(150, 40, 30), font=font)
+    path = save_png(path, np.asarray(page))
+    caption = f"{head}, so {Path(path).name} cannot be drawn yet" + (f" (it will show {what})" if what else "") + f". {msg}"
+    return Figure(path, caption, lab)
+
+
+def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Figure]:
+    """Run figure builders; a builder stopped by a missing task gives a placeholder figure instead.
+
+    Parameters
+    ----------
+    builders : sequence of callables
+        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them. The placeholder
+        goes to ``out_dir / "<name>.png"``, where ``<name>`` is the builder's ``figure_name``
+        attribute or its name without the ``fig_`` / ``_fig_`` / ``_`` prefix.
+    out_dir : Path
+    lab_name : str
+    *args
+        Passed on to every builder.
+
+    Returns
+    -------
+    list of Figure
+        In builder order; students see every figure their finished tasks allow, and one
+        "Task N not implemented yet" picture for each of the others.
+    """
+    figures: list[Figure] = []
+    for build in builders:
+        try:
+            out = build(out_dir, *args)
+        except NotImplementedError as e:
+            name = getattr(build, "figure_name", None) or build.__name__.removeprefix("_").removeprefix("fig_")
+            out = missing_task_figure(Path(out_dir) / f"{name}.png", e, lab_name)
+        figures.extend(out if isinstance(out, list) else [out])
+    return figures
+
+
+# --------------------------------------------------------------------------------------------
 # Index pages
 # --------------------------------------------------------------------------------------------
 
@@ -589,6 +683,8 @@ figure { margin: 0; background: #fff; border: 1px solid #e3e3e3; border-radius: 
 figure img { width: 100%; height: auto; display: block; }
 figcaption { font-size: 0.9rem; line-height: 1.35; margin-top: 0.5rem; color: #333; }
 figcaption code { font-size: 0.8rem; color: #777; }
+figure.wide { grid-column: 1 / -1; }
+figure iframe { width: 100%; height: 480px; border: 0; display: block; }
 """
 
 
@@ -657,6 +753,14 @@ def write_index(figures: Sequence[Figure], out_dir, *, title: str = "Course figu
             rel = _rel(f.path, out)
             src = html.escape(rel, quote=True)
             cap = html.escape(f.caption)
+            if f.path.suffix.lower() == ".html":  # an interactive 3D view (geomlib.viewer): the page in a frame
+                h.append(
+                    f'<figure class="wide"><iframe src="{src}" title="{html.escape(f.caption, quote=True)}" '
+                    f'loading="lazy"></iframe><figcaption>{cap} <a href="{src}">Open it alone</a>.<br>'
+                    f"<code>{html.escape(rel)}</code></figcaption></figure>"
+                )
+                md += [f"[Interactive 3D view: {rel}]({rel.replace(' ', '%20')})", "", f"*{f.caption}*", ""]
+                continue
             h.append(
                 f'<figure><a href="{src}"><img src="{src}" alt="{html.escape(f.caption, quote=True)}" loading="lazy"></a>'
                 f"<figcaption>{cap}<br><code>{html.escape(rel)}</code></figcaption></figure>"

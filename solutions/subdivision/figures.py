@@ -12,8 +12,20 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
+from geomlib.plot import (
+    Figure,
+    colorbar,
+    figures_or_placeholders,
+    heat_colors,
+    lab_package,
+    line_plot,
+    panels,
+    save_png,
+)
 from geomlib.render import camera_pose, render, render_polygons
+from geomlib.viewer import write_html
+
+__all__ = ["make_figures", "airplane"]
 
 LAB = "subdivision"
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the difference vanishes
@@ -223,28 +235,56 @@ def fig_convergence(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+def fig_view(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, _ = _functions(lab)
+    V, F = airplane()
+    levels = 1 if quick else 2
+    Vs, Fs = loop_subdivide(V, F, levels=levels)
+    path = write_html(
+        out / "subdivision_3d.html", Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z"
+    )
+    return Figure(
+        path,
+        f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wing tips and the "
+        "open edges keep their boundary curves.",
+        LAB,
+    )
+
+
+#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
+fig_loop_levels.figure_name = "loop_levels"
+fig_weights.figure_name = "warren_vs_loop"
+fig_catmull_clark.figure_name = "catmull_clark_levels"
+fig_boundary.figure_name = "boundary"
+fig_convergence.figure_name = "convergence"
+fig_view.figure_name = "subdivision_3d"
+
+
 def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir``.
+    """Render the lab's figures into ``out_dir`` and return them with their captions.
 
     Parameters
     ----------
     out_dir : str or Path
         Folder for the PNG files (created if missing).
     lab : module, optional
-        A lab module providing ``loop_subdivide`` and ``catmull_clark`` (default: this package).
+        The lab package whose functions the figures draw (``solutions.subdivision``, ``labs.subdivision``, a
+        submission); default: the package this file is in, so in ``labs/subdivision/`` your own code.
     quick : bool
         Fewer levels and smaller images (for notebooks and smoke tests).
 
     Returns
     -------
     list of Figure
+        Every figure; one whose tasks are not implemented yet is a picture saying
+        "Task N not implemented yet" (under the same file name).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    return [
-        fig_loop_levels(out, lab, quick),
-        fig_weights(out, lab, quick),
-        fig_catmull_clark(out, lab, quick),
-        fig_boundary(out, lab, quick),
-        fig_convergence(out, lab, quick),
-    ]
+    return figures_or_placeholders(
+        (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence, fig_view),
+        out,
+        LAB,
+        lab_package(lab, __package__),
+        quick,
+    )

@@ -18,17 +18,13 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.plot import Figure, line_plot, panels, save_png
-
-from .features import sharp_features
-from .grid import grid_faces, uniform_grid, valid_diagonals
-from .importance import area_density, importance_field, vertex_importance
-from .parameterize import parameterize_square
-from .shapes import open_box
-from .transport import transport_grid
-from .vdm import bake_vdm, vdm_to_mesh
+from geomlib.plot import Figure, figures_or_placeholders, lab_package, line_plot, panels, save_png
+from geomlib.viewer import write_html
 
 __all__ = ["make_figures"]
+
+#: The lab package whose functions the figures draw (set by :func:`make_figures`).
+_L = None
 
 LAB = "vdm"
 STAGES = {
@@ -109,13 +105,13 @@ def _pipeline(out: Path, quick: bool) -> Figure:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     px = 180 if quick else 220
-    UV = parameterize_square(V, F)
-    imp = vertex_importance(V, F)
-    fld = importance_field(UV, imp, 64, density=area_density(V, F, UV, 64))
-    G0 = uniform_grid(res)
-    G = transport_grid(fld, res)
-    edges, corners = sharp_features(V, F)
-    vdm = bake_vdm(V, F, res, UV=UV)
+    UV = _L.parameterize_square(V, F)
+    imp = _L.vertex_importance(V, F)
+    fld = _L.importance_field(UV, imp, 64, density=_L.area_density(V, F, UV, 64))
+    G0 = _L.uniform_grid(res)
+    G = _L.transport_grid(fld, res)
+    edges, corners = _L.sharp_features(V, F)
+    vdm = _L.bake_vdm(V, F, res, UV=UV)
 
     mesh_img = _render(V, F, (px * 4 // 3, px))
     fig, ax = _canvas(px)
@@ -169,11 +165,11 @@ def _rock_reconstruction(out: Path, quick: bool) -> Figure:
     res = 16 if quick else 32
     size = (300, 225) if quick else (420, 315)
     ns = 5000 if quick else 30000
-    UV = parameterize_square(V, F)
+    UV = _L.parameterize_square(V, F)
     imgs, caps = [_render(V, F, size)], [f"original ({len(F)} triangles)"]
     for name in ("naive", "+diagonals"):
-        vdm = bake_vdm(V, F, res, UV=UV, **STAGES[name])
-        Vr, Fr = vdm_to_mesh(vdm)
+        vdm = _L.bake_vdm(V, F, res, UV=UV, **STAGES[name])
+        Vr, Fr = _L.vdm_to_mesh(vdm)
         h, c = _errors(V, F, Vr, Fr, ns)
         imgs.append(_render(Vr, Fr, size, wireframe=True, edge_width=0.6))
         label = "naive (uniform grid)" if name == "naive" else "optimised (density + alignment + diagonals)"
@@ -189,15 +185,15 @@ def _rock_reconstruction(out: Path, quick: bool) -> Figure:
 
 
 def _box_stages(out: Path, quick: bool) -> Figure:
-    V, F = open_box(8)
+    V, F = _L.open_box(8)
     res = 16
     size = (280, 210) if quick else (340, 255)
     ns = 5000 if quick else 20000
-    UV = parameterize_square(V, F)
+    UV = _L.parameterize_square(V, F)
     imgs, caps = [], []
     for name, st in STAGES.items():
-        vdm = bake_vdm(V, F, res, UV=UV, **st)
-        Vr, Fr = vdm_to_mesh(vdm)
+        vdm = _L.bake_vdm(V, F, res, UV=UV, **st)
+        Vr, Fr = _L.vdm_to_mesh(vdm)
         h, c = _errors(V, F, Vr, Fr, ns)
         imgs.append(_render(Vr, Fr, size, wireframe=True, edge_width=0.7))
         caps.append(f"{name}: Hausdorff {h:.1e}, Chamfer {c:.1e}")
@@ -213,21 +209,21 @@ def _box_stages(out: Path, quick: bool) -> Figure:
 
 
 def _diagonals(out: Path, quick: bool) -> Figure:
-    V, F = open_box(8)
+    V, F = _L.open_box(8)
     res = 16
     px = 260 if quick else 340
-    UV = parameterize_square(V, F)
-    edges, _ = sharp_features(V, F)
-    vdm = bake_vdm(V, F, res, UV=UV)
+    UV = _L.parameterize_square(V, F)
+    edges, _ = _L.sharp_features(V, F)
+    vdm = _L.bake_vdm(V, F, res, UV=UV)
     G = vdm.grid_uv
     imgs, caps = [], []
-    for name, diag in (("global", valid_diagonals(G)), ("per-quad", vdm.diagonals)):
-        T = grid_faces(res, diag)
+    for name, diag in (("global", _L.valid_diagonals(G)), ("per-quad", vdm.diagonals)):
+        T = _L.grid_faces(res, diag)
         P = G.reshape(-1, 2)
         fig, ax = _canvas(px)
         ax.triplot(P[:, 0], P[:, 1], T, color="#1f3b73", lw=0.6)
         _draw_sharp(ax, UV, edges, lw=1.6)
-        flipped = np.flatnonzero(~diag.ravel() != ~valid_diagonals(G).ravel()) if name == "per-quad" else []
+        flipped = np.flatnonzero(~diag.ravel() != ~_L.valid_diagonals(G).ravel()) if name == "per-quad" else []
         for c in flipped:
             i, j = divmod(int(c), res - 1)
             quad = G[[i, i, i + 1, i + 1], [j, j + 1, j + 1, j]]
@@ -240,7 +236,7 @@ def _diagonals(out: Path, quick: bool) -> Figure:
         )
         from dataclasses import replace
 
-        Vr, Fr = vdm_to_mesh(replace(vdm, diagonals=diag))
+        Vr, Fr = _L.vdm_to_mesh(replace(vdm, diagonals=diag))
         # Close-up of the vertical crease above the rim corner (1, 0, 0), which runs along the cells'
         # b-d diagonals in uv.
         eye, target = (1.75, -0.75, 0.55), (1.0, 0.0, 0.22)
@@ -262,12 +258,12 @@ def _background_sweep(out: Path, quick: bool) -> Figure:
     res = 16 if quick else 32
     px = 160 if quick else 190
     values = [0.01, 0.3, 5.0] if quick else [0.01, 0.1, 0.3, 1.0, 5.0]
-    UV = parameterize_square(V, F)
-    edges, _ = sharp_features(V, F)
+    UV = _L.parameterize_square(V, F)
+    edges, _ = _L.sharp_features(V, F)
     imgs, caps, haus, cham = [], [], [], []
     for bg in values:
-        vdm = bake_vdm(V, F, res, UV=UV, background=bg)
-        h, c = _errors(V, F, *vdm_to_mesh(vdm), 5000 if quick else 20000)
+        vdm = _L.bake_vdm(V, F, res, UV=UV, background=bg)
+        h, c = _errors(V, F, *_L.vdm_to_mesh(vdm), 5000 if quick else 20000)
         haus.append(h)
         cham.append(c)
         fig, ax = _canvas(px)
@@ -298,14 +294,51 @@ def _background_sweep(out: Path, quick: bool) -> Figure:
     )
 
 
-def make_figures(out_dir: Path, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them (with captions)."""
+def _fig_view(out: Path, quick: bool) -> Figure:
+    V, F = datasets.rock_on_plinth(32 if quick else 48)
+    res = 32 if quick else 64
+    Vr, Fr = _L.vdm_to_mesh(_L.bake_vdm(V, F, res, UV=_L.parameterize_square(V, F)))
+    path = write_html(out / "vdm_3d.html", Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z")
+    return Figure(
+        path,
+        f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
+        "gather on the crease of the plinth and follow it.",
+        LAB,
+    )
+
+
+#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
+_pipeline.figure_name = "vdm_pipeline"
+_rock_reconstruction.figure_name = "vdm_rock_naive_vs_optimised"
+_box_stages.figure_name = "vdm_box_stages"
+_diagonals.figure_name = "vdm_diagonals"
+_background_sweep.figure_name = "vdm_background_sweep"
+_fig_view.figure_name = "vdm_3d"
+
+
+def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
+    """Render the lab's figures into ``out_dir`` and return them with their captions.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Folder for the PNG files (created if missing).
+    lab : module, optional
+        The lab package whose functions the figures draw (``solutions.vdm``, ``labs.vdm``, a
+        submission); default: the package this file is in, so in ``labs/vdm/`` your own code.
+    quick : bool
+        Smaller meshes, grids and images (for the notebook and tests).
+
+    Returns
+    -------
+    list of Figure
+        Every figure; one whose tasks are not implemented yet is a picture saying
+        "Task N not implemented yet" (under the same file name).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    figures = []
-    for build in (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep):
-        try:
-            figures.append(build(out, quick))
-        except NotImplementedError as e:  # a student's copy before the tasks are done
-            print(f"skipped {build.__name__.strip('_')}: {e}")
-    return figures
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders(
+        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep, _fig_view), out, LAB, quick
+    )
