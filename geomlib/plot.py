@@ -633,7 +633,9 @@ def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "")
     top = img.shape[0] // 2 - 40
     draw.text(((img.shape[1] - w) / 2, top), head, fill=(150, 40, 30), font=font)
     path = save_png(path, np.asarray(page))
-    caption = f"{head}, so {Path(path).name} cannot be drawn yet" + (f" (it will show {what})" if what else "") + f". {msg}"
+    caption = (
+        f"{head}, so {Path(path).name} cannot be drawn yet" + (f" (it will show {what})" if what else "") + f". {msg}"
+    )
     return Figure(path, caption, lab)
 
 
