@@ -39,6 +39,7 @@ __all__ = [
     "colorbar",
     "heat_colors",
     "heatmap_image",
+    "with_colorbar",
     "line_plot",
     "save_png",
     "write_index",
@@ -438,6 +439,24 @@ def colorbar(
 # --------------------------------------------------------------------------------------------
 
 
+def with_colorbar(image, bar, *, gap: int = 6, background=(255, 255, 255)) -> np.ndarray:
+    """Put a colour bar right beside its heat-map image (vertically centred), as one image.
+
+    Use it instead of giving the bar its own :func:`panels` cell, which would be as wide as the
+    largest panel and leave a blank column.
+    """
+    a = to_rgb8(image, "image", where="with_colorbar")
+    b = to_rgb8(bar, "bar", where="with_colorbar")
+    h = max(a.shape[0], b.shape[0])
+
+    out = np.empty((h, a.shape[1] + gap + b.shape[1], 3), np.uint8)
+    out[:] = np.asarray(background, np.uint8)
+    ta, tb = (h - a.shape[0]) // 2, (h - b.shape[0]) // 2
+    out[ta : ta + a.shape[0], : a.shape[1]] = a
+    out[tb : tb + b.shape[0], a.shape[1] + gap :] = b
+    return out
+
+
 def line_plot(
     xs_list,
     ys_list,
@@ -451,6 +470,7 @@ def line_plot(
     size: tuple[int, int] = (640, 420),
     dpi: int = 100,
     markers: bool = True,
+    legend: str = "below",
 ) -> np.ndarray:
     """Plot one or more curves (convergence, timings, error vs. level) to an image.
 
@@ -469,15 +489,23 @@ def line_plot(
     dpi : int
         Resolution used to size the text.
     markers : bool
-        Mark the data points.
+        Mark the data points. Every curve gets its own marker and dash pattern, and earlier curves
+        are drawn on top, so curves that coincide stay distinguishable.
+    legend : {"below", "inside"}
+        Legend under the axes (never over the curves), or matplotlib's best spot inside.
 
     Returns
     -------
     (height, width, 3) uint8
+
+    Notes
+    -----
+    Log axes are labelled with plain numbers (``0.6``, ``2``, ``50``), not ``6×10⁻¹``.
     """
     import matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as MplFigure
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     where = "line_plot"
     if len(xs_list) and np.ndim(xs_list[0]) == 0:
@@ -511,6 +539,8 @@ def line_plot(
     w = check_int(size[0], "size[0]", minimum=64, maximum=8192, where=where)
     h = check_int(size[1], "size[1]", minimum=64, maximum=8192, where=where)
     dpi = check_int(dpi, "dpi", minimum=20, maximum=600, where=where)
+    if legend not in ("below", "inside"):
+        raise MeshError(f"{where}: legend must be 'below' or 'inside', got {legend!r}")
 
     style = {
         "svg.hashsalt": "geomlib",
@@ -526,20 +556,39 @@ def line_plot(
         fig = MplFigure(figsize=(w / dpi, h / dpi), dpi=dpi, facecolor="white")
         canvas = FigureCanvasAgg(fig)
         ax = fig.add_subplot(1, 1, 1)
+        shapes, dashes = "osD^vP*X", ["-", "--", "-.", ":"]
         for i, (x, y) in enumerate(curves):
             ax.plot(
-                x, y, marker="o" if markers else None, markersize=4, linewidth=1.8, label=labels[i] if labels else None
+                x,
+                y,
+                marker=shapes[i % len(shapes)] if markers else None,
+                markersize=4 + 1.5 * (i % 3),
+                markerfacecolor="none" if i else None,
+                linestyle=dashes[i % len(dashes)],
+                linewidth=2.2 if i == 0 else 1.5,
+                zorder=10 + len(curves) - i,
+                label=labels[i] if labels else None,
             )
-        if logy:
-            ax.set_yscale("log")
-        if logx:
-            ax.set_xscale("log")
+
+        def plain(v, _pos):
+            return f"{v:.10g}"
+
+        for axis, log in ((ax.xaxis, logx), (ax.yaxis, logy)):
+            if log:
+                (ax.set_xscale if axis is ax.xaxis else ax.set_yscale)("log")
+                axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+                axis.set_major_formatter(FuncFormatter(plain))
+                axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         if title:
             ax.set_title(title)
-        if labels:
+        if labels and legend == "inside":
             ax.legend(frameon=False)
+        elif labels:
+            ax.legend(
+                frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=min(3, len(labels)), fontsize=9
+            )
         fig.tight_layout()
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[:, :, :3].copy()

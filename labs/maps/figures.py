@@ -109,7 +109,7 @@ def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
         caps = [
             f"plain: {len(F):,} faces, smooth normals",
             f"normal-mapped: the same {len(F):,} faces, per-pixel normals from the {s}x{s} map",
-            f"displaced: {len(Fd):,} faces moved by lam * h along the normal",
+            f"displaced: {len(Fd):,} faces moved by λh along the normal",
         ]
         if name == "mapped_vs_displaced":
             imgs = [_thumb(_grey(H), size), _thumb(_L.encode_normal_map(nmap), size)] + imgs
@@ -145,9 +145,9 @@ def _fig_bias_scale(out: Path, quick: bool) -> Figure:
         rad = np.linalg.norm(Vd, axis=1)
         imgs.append(render(Vd, F, camera="three_quarter", up_axis="z", size=(size, size)))
         caps.append(
-            f"(bias, scale) = ({bias:g}, {scale:g}): offsets lam * [{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
+            f"(bias, scale) = ({bias:g}, {scale:g}): offsets λ·[{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
         )
-    img = panels(imgs, caps, ncols=4, title="Displacement P' = P + lam (bias + scale h) n, lam = 0.12")
+    img = panels(imgs, caps, ncols=4, title="Displacement P' = P + λ (bias + scale h) n, λ = 0.12")
     path = save_png(out / "bias_scale.png", img)
     return Figure(
         path,
@@ -194,10 +194,14 @@ def _fig_bake(out: Path, quick: bool) -> list[Figure]:
         f"decimated + baked {s}x{s} normal map",
         f"original: {len(Fh):,} faces",
     ]
+    # Texels outside every chart would be flat-normal lilac like the flat areas: paint them dark grey.
+    shown = np.array(enc[..., :3], dtype=np.uint8, copy=True)
+    shown[~np.asarray(mask, bool)] = (70, 70, 70)
     img = panels(
-        [_thumb(enc, size)] + shots["key"],
+        [_thumb(shown, size)] + shots["key"],
         [
-            f"baked normal map, one chart per triangle ({100 * mask.mean():.0f}% of texels inside charts; flat areas are lilac)"
+            f"baked normal map, one chart per triangle: {100 * mask.mean():.0f}% of texels inside charts "
+            "(dark grey: unused), flat areas lilac"
         ]
         + caps,
         ncols=4,
