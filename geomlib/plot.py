@@ -573,10 +573,14 @@ def line_plot(
         def plain(v, _pos):
             return f"{v:.10g}"
 
-        for axis, log in ((ax.xaxis, logx), (ax.yaxis, logy)):
+        for k, (axis, log) in enumerate(((ax.xaxis, logx), (ax.yaxis, logy))):
             if log:
                 (ax.set_xscale if axis is ax.xaxis else ax.set_yscale)("log")
-                axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+                values = np.concatenate([c[k] for c in curves])
+                decades = np.log10(values.max() / values.min()) if len(values) else 0.0
+                # 1-2-5 ticks over short ranges; only powers of ten where those would crowd.
+                subs = (1.0, 2.0, 5.0) if decades <= 1.6 else (1.0,)
+                axis.set_major_locator(LogLocator(base=10, subs=subs))
                 axis.set_major_formatter(FuncFormatter(plain))
                 axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(xlabel)
@@ -586,9 +590,11 @@ def line_plot(
         if labels and legend == "inside":
             ax.legend(frameon=False)
         elif labels:
-            ax.legend(
-                frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=min(3, len(labels)), fontsize=9
-            )
+            # As many columns as fit the width (about 7 px per character at 9 pt, plus the key; generous,
+            # because the legend is centred on the axes, which sit right of the y label).
+            entry = max(7 * len(t) + 55 for t in labels)
+            ncol = int(max(1, min(3, len(labels), (w - 20) // entry)))
+            ax.legend(frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, fontsize=9)
         fig.tight_layout()
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
