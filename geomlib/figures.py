@@ -1,8 +1,10 @@
 """The main job: regenerate every figure from the reference solutions, with an index page.
 
 ``geomlib figures`` renders the gallery of built-in datasets and, for every lab that has a
-``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, quick)``; then writes
-``index.html`` and ``index.md`` showing every figure with its caption.
+``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, lab=None, quick=False)`` (one
+signature in every lab, checked by ``tests/test_lab_contracts.py``); then writes ``index.html``
+and ``index.md`` showing every figure with its caption, and each lab's interactive 3D view
+(``<lab>_3d.html``, see :mod:`geomlib.viewer`) in a frame.
 """
 
 from __future__ import annotations

@@ -161,7 +161,7 @@ def fig_error_curve(out: Path, lab, quick: bool) -> Figure:
     )  # fmt: skip
     img = panels([absolute, relative], ["", ""], ncols=2)
     spread = "; ".join(
-        f"{name} {100 * (r.min() - 1):+.0f}% to {100 * (r.max() - 1):+.0f}%"
+        f"{name} {100 * (r.min() - 1):+.1f}% to {100 * (r.max() - 1):+.1f}%"
         for name, r in ((n, y / ref) for n, y in zip(labels, ys, strict=True))
         if name != "igl.qslim"
     )

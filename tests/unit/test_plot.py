@@ -16,7 +16,7 @@ import pytest
 from PIL import Image
 
 from geomlib import gallery, plot, topology
-from geomlib.plot import Figure
+from geomlib.plot import Figure, save_png, write_index
 from geomlib.validate import MeshError
 
 
@@ -263,3 +263,13 @@ def test_a_missing_task_becomes_a_labelled_placeholder(tmp_path):
     assert figs[1].path.is_file()
     with pytest.raises(MeshError, match="lab must be a module"):
         lab_package("subdivision", "solutions.subdivision")
+
+
+def test_the_index_frames_interactive_views(tmp_path):
+    png = Figure(save_png(tmp_path / "lab" / "a.png", np.zeros((8, 8, 3), np.uint8)), "a picture", "lab")
+    page = tmp_path / "lab" / "lab_3d.html"
+    page.write_text("<!DOCTYPE html><title>view</title>", encoding="utf-8")
+    index = write_index([png, Figure(page, "Turn it: a mesh", "lab")], tmp_path)
+    text = index.read_text(encoding="utf-8")
+    assert '<iframe src="lab/lab_3d.html"' in text and '<img src="lab/a.png"' in text
+    assert "[Interactive 3D view: lab/lab_3d.html](lab/lab_3d.html)" in (tmp_path / "index.md").read_text()

@@ -148,3 +148,22 @@ def test_the_page_draws_in_headless_chromium(tmp_path):
     coloured = (mid.max(axis=2) - mid.min(axis=2)) > 40
     assert coloured.mean() > 0.5, f"screenshot is blank: {coloured.mean():.1%} coloured pixels in the middle"
     assert len(np.unique(mid.reshape(-1, 3), axis=0)) > 200  # shading and a colour map, not one flat colour
+
+
+def test_with_a_display_a_pyvista_window_opens(monkeypatch):
+    import pyvista as pv
+
+    shown = {}
+
+    def fake_show(self, *args, **kwargs):  # the window itself needs a screen; record what it would show
+        shown["mesh"] = self.mesh
+        shown["scalars"] = self.mesh.active_scalars_name
+        self.close()
+
+    monkeypatch.setattr(viewer, "has_display", lambda: True)
+    monkeypatch.setattr(viewer, "in_notebook", lambda: False)
+    monkeypatch.setattr(pv, "OFF_SCREEN", True)
+    monkeypatch.setattr(pv.Plotter, "show", fake_show)
+    V, Q = datasets.quad_cube()
+    assert geomlib.view(V, Q, np.arange(len(V), dtype=float)) is None
+    assert shown["mesh"].n_cells == 12 and shown["scalars"] == "scalars"  # 6 quads drawn as 12 triangles
