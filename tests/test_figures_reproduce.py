@@ -8,6 +8,8 @@ figures shifting with it) but not a changed mesh, a moved colour bar or a new ca
 into the picture: the two stale figures this test was written for differed in 53,893
 (``series.png``) and 80,852 (``vdm_pipeline.png``) pixels.
 
+Every figure also keeps a white margin: nothing (a label, a legend) runs past the image edge.
+
 When it fails after an intended change, regenerate and commit the lab's figures:
 ``uv run geomlib figures --lab <lab> --out docs/figures``.
 """
@@ -46,6 +48,10 @@ def test_regenerated_figures_equal_the_committed_ones(lab, tmp_path):
     for name, path in sorted(committed.items()):
         old = np.asarray(Image.open(path).convert("RGB"))
         new = np.asarray(Image.open(made[name]).convert("RGB"))
+        border = np.concatenate([new[:2].reshape(-1, 3), new[-2:].reshape(-1, 3),
+                                 new[:, :2].reshape(-1, 3), new[:, -2:].reshape(-1, 3)])  # fmt: skip
+        if (border.min(axis=1) < 200).any():
+            stale.append(f"{name}: something is drawn on the image edge (a label or legend cut off)")
         if old.shape != new.shape:
             stale.append(f"{name}: size {old.shape[1]}x{old.shape[0]} committed, {new.shape[1]}x{new.shape[0]} now")
             continue
