@@ -1,12 +1,13 @@
 """Per-lab contracts, checked for every lab at once (issue 15, item 7; issue 14, item 5).
 
-- ``make_figures(out_dir, lab=None, quick=False)`` in ``solutions/<lab>/figures.py`` and its copy
-  in ``labs/<lab>/``; ``lab`` is a module of the lab's functions, and passing one is honoured;
+- ``make_figures(out_dir, lab=None, quick=False)`` and ``make_view`` (same arguments: the lab's
+  interactive 3D page) in ``solutions/<lab>/figures.py`` and its copy in ``labs/<lab>/``; ``lab`` is
+  a module of the lab's functions, and passing one is honoured;
 - ``__all__`` of every lab package and figures module names things that exist, and the stubs
   export exactly what the solution exports;
 - the handout's task list (section "Tasks": numbered items or a table) names the same tasks as
   the stubs' ``NotImplementedError("Task N ...")`` messages;
-- ``make_figures`` on the untouched stubs finishes, and draws one "Task N not implemented yet"
+- ``make_figures`` and ``make_view`` on the untouched stubs finish, and draw one "Task N not implemented yet"
   picture (naming a task the stubs really leave open) for each figure it cannot draw, under the
   figure's own file name.
 """
@@ -49,14 +50,15 @@ def handout_tasks(lab: str) -> set[str]:
 
 
 @pytest.mark.parametrize("lab", LABS)
-def test_make_figures_has_one_signature(lab):
+def test_make_figures_and_make_view_have_one_signature(lab):
     for pkg in ("solutions", "labs"):
-        fn = importlib.import_module(f"{pkg}.{lab}.figures").make_figures
-        params = inspect.signature(fn).parameters
-        got = [(p.name, p.default) for p in params.values()]
-        assert got == [("out_dir", inspect.Parameter.empty), ("lab", None), ("quick", False)], (
-            f"{pkg}/{lab}/figures.py: make_figures{inspect.signature(fn)}; expected (out_dir, lab=None, quick=False)"
-        )
+        for name in ("make_figures", "make_view"):
+            fn = getattr(importlib.import_module(f"{pkg}.{lab}.figures"), name)
+            params = inspect.signature(fn).parameters
+            got = [(p.name, p.default) for p in params.values()]
+            assert got == [("out_dir", inspect.Parameter.empty), ("lab", None), ("quick", False)], (
+                f"{pkg}/{lab}/figures.py: {name}{inspect.signature(fn)}; expected (out_dir, lab=None, quick=False)"
+            )
 
 
 @pytest.mark.parametrize("lab", LABS)
@@ -89,7 +91,7 @@ def test_figures_of_the_untouched_stubs_name_the_missing_tasks(lab, tmp_path):
     from PIL import Image
 
     figures = importlib.import_module(f"labs.{lab}.figures")
-    out = figures.make_figures(tmp_path, quick=True)
+    out = [*figures.make_figures(tmp_path, quick=True), figures.make_view(tmp_path, quick=True)]
     assert out and all(isinstance(f, Figure) for f in out)
     open_tasks = stub_tasks(lab)
     documented = {p.stem for p in (ROOT / "docs" / "figures" / lab).glob("*.png")} | {f"{lab}_3d"}

@@ -30,7 +30,7 @@ from geomlib.plot import (
 from geomlib.render import camera_pose, render
 from geomlib.viewer import write_html
 
-__all__ = ["make_figures"]
+__all__ = ["make_figures", "make_view"]
 
 LAB = "denoise"
 CMAP = "YlOrRd"  # light at zero error, so the shape stays readable where the error vanishes
@@ -320,9 +320,21 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     return figures_or_placeholders(
-        (fig_lambda_sequence, fig_iterations, fig_offset_map, fig_seam, fig_view),
+        (fig_lambda_sequence, fig_iterations, fig_offset_map, fig_seam),
         out,
         LAB,
         lab_package(lab, __package__),
         quick,
     )
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``denoise_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]

@@ -17,7 +17,7 @@ from geomlib.plot import Figure, figures_or_placeholders, lab_package, panels, s
 from geomlib.textures import triangle_atlas
 from geomlib.viewer import write_html
 
-__all__ = ["make_figures", "bump_tiles", "smooth_noise"]
+__all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]
 
 #: The lab package whose functions the figures draw (set by :func:`make_figures`).
 _L = None
@@ -279,4 +279,18 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
     out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake, _fig_view), out, LAB, quick)
+    return figures_or_placeholders((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), out, LAB, quick)
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``maps_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders((_fig_view,), out, LAB, quick)[0]

@@ -27,7 +27,7 @@ from geomlib.viewer import write_html
 #: The lab package whose functions the figures draw (set by :func:`make_figures`).
 _L = None
 
-__all__ = ["make_figures"]
+__all__ = ["make_figures", "make_view"]
 
 LAB = "shadows"
 #: A closer look at the shadows of the tall box, the floating cube and the sphere.
@@ -335,7 +335,21 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
     _CACHE.clear()
     try:
         return figures_or_placeholders(
-            (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights, fig_view), out, LAB, quick
+            (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), out, LAB, quick
         )
     finally:
         _CACHE.clear()
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``shadows_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders((fig_view,), out, LAB, quick)[0]

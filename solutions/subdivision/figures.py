@@ -26,7 +26,7 @@ from geomlib.plot import (
 from geomlib.render import camera_pose, render, render_polygons
 from geomlib.viewer import write_html
 
-__all__ = ["make_figures", "airplane"]
+__all__ = ["make_figures", "make_view", "airplane"]
 
 LAB = "subdivision"
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the difference vanishes
@@ -292,9 +292,21 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     return figures_or_placeholders(
-        (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence, fig_view),
+        (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence),
         out,
         LAB,
         lab_package(lab, __package__),
         quick,
     )
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``subdivision_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]

@@ -7,7 +7,7 @@ box through the four stages; global vs per-quad diagonals; and a background-impo
 
 The same file is copied into ``labs/vdm/``: there the relative imports pick up the student's
 functions, so the figures show *their* results. A figure whose tasks are not implemented yet is
-skipped with a message.
+a picture saying "Task N not implemented yet".
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from geomlib.plot import (
 )
 from geomlib.viewer import write_html
 
-__all__ = ["make_figures"]
+__all__ = ["make_figures", "make_view"]
 
 #: The lab package whose functions the figures draw (set by :func:`make_figures`).
 _L = None
@@ -356,5 +356,19 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
     global _L
     _L = lab_package(lab, __package__)
     return figures_or_placeholders(
-        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep, _fig_view), out, LAB, quick
+        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep), out, LAB, quick
     )
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``vdm_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders((_fig_view,), out, LAB, quick)[0]
