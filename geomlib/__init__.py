@@ -11,6 +11,7 @@ Meshes are ``(V, F)`` arrays as in libigl/gpytoolbox (``V`` float64 ``(n, 3)``, 
 * :mod:`geomlib.geometry` — normals, areas, closest points, ray casting, surface sampling,
   mesh distances;
 * :mod:`geomlib.datasets` — test meshes;
+* :mod:`geomlib.viewer` — ``geomlib.view(V, F, scalars=...)`` turns a mesh in 3D;
 * I/O, camera, rasterizer, rendering and plotting modules, and :mod:`geomlib.grading` (the
   course's grader).
 
@@ -45,6 +46,7 @@ _EXPORTS = {
         "triangulate_polygons",
     ),
     "vectors": ("normalize_rows", "as_unit_vectors"),
+    "viewer": ("view",),
     "geometry": (
         "face_normals",
         "vertex_normals",

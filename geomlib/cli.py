@@ -2,7 +2,7 @@
 
 Students:      geomlib grade --impl labs --lab subdivision
 Instructors:   geomlib figures | refs build | refs check | stubs build | stubs check | release OUT
-Anyone:        geomlib info mesh.obj | geomlib render mesh.obj -o mesh.png
+Anyone:        geomlib info mesh.obj | geomlib view mesh.obj [--html out.html] | geomlib render mesh.obj -o mesh.png
 """
 
 from __future__ import annotations
@@ -21,7 +21,9 @@ examples:
   geomlib refs build --lab subdivision         store reference outputs from solutions/
   geomlib stubs build                          regenerate labs/ from solutions/
   geomlib release dist/                        student bundle + Gradescope autograder zip
-  geomlib info mesh.obj                        counts, face kinds, manifoldness, genus, bbox
+  geomlib info mesh.obj                        counts, defects (duplicate, degenerate, non-manifold), genus, bbox
+  geomlib view mesh.obj                        turn the mesh in a window (needs a display)
+  geomlib view mesh.obj --html mesh.html       the same as one self-contained page (works offline)
   geomlib render mesh.off -o mesh.png --wireframe
   geomlib render spot.obj -o spot.png --view three_quarter --forward=-z
 """
@@ -40,6 +42,15 @@ def _cmd_info(a) -> int:
     from geomlib import info
 
     print(info.describe(a.file))
+    return 0
+
+
+def _cmd_view(a) -> int:
+    from geomlib import viewer
+
+    out = viewer.view_file(a.file, html=a.html, up=a.up, edges=a.edges)
+    if out is not None:
+        print(f"wrote {out} (open it in a web browser; it needs no network)")
     return 0
 
 
@@ -147,10 +158,21 @@ def build_parser() -> argparse.ArgumentParser:
     f.set_defaults(func=_cmd_figures)
 
     i = sub.add_parser(
-        "info", help="describe a mesh file: counts, face kinds, manifoldness, boundary loops, genus, bbox"
+        "info",
+        help="describe a mesh file: counts, defects (duplicate/degenerate faces, duplicate/unreferenced vertices, "
+        "non-manifold edges/vertices), boundary loops, components, genus, bbox",
     )
     i.add_argument("file")
     i.set_defaults(func=_cmd_info)
+
+    v = sub.add_parser("view", help="turn a mesh in 3D: a window, or --html for a self-contained page")
+    v.add_argument("file")
+    v.add_argument("--html", help="write an interactive page here instead of opening a window")
+    v.add_argument("--up", default="y", choices=["y", "z"], help="the mesh's up axis (default y)")
+    v.add_argument(
+        "--edges", action=argparse.BooleanOptionalAction, default=None, help="draw edges (default: below 20k edges)"
+    )
+    v.set_defaults(func=_cmd_view)
 
     r = sub.add_parser("render", help="render an OBJ/OFF/PLY mesh to a PNG")
     r.add_argument("file")

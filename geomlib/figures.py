@@ -1,8 +1,10 @@
 """The main job: regenerate every figure from the reference solutions, with an index page.
 
 ``geomlib figures`` renders the gallery of built-in datasets and, for every lab that has a
-``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, quick)``; then writes
-``index.html`` and ``index.md`` showing every figure with its caption.
+``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, lab=None, quick=False)`` (one
+signature in every lab, checked by ``tests/test_lab_contracts.py``); then writes ``index.html``
+and ``index.md`` showing every figure with its caption, and each lab's interactive 3D view
+(``make_view``: ``<lab>_3d.html``, see :mod:`geomlib.viewer`) in a frame.
 """
 
 from __future__ import annotations
@@ -47,6 +49,8 @@ def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, 
                 raise FileNotFoundError(f"no figures for lab {name!r} (expected solutions/{name}/figures.py)")
             mod = importlib.import_module(f"solutions.{name}.figures")
             figs = mod.make_figures(out / name, quick=quick)
+            if hasattr(mod, "make_view"):  # the lab's interactive 3D page, framed in the index
+                figs = [*figs, mod.make_view(out / name, quick=quick)]
         figures.extend(figs)
         if progress:
             print(f"      {len(figs)} figure(s) in {time.time() - t:.1f} s", flush=True)

@@ -39,9 +39,13 @@ __all__ = [
     "colorbar",
     "heat_colors",
     "heatmap_image",
+    "with_colorbar",
     "line_plot",
     "save_png",
     "write_index",
+    "lab_package",
+    "missing_task_figure",
+    "figures_or_placeholders",
 ]
 
 
@@ -52,7 +56,8 @@ class Figure:
     Attributes
     ----------
     path : Path
-        The PNG file.
+        The PNG file, or an ``.html`` interactive 3D view (:mod:`geomlib.viewer`), which the index
+        shows in a frame across the page.
     caption : str
         One or two sentences saying what the figure shows.
     lab : str
@@ -434,6 +439,24 @@ def colorbar(
 # --------------------------------------------------------------------------------------------
 
 
+def with_colorbar(image, bar, *, gap: int = 6, background=(255, 255, 255)) -> np.ndarray:
+    """Put a colour bar right beside its heat-map image (vertically centred), as one image.
+
+    Use it instead of giving the bar its own :func:`panels` cell, which would be as wide as the
+    largest panel and leave a blank column.
+    """
+    a = to_rgb8(image, "image", where="with_colorbar")
+    b = to_rgb8(bar, "bar", where="with_colorbar")
+    h = max(a.shape[0], b.shape[0])
+
+    out = np.empty((h, a.shape[1] + gap + b.shape[1], 3), np.uint8)
+    out[:] = np.asarray(background, np.uint8)
+    ta, tb = (h - a.shape[0]) // 2, (h - b.shape[0]) // 2
+    out[ta : ta + a.shape[0], : a.shape[1]] = a
+    out[tb : tb + b.shape[0], a.shape[1] + gap :] = b
+    return out
+
+
 def line_plot(
     xs_list,
     ys_list,
@@ -447,6 +470,7 @@ def line_plot(
     size: tuple[int, int] = (640, 420),
     dpi: int = 100,
     markers: bool = True,
+    legend: str = "below",
 ) -> np.ndarray:
     """Plot one or more curves (convergence, timings, error vs. level) to an image.
 
@@ -465,15 +489,23 @@ def line_plot(
     dpi : int
         Resolution used to size the text.
     markers : bool
-        Mark the data points.
+        Mark the data points. Every curve gets its own marker and dash pattern, and earlier curves
+        are drawn on top, so curves that coincide stay distinguishable.
+    legend : {"below", "inside"}
+        Legend under the axes (never over the curves), or matplotlib's best spot inside.
 
     Returns
     -------
     (height, width, 3) uint8
+
+    Notes
+    -----
+    Log axes are labelled with plain numbers (``0.6``, ``2``, ``50``), not ``6×10⁻¹``.
     """
     import matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure as MplFigure
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
     where = "line_plot"
     if len(xs_list) and np.ndim(xs_list[0]) == 0:
@@ -507,6 +539,8 @@ def line_plot(
     w = check_int(size[0], "size[0]", minimum=64, maximum=8192, where=where)
     h = check_int(size[1], "size[1]", minimum=64, maximum=8192, where=where)
     dpi = check_int(dpi, "dpi", minimum=20, maximum=600, where=where)
+    if legend not in ("below", "inside"):
+        raise MeshError(f"{where}: legend must be 'below' or 'inside', got {legend!r}")
 
     style = {
         "svg.hashsalt": "geomlib",
@@ -522,20 +556,45 @@ def line_plot(
         fig = MplFigure(figsize=(w / dpi, h / dpi), dpi=dpi, facecolor="white")
         canvas = FigureCanvasAgg(fig)
         ax = fig.add_subplot(1, 1, 1)
+        shapes, dashes = "osD^vP*X", ["-", "--", "-.", ":"]
         for i, (x, y) in enumerate(curves):
             ax.plot(
-                x, y, marker="o" if markers else None, markersize=4, linewidth=1.8, label=labels[i] if labels else None
+                x,
+                y,
+                marker=shapes[i % len(shapes)] if markers else None,
+                markersize=4 + 1.5 * (i % 3),
+                markerfacecolor="none" if i else None,
+                linestyle=dashes[i % len(dashes)],
+                linewidth=2.2 if i == 0 else 1.5,
+                zorder=10 + len(curves) - i,
+                label=labels[i] if labels else None,
             )
-        if logy:
-            ax.set_yscale("log")
-        if logx:
-            ax.set_xscale("log")
+
+        def plain(v, _pos):
+            return f"{v:.10g}"
+
+        for k, (axis, log) in enumerate(((ax.xaxis, logx), (ax.yaxis, logy))):
+            if log:
+                (ax.set_xscale if axis is ax.xaxis else ax.set_yscale)("log")
+                values = np.concatenate([c[k] for c in curves])
+                decades = np.log10(values.max() / values.min()) if len(values) else 0.0
+                # 1-2-5 ticks over short ranges; only powers of ten where those would crowd.
+                subs = (1.0, 2.0, 5.0) if decades <= 1.6 else (1.0,)
+                axis.set_major_locator(LogLocator(base=10, subs=subs))
+                axis.set_major_formatter(FuncFormatter(plain))
+                axis.set_minor_formatter(NullFormatter())
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         if title:
             ax.set_title(title)
-        if labels:
+        if labels and legend == "inside":
             ax.legend(frameon=False)
+        elif labels:
+            # As many columns as fit the width (about 7 px per character at 9 pt, plus the key; generous,
+            # because the legend is centred on the axes, which sit right of the y label).
+            entry = max(7 * len(t) + 55 for t in labels)
+            ncol = int(max(1, min(3, len(labels), (w - 20) // entry)))
+            ax.legend(frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=ncol, fontsize=9)
         fig.tight_layout()
         canvas.draw()
         img = np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
@@ -575,6 +634,98 @@ def save_png(path, image) -> Path:
 
 
 # --------------------------------------------------------------------------------------------
+# Lab figures on partial work
+# --------------------------------------------------------------------------------------------
+
+
+def lab_package(lab, package: str):
+    """The lab whose functions a ``make_figures`` draws: ``lab`` (a module) or the package ``package``.
+
+    Every lab's ``make_figures(out_dir, lab=None, quick=False)`` takes ``lab`` the same way: a module
+    that provides the lab's public functions (``solutions.<lab>``, ``labs.<lab>``, a submission
+    loaded as a module); None means the package the figures file lives in.
+    """
+    import importlib
+    import types
+
+    if lab is None:
+        return importlib.import_module(package)
+    if not isinstance(lab, types.ModuleType):
+        raise MeshError(
+            f"make_figures: lab must be a module providing the lab's functions (or None), got {type(lab).__name__}"
+        )
+    return lab
+
+
+def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "") -> Figure:
+    """A placeholder figure saying which task is missing, written where the real figure would go.
+
+    Parameters
+    ----------
+    path : str or Path
+        The PNG to write (the name the finished figure will have).
+    error : NotImplementedError
+        Raised by a stub; its message starts with the task (``"Task 2 (even vertices): ..."``).
+    lab : str
+        The lab name for the figure record.
+    what : str
+        What the figure will show once the task is done (goes into the caption).
+    """
+    import re
+
+    msg = str(error).strip() or type(error).__name__
+    m = re.search(r"Task\s+(\d+[a-z]?)", msg)
+    head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
+    blank = np.full((160, 560, 3), 244, dtype=np.uint8)
+    img = panels([blank], [msg if len(msg) <= 300 else msg[:297] + "..."], title=Path(path).stem, font_size=14)
+    # Write the head into the grey box too, so a thumbnail still says it.
+    from PIL import Image, ImageDraw
+
+    page = Image.fromarray(img)
+    draw = ImageDraw.Draw(page)
+    font = _font(22, bold=True)
+    w = draw.textlength(head, font=font)
+    top = img.shape[0] // 2 - 40
+    draw.text(((img.shape[1] - w) / 2, top), head, fill=(150, 40, 30), font=font)
+    path = save_png(path, np.asarray(page))
+    caption = (
+        f"{head}, so {Path(path).name} cannot be drawn yet" + (f" (it will show {what})" if what else "") + f". {msg}"
+    )
+    return Figure(path, caption, lab)
+
+
+def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Figure]:
+    """Run figure builders; a builder stopped by a missing task gives a placeholder figure instead.
+
+    Parameters
+    ----------
+    builders : sequence of callables
+        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them. The placeholder
+        goes to ``out_dir / "<name>.png"``, where ``<name>`` is the builder's ``figure_name``
+        attribute or its name without the ``fig_`` / ``_fig_`` / ``_`` prefix.
+    out_dir : Path
+    lab_name : str
+    *args
+        Passed on to every builder.
+
+    Returns
+    -------
+    list of Figure
+        In builder order; students see every figure their finished tasks allow, and one
+        "Task N not implemented yet" picture for each of the others.
+    """
+    figures: list[Figure] = []
+    for build in builders:
+        try:
+            out = build(out_dir, *args)
+        except NotImplementedError as e:
+            name = getattr(build, "figure_name", None) or build.__name__.removeprefix("_").removeprefix("fig_")
+            out = missing_task_figure(Path(out_dir) / f"{name}.png", e, lab_name)
+        figures.extend(out if isinstance(out, list) else [out])
+    return figures
+
+
+# --------------------------------------------------------------------------------------------
 # Index pages
 # --------------------------------------------------------------------------------------------
 
@@ -589,6 +740,8 @@ figure { margin: 0; background: #fff; border: 1px solid #e3e3e3; border-radius: 
 figure img { width: 100%; height: auto; display: block; }
 figcaption { font-size: 0.9rem; line-height: 1.35; margin-top: 0.5rem; color: #333; }
 figcaption code { font-size: 0.8rem; color: #777; }
+figure.wide { grid-column: 1 / -1; }
+figure iframe { width: 100%; height: 480px; border: 0; display: block; }
 """
 
 
@@ -657,6 +810,14 @@ def write_index(figures: Sequence[Figure], out_dir, *, title: str = "Course figu
             rel = _rel(f.path, out)
             src = html.escape(rel, quote=True)
             cap = html.escape(f.caption)
+            if f.path.suffix.lower() == ".html":  # an interactive 3D view (geomlib.viewer): the page in a frame
+                h.append(
+                    f'<figure class="wide"><iframe src="{src}" title="{html.escape(f.caption, quote=True)}" '
+                    f'loading="lazy"></iframe><figcaption>{cap} <a href="{src}">Open it alone</a>.<br>'
+                    f"<code>{html.escape(rel)}</code></figcaption></figure>"
+                )
+                md += [f"[Interactive 3D view: {rel}]({rel.replace(' ', '%20')})", "", f"*{f.caption}*", ""]
+                continue
             h.append(
                 f'<figure><a href="{src}"><img src="{src}" alt="{html.escape(f.caption, quote=True)}" loading="lazy"></a>'
                 f"<figcaption>{cap}<br><code>{html.escape(rel)}</code></figcaption></figure>"

@@ -15,8 +15,22 @@ import numpy as np
 
 from geomlib import datasets
 from geomlib.geometry import vertex_normals
-from geomlib.plot import Figure, colorbar, heat_colors, heatmap_image, line_plot, panels, save_png
+from geomlib.plot import (
+    Figure,
+    colorbar,
+    figures_or_placeholders,
+    heat_colors,
+    heatmap_image,
+    lab_package,
+    line_plot,
+    panels,
+    save_png,
+    with_colorbar,
+)
 from geomlib.render import camera_pose, render
+from geomlib.viewer import write_html
+
+__all__ = ["make_figures", "make_view"]
 
 LAB = "denoise"
 CMAP = "YlOrRd"  # light at zero error, so the shape stays readable where the error vanishes
@@ -41,6 +55,10 @@ def _functions(lab) -> SimpleNamespace:
             surface_error=noise.surface_error,
         )
     return lab
+
+
+def _passes(n: int) -> str:
+    return f"{n} pass" if n == 1 else f"{n} passes"
 
 
 def _blank(size: tuple[int, int]) -> np.ndarray:
@@ -69,9 +87,7 @@ def fig_lambda_sequence(out: Path, lab, quick: bool) -> Figure:
     ratios = {}
     for sigma in (0.3, LOW_NOISE):
         Vn, N = L.make_noisy(V, F, sigma, 0)
-        results = [(f"noisy ({sigma} h)", Vn)] + [
-            (f"lambda = {lam}", L.denoise_vertices(Vn, F, N, lam)) for lam in lams
-        ]
+        results = [(f"noisy ({sigma} h)", Vn)] + [(f"λ = {lam}", L.denoise_vertices(Vn, F, N, lam)) for lam in lams]
         errs = [np.asarray(L.surface_error(V, F, X)) for _, X in results]
         e0 = errs[0].mean()
         ratios[sigma] = [e.mean() / e0 for e in errs[1:]]
@@ -93,10 +109,10 @@ def fig_lambda_sequence(out: Path, lab, quick: bool) -> Figure:
     return Figure(
         path,
         "Noisy torus (Gaussian noise of 0.3 mean edge lengths h along random directions) and one denoising pass "
-        "p' = p - lambda <delta, n> n with lambda = 0.3, 0.7, 1 (top), with each vertex's distance to the clean "
+        "p' = p − λ ⟨δ, n⟩ n with λ = 0.3, 0.7, 1 (top), with each vertex's distance to the clean "
         "surface and the mean error relative to the noisy input (middle): it falls to "
         f"{hi_r[0]:.2f}x, {hi_r[1]:.2f}x and {hi_r[2]:.2f}x. Bottom: the same at low noise ({LOW_NOISE} h), where "
-        f"lambda = 0.3, 0.7, 1 end at {lo_r[0]:.2f}x, {lo_r[1]:.2f}x and {lo_r[2]:.2f}x: the curvature part of delta "
+        f"λ = 0.3, 0.7, 1 end at {lo_r[0]:.2f}x, {lo_r[1]:.2f}x and {lo_r[2]:.2f}x: the curvature part of δ "
         "shrinks the whole torus, most on its outer rim where the mean curvature is largest.",
         LAB,
     )
@@ -118,7 +134,7 @@ def _error_curves(L, V, F, sigma: float, iterations: int):
                 curve.append(float(np.mean(L.surface_error(V, F, X))) / e0)
             xs.append(np.arange(iterations + 1))
             ys.append(np.array(curve))
-            labels.append(f"{weights}, lambda = {lam}")
+            labels.append(f"{weights}, λ = {lam}")
     return xs, ys, labels
 
 
@@ -145,9 +161,9 @@ def fig_iterations(out: Path, lab, quick: bool) -> Figure:
         path,
         "Mean vertex distance to the clean surface after 0 to "
         f"{iterations} passes, relative to the noisy input (log scale), for uniform and cotangent weights. Every pass "
-        "removes part of the noise but also shrinks the surface by the curvature part of delta, so each curve has a "
-        f"best iteration count. At high noise the best here is {b_hi} after {it_hi} pass(es) ({r_hi:.2f}x); at low "
-        f"noise it is {b_lo} after {it_lo} pass(es) ({r_lo:.2f}x), and large lambda or many passes make it worse than "
+        "removes part of the noise but also shrinks the surface by the curvature part of δ, so each curve has a "
+        f"best iteration count. At high noise the best here is {b_hi} after {_passes(it_hi)} ({r_hi:.2f}x); at low "
+        f"noise it is {b_lo} after {_passes(it_lo)} ({r_lo:.2f}x), and large λ or many passes make it worse than "
         "doing nothing.",
         LAB,
     )
@@ -169,31 +185,28 @@ def fig_offset_map(out: Path, lab, quick: bool) -> Figure:
     lim = float(np.abs(s).max())
     up = max(1, side // res)
     heat_map = heatmap_image(bias + scale * grey, DIVERGING, -lim, lim)
-    pose = camera_pose(V, "three_quarter", size=(side, side), zoom=1.1)
+    pose = camera_pose(V, "three_quarter", size=(side, side))  # default margin: the whole sphere in frame
+    bar = colorbar(-lim, lim, DIVERGING, label="offset s", height=side)
     images = [
         np.repeat(np.repeat(np.round(grey * 255).astype(np.uint8), up, axis=0), up, axis=1),
-        np.repeat(np.repeat(heat_map, up, axis=0), up, axis=1),
-        colorbar(-lim, lim, DIVERGING, label="offset s", height=side),
+        with_colorbar(np.repeat(np.repeat(heat_map, up, axis=0), up, axis=1), bar),
         render(Vn, F, camera=pose, size=(side, side)),
-        render(Vn, F, camera=pose, size=(side, side), uv=UV, texture=heat_map, flat=True),
-        _blank((60, side)),
+        with_colorbar(render(Vn, F, camera=pose, size=(side, side), uv=UV, texture=heat_map, flat=True), bar),
     ]
     captions = [
         f"stored 16-bit map, {res}x{res} texels (grey = h)",
         "decoded offsets bias + scale h",
-        "",
         "the noisy sphere",
         "its offset map on the surface",
-        "",
     ]
-    path = save_png(out / "offset_map.png", panels(images, captions, ncols=3, title="Offset map of a noisy UV sphere"))
+    path = save_png(out / "offset_map.png", panels(images, captions, ncols=2, title="Offset map of a noisy UV sphere"))
     return Figure(
         path,
-        "The normal offsets s = <delta, n> of a noisy latitude-longitude sphere baked into a 16-bit offset map: "
+        "The normal offsets s = ⟨δ, n⟩ of a noisy latitude-longitude sphere baked into a 16-bit offset map: "
         "u runs once around the sphere, v from the south pole (bottom row of the image) to the north pole (top). "
         f"bias = {bias:.4f} and scale = {scale:.4f} map the offsets onto [0, 1]. Bottom: the noisy sphere and the "
         "decoded map drawn on it as a texture: red vertices stick out of their neighbourhood, blue ones sink in "
-        "(red dominates: the sphere's curvature adds about h^2 / (2R) to every offset); inside each triangle the map "
+        "(red dominates: the sphere's curvature adds about h²/(2R) to every offset); inside each triangle the map "
         "interpolates the three corner offsets linearly.",
         LAB,
     )
@@ -227,9 +240,17 @@ def fig_seam(out: Path, lab, quick: bool) -> Figure:
         ((1.3, 0.5, 0.5), (0.95, -0.05, 0.25), (0.0, 0.0, 1.0)),
     ]
     seam = np.flatnonzero(np.bincount(group)[group] > 1)  # vertices that have a copy
+    # Context: the whole sphere seen from the seam's side, the seam's vertices in blue; the two
+    # close-ups look at the middle of that meridian from either side.
+    overview = ((4.9, -2.2, 0.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))  # near the equator: the poles sit on the outline
     images, captions = [], []
     for title, X, gap in rows:
         nrm = _seam_normals(X, F, group)
+        images.append(
+            render(X, F, normals=nrm, camera=overview, fov_deg=30, size=size, back_color=BACK,
+                   highlight_points=seam, point_color=(0.1, 0.2, 0.7), point_radius=2.5)
+        )  # fmt: skip
+        captions.append(f"{title}: the whole sphere,\nblue dots = the seam u = 0 = 1")
         for j, cam in enumerate(cams):
             images.append(
                 render(X, F, normals=nrm, camera=cam, fov_deg=30, size=size, back_color=BACK,
@@ -237,11 +258,12 @@ def fig_seam(out: Path, lab, quick: bool) -> Figure:
             )  # fmt: skip
             side = "from the u = 1 side" if j == 0 else "from the u = 0 side"
             captions.append(f"{title}, {side}" + (f"\nwidest gap {gap:.1e} (radius 1)" if j == 0 else ""))
-    img = panels(images, captions, ncols=2, title="UV seam of a denoised sphere (map route, lambda = 0.7)")
+    img = panels(images, captions, ncols=3, title="UV seam of a denoised sphere (map route, λ = 0.7)")
     path = save_png(out / "seam_crack.png", img)
     return Figure(
         path,
-        "The latitude-longitude sphere is cut along the meridian u = 0 = 1: every vertex there exists twice (and the "
+        "The latitude-longitude sphere is cut along the meridian u = 0 = 1 (left: the whole sphere, the seam in blue; "
+        "middle and right: close-ups of the seam's middle from either side). Every vertex on the seam exists twice (and the "
         "poles once per triangle). Without the fix (top) each copy sees only its own side's neighbours and reads its "
         "own texels, so the copies move apart and the back faces (red) show through the crack (blue dots: the seam's "
         "vertices). Welding by position "
@@ -250,27 +272,69 @@ def fig_seam(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+def fig_view(out: Path, lab, quick: bool) -> Figure:
+    L = _functions(lab)
+    V, F = datasets.torus(n_major=64, n_minor=32)
+    Vn, N = L.make_noisy(V, F, 0.3, 0)
+    X = L.denoise_vertices(Vn, F, N, 0.7)
+    err = 100 * np.asarray(L.surface_error(V, F, X))
+    path = write_html(
+        out / "denoise_3d.html", X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
+        cmap=CMAP, scalar_name="% of diagonal",
+    )  # fmt: skip
+    return Figure(
+        path,
+        "Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
+        "to the clean surface (% of the bounding-box diagonal).",
+        LAB,
+    )
+
+
+#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
+fig_lambda_sequence.figure_name = "lambda_sequence"
+fig_iterations.figure_name = "error_vs_iterations"
+fig_offset_map.figure_name = "offset_map"
+fig_seam.figure_name = "seam_crack"
+fig_view.figure_name = "denoise_3d"
+
+
 def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir``.
+    """Render the lab's figures into ``out_dir`` and return them with their captions.
 
     Parameters
     ----------
     out_dir : str or Path
         Folder for the PNG files (created if missing).
     lab : module, optional
-        A lab module providing the lab's functions (default: this package).
+        The lab package whose functions the figures draw (``solutions.denoise``, ``labs.denoise``, a
+        submission); default: the package this file is in, so in ``labs/denoise/`` your own code.
     quick : bool
         Smaller meshes, images and iteration counts (for notebooks and smoke tests).
 
     Returns
     -------
     list of Figure
+        Every figure; one whose tasks are not implemented yet is a picture saying
+        "Task N not implemented yet" (under the same file name).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    return [
-        fig_lambda_sequence(out, lab, quick),
-        fig_iterations(out, lab, quick),
-        fig_offset_map(out, lab, quick),
-        fig_seam(out, lab, quick),
-    ]
+    return figures_or_placeholders(
+        (fig_lambda_sequence, fig_iterations, fig_offset_map, fig_seam),
+        out,
+        LAB,
+        lab_package(lab, __package__),
+        quick,
+    )
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``denoise_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]

@@ -13,17 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, panels, save_png
+from geomlib.plot import Figure, figures_or_placeholders, lab_package, panels, save_png
 from geomlib.textures import triangle_atlas
+from geomlib.viewer import write_html
 
-from .bake import bake_normal_map
-from .displacement import displace, welded_vertex_normals
-from .encoding import encode_normal_map
-from .heightmap import height_to_normal_map
-from .shading import rasterize_mesh, shade
-from .tangents import tangent_frames
+__all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]
 
-__all__ = ["make_figures", "bump_tiles", "smooth_noise"]
+#: The lab package whose functions the figures draw (set by :func:`make_figures`).
+_L = None
 
 LAB = "maps"
 ALBEDO = (0.80, 0.66, 0.52)
@@ -69,8 +66,8 @@ def _view(V: np.ndarray, direction, size: int, fov: float = 30.0, margin: float 
 
 
 def _shaded(V, F, eye, M, size, lights, *, N=None, UV=None, tangents=None, normal_map=None, wrap="clamp"):
-    g = rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
-    img = shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
+    g = _L.rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
+    img = _L.shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
     return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)  # display gamma
 
 
@@ -91,14 +88,14 @@ def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
     H = bump_tiles(s, nu, nv)
     R, r, lam = 1.0, 0.35, 0.05
     # Tangent-space slope of the relief: the UV square spans 2 pi R around and 2 pi r across.
-    nmap = height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
+    nmap = _L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
     V, F, UV = datasets.uv_torus(48, 24, R, r)
-    N = welded_vertex_normals(V, F)
-    T, _, _, w = tangent_frames(V, F, UV, N)
+    N = _L.welded_vertex_normals(V, F)
+    T, _, _, w = _L.tangent_frames(V, F, UV, N)
     tg = np.column_stack([T, w])
     dm, dn = (144, 48) if quick else (384, 128)
     Vd0, Fd, UVd = datasets.uv_torus(dm, dn, R, r)
-    Vd, Nd = displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
+    Vd, Nd = _L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
     eye, M = _view(Vd, (0.15, -1.0, 0.85), size, margin=0.8)
     figs = []
     for name, lights, label in (
@@ -112,10 +109,10 @@ def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
         caps = [
             f"plain: {len(F):,} faces, smooth normals",
             f"normal-mapped: the same {len(F):,} faces, per-pixel normals from the {s}x{s} map",
-            f"displaced: {len(Fd):,} faces moved by lam * h along the normal",
+            f"displaced: {len(Fd):,} faces moved by λh along the normal",
         ]
         if name == "mapped_vs_displaced":
-            imgs = [_thumb(_grey(H), size), _thumb(encode_normal_map(nmap), size)] + imgs
+            imgs = [_thumb(_grey(H), size), _thumb(_L.encode_normal_map(nmap), size)] + imgs
             caps = ["height map h (24 x 8 bumps)", "its tangent-space normal map (RGB = (n + 1) / 2)"] + caps
         img = panels(imgs, caps, ncols=len(imgs), title=f"Normal mapping vs displacement, {label}")
         path = save_png(out / f"{name}.png", img)
@@ -144,13 +141,13 @@ def _fig_bias_scale(out: Path, quick: bool) -> Figure:
     lam = 0.12
     imgs, caps = [_thumb(_grey(H), size)], ["displacement map h in [0, 1] (black = 0), mid-grey at the poles"]
     for bias, scale in ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0)):
-        Vd = displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
+        Vd = _L.displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
         rad = np.linalg.norm(Vd, axis=1)
         imgs.append(render(Vd, F, camera="three_quarter", up_axis="z", size=(size, size)))
         caps.append(
-            f"(bias, scale) = ({bias:g}, {scale:g}): offsets lam * [{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
+            f"(bias, scale) = ({bias:g}, {scale:g}): offsets λ·[{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
         )
-    img = panels(imgs, caps, ncols=4, title="Displacement P' = P + lam (bias + scale h) n, lam = 0.12")
+    img = panels(imgs, caps, ncols=4, title="Displacement P' = P + λ (bias + scale h) n, λ = 0.12")
     path = save_png(out / "bias_scale.png", img)
     return Figure(
         path,
@@ -171,19 +168,19 @@ def _rock(quick: bool):
     Vl, Fl = np.asarray(Vl, np.float64), np.asarray(Fl, np.int64)
     # Decimated triangles vary a lot in size and shape: every chart gets half a cell (mode="fill").
     Vs, Fs, UV, src = triangle_atlas(Vl, Fl, gutter=0.04, mode="fill")
-    N_lo = welded_vertex_normals(Vs, Fs)
+    N_lo = _L.welded_vertex_normals(Vs, Fs)
     return Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo
 
 
 def _fig_bake(out: Path, quick: bool) -> list[Figure]:
     size, s = (160, 128) if quick else (300, 512)
     Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo = _rock(quick)
-    nmap, mask = bake_normal_map(Vh, Fh, Vs, Fs, UV, s, N_lo=N_lo, padding=4, return_mask=True)
-    T, _, _, w = tangent_frames(Vs, Fs, UV, N_lo)
+    nmap, mask = _L.bake_normal_map(Vh, Fh, Vs, Fs, UV, s, N_lo=N_lo, padding=4, return_mask=True)
+    T, _, _, w = _L.tangent_frames(Vs, Fs, UV, N_lo)
     tg = np.column_stack([T, w])
-    Nh = welded_vertex_normals(Vh, Fh)
+    Nh = _L.welded_vertex_normals(Vh, Fh)
     eye, M = _view(Vh, (0.9, -1.0, 0.9), size, margin=0.85)
-    enc = encode_normal_map(nmap)
+    enc = _L.encode_normal_map(nmap)
     figs = []
     shots = {}
     for key, lights in (("key", KEY_LIGHTS), ("grazing", GRAZING_LIGHTS)):
@@ -197,10 +194,14 @@ def _fig_bake(out: Path, quick: bool) -> list[Figure]:
         f"decimated + baked {s}x{s} normal map",
         f"original: {len(Fh):,} faces",
     ]
+    # Texels outside every chart would be flat-normal lilac like the flat areas: paint them dark grey.
+    shown = np.array(enc[..., :3], dtype=np.uint8, copy=True)
+    shown[~np.asarray(mask, bool)] = (70, 70, 70)
     img = panels(
-        [_thumb(enc, size)] + shots["key"],
+        [_thumb(shown, size)] + shots["key"],
         [
-            f"baked normal map, one chart per triangle ({100 * mask.mean():.0f}% of texels inside charts; flat areas are lilac)"
+            f"baked normal map, one chart per triangle: {100 * mask.mean():.0f}% of texels inside charts "
+            "(dark grey: unused), flat areas lilac"
         ]
         + caps,
         ncols=4,
@@ -234,21 +235,62 @@ def _fig_bake(out: Path, quick: bool) -> list[Figure]:
     return figs
 
 
-def make_figures(out_dir: Path, lab: str | None = None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with captions.
+def _fig_view(out: Path, quick: bool) -> Figure:
+    R, r, lam = 1.0, 0.4, 0.045
+    s = 128 if quick else 256
+    H = bump_tiles(s, 24, 8)
+    Vd0, Fd, UVd = datasets.uv_torus(*((144, 48) if quick else (288, 96)), R, r)
+    Vd = _L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
+    path = write_html(out / "maps_3d.html", Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False)
+    return Figure(
+        path,
+        f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map imitates.",
+        LAB,
+    )
+
+
+#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
+_fig_mapped_vs_displaced.figure_name = "mapped_vs_displaced"
+_fig_bias_scale.figure_name = "bias_scale"
+_fig_bake.figure_name = "bake"
+_fig_view.figure_name = "maps_3d"
+
+
+def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
+    """Render the lab's figures into ``out_dir`` and return them with their captions.
 
     Parameters
     ----------
-    out_dir : Path
-        Folder for the PNG files (created).
-    lab : str, optional
-        Ignored (the figures command passes it for some labs).
+    out_dir : str or Path
+        Folder for the PNG files (created if missing).
+    lab : module, optional
+        The lab package whose functions the figures draw (``solutions.maps``, ``labs.maps``, a
+        submission); default: the package this file is in, so in ``labs/maps/`` your own code.
     quick : bool
         Smaller images and meshes (for the notebook and tests).
+
+    Returns
+    -------
+    list of Figure
+        Every figure; one whose tasks are not implemented yet is a picture saying
+        "Task N not implemented yet" (under the same file name).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    figs = _fig_mapped_vs_displaced(out, quick)
-    figs.append(_fig_bias_scale(out, quick))
-    figs.extend(_fig_bake(out, quick))
-    return figs
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), out, LAB, quick)
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``maps_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    global _L
+    _L = lab_package(lab, __package__)
+    return figures_or_placeholders((_fig_view,), out, LAB, quick)[0]

@@ -12,8 +12,21 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
+from geomlib.plot import (
+    Figure,
+    colorbar,
+    figures_or_placeholders,
+    heat_colors,
+    lab_package,
+    line_plot,
+    panels,
+    save_png,
+    with_colorbar,
+)
 from geomlib.render import camera_pose, render, render_polygons
+from geomlib.viewer import write_html
+
+__all__ = ["make_figures", "make_view", "airplane"]
 
 LAB = "subdivision"
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the difference vanishes
@@ -58,6 +71,9 @@ def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
         pose = camera_pose(row[0][0], "three_quarter", size=size, zoom=1.05)  # one camera per row
         for k, (V, F) in enumerate(row):
             dense = len(F) > 1500
+            # The airplane is open: its wings and tail are sheets bounded by boundary loops. Red dots
+            # mark the boundary vertices, so the boundary rule can be seen.
+            border = np.unique(topology.boundary_edges(F)) if name == "airplane" else None
             images.append(
                 render(
                     V,
@@ -68,16 +84,21 @@ def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
                     wireframe=True,
                     wire_opacity=0.25 if dense else 0.9,
                     smooth=k > 0,
+                    highlight_points=border,
                 )
             )
-            captions.append(f"{name}, level {k}: {len(F):,} faces")
+            extra = f", {len(border):,} boundary vertices" if border is not None else ""
+            captions.append(f"{name}, level {k}: {len(F):,} faces{extra}")
     img = panels(images, captions, ncols=L + 1, title=f"Loop subdivision, Warren weights (levels 0-{L})")
     path = save_png(out / "loop_levels.png", img)
     return Figure(
         path,
         "Loop subdivision of the icosahedron (top) and of the open airplane mesh (bottom): every level splits each "
         "triangle into four and moves all vertices by fixed weights. The icosahedron shrinks toward a smooth limit "
-        "surface inside its control mesh; the airplane's boundary edges follow the cubic B-spline curve rule.",
+        "surface inside its control mesh. The airplane is open (red dots: its boundary vertices): the wings and the "
+        "tail are sheets whose edges and roots are boundary loops. Boundary vertices follow the curve rule "
+        "(midpoints; 3/4, 1/8, 1/8 along the boundary), so these edges stay sharp and straight at every level while "
+        "the fuselage is rounded off.",
         LAB,
     )
 
@@ -92,20 +113,20 @@ def fig_weights(out: Path, lab, quick: bool) -> Figure:
     diag = float(np.linalg.norm(V.max(0) - V.min(0)))
     d = np.linalg.norm(np.asarray(Vw) - np.asarray(Vl), axis=1) / diag
     hi = float(d.max())
-    pose = camera_pose(V, "three_quarter", size=size)
+    # The ant stands on its legs along +y: a y-up three-quarter view shows all six legs.
+    pose = camera_pose(V, "three_quarter", size=size, up_axis="y")
+    heat = render(Vw, Fw, camera=pose, size=size, supersample=_ss(quick), colors=heat_colors(d, 0.0, hi, cmap=CMAP))
     imgs = [
         render(Vw, Fw, camera=pose, size=size, supersample=_ss(quick)),
         render(Vl, Fw, camera=pose, size=size, supersample=_ss(quick)),
-        render(Vw, Fw, camera=pose, size=size, supersample=_ss(quick), colors=heat_colors(d, 0.0, hi, cmap=CMAP)),
-        colorbar(0.0, hi, CMAP, label="|warren - loop| / diag", height=size[1] - 20),
+        with_colorbar(heat, colorbar(0.0, hi, CMAP, label="|warren - loop| / diag", height=size[1] - 20)),
     ]
     caps = [
         f'weights="warren", {L} levels',
         f'weights="loop", {L} levels',
         "distance between the two",
-        "",
     ]
-    img = panels(imgs, caps, ncols=4, title="Warren's weights vs Loop's beta on the pyvista ant")
+    img = panels(imgs, caps, ncols=3, title="Warren's weights vs Loop's beta on the pyvista ant")
     path = save_png(out / "warren_vs_loop.png", img)
     return Figure(
         path,
@@ -163,23 +184,24 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     imgs = [
         render(V, F, camera=pose, size=size, supersample=_ss(quick), wireframe=True, smooth=False),
         render(V2, F2, camera=pose, size=size, supersample=_ss(quick), wireframe=True, wire_opacity=0.4),
-        render(
-            Vt,
-            Ft,
-            camera=pose,
-            size=size,
-            supersample=_ss(quick),
-            colors=heat_colors(d, 0.0, max(float(d.max()), 1e-12), cmap=CMAP),
+        with_colorbar(
+            render(
+                Vt,
+                Ft,
+                camera=pose,
+                size=size,
+                supersample=_ss(quick),
+                colors=heat_colors(d, 0.0, max(float(d.max()), 1e-12), cmap=CMAP),
+            ),
+            colorbar(0.0, float(d.max()), CMAP, label="distance to ours", height=size[1] - 20),
         ),
-        colorbar(0.0, float(d.max()), CMAP, label="distance to ours", height=size[1] - 20),
     ]
     caps = [
         "open height field (control mesh)",
         f"loop_subdivide, {L} levels (same as igl.loop and VTK)",
         f"trimesh.subdivide_loop, {L} levels",
-        "",
     ]
-    img = panels(imgs, caps, ncols=4, title="Boundary rules: midpoints and 1/8, 3/4, 1/8 along the boundary")
+    img = panels(imgs, caps, ncols=3, title="Boundary rules: midpoints and 1/8, 3/4, 1/8 along the boundary")
     path = save_png(out / "boundary.png", img)
     return Figure(
         path,
@@ -223,28 +245,68 @@ def fig_convergence(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+def fig_view(out: Path, lab, quick: bool) -> Figure:
+    loop_subdivide, _ = _functions(lab)
+    V, F = airplane()
+    levels = 1 if quick else 2
+    Vs, Fs = loop_subdivide(V, F, levels=levels)
+    path = write_html(
+        out / "subdivision_3d.html", Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z"
+    )
+    return Figure(
+        path,
+        f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are open "
+        "sheets, and their boundary edges stay sharp and straight.",
+        LAB,
+    )
+
+
+#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
+fig_loop_levels.figure_name = "loop_levels"
+fig_weights.figure_name = "warren_vs_loop"
+fig_catmull_clark.figure_name = "catmull_clark_levels"
+fig_boundary.figure_name = "boundary"
+fig_convergence.figure_name = "convergence"
+fig_view.figure_name = "subdivision_3d"
+
+
 def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir``.
+    """Render the lab's figures into ``out_dir`` and return them with their captions.
 
     Parameters
     ----------
     out_dir : str or Path
         Folder for the PNG files (created if missing).
     lab : module, optional
-        A lab module providing ``loop_subdivide`` and ``catmull_clark`` (default: this package).
+        The lab package whose functions the figures draw (``solutions.subdivision``, ``labs.subdivision``, a
+        submission); default: the package this file is in, so in ``labs/subdivision/`` your own code.
     quick : bool
         Fewer levels and smaller images (for notebooks and smoke tests).
 
     Returns
     -------
     list of Figure
+        Every figure; one whose tasks are not implemented yet is a picture saying
+        "Task N not implemented yet" (under the same file name).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    return [
-        fig_loop_levels(out, lab, quick),
-        fig_weights(out, lab, quick),
-        fig_catmull_clark(out, lab, quick),
-        fig_boundary(out, lab, quick),
-        fig_convergence(out, lab, quick),
-    ]
+    return figures_or_placeholders(
+        (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence),
+        out,
+        LAB,
+        lab_package(lab, __package__),
+        quick,
+    )
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``subdivision_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
+    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
+    returned figure is a "Task N not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]

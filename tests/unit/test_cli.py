@@ -24,7 +24,7 @@ def _cli(*args, cwd=None):
 def test_help_lists_every_command(capsys):
     assert main([]) == 0
     out = capsys.readouterr().out
-    for cmd in ("figures", "grade", "refs", "stubs", "release", "info", "render"):
+    for cmd in ("figures", "grade", "refs", "stubs", "release", "info", "view", "render"):
         assert cmd in out
 
 

@@ -16,7 +16,7 @@ import pytest
 from PIL import Image
 
 from geomlib import gallery, plot, topology
-from geomlib.plot import Figure
+from geomlib.plot import Figure, save_png, write_index
 from geomlib.validate import MeshError
 
 
@@ -217,3 +217,59 @@ def test_build_gallery_files_and_captions(tmp_path, monkeypatch):
     assert "8 extraordinary vertices" in figs[2].caption
     with pytest.raises(KeyError, match="unknown dataset"):
         gallery.build_gallery(tmp_path, names=["no_such_mesh"])
+
+
+# --------------------------------------------------------------------------------------------
+# Issue 14: legends and labels inside the image, colour bars beside their maps, missing tasks
+# --------------------------------------------------------------------------------------------
+
+
+def test_line_plot_keeps_legend_and_labels_inside_the_image():
+    from geomlib.plot import line_plot
+
+    x = np.arange(1, 7.0)
+    labels = ["Loop, icosahedron", "Catmull-Clark, cube", "Catmull-Clark, cage", "a fourth, rather long label"]
+    for size in ((420, 300), (560, 380), (900, 500)):
+        img = line_plot([x] * 4, [4.0**-x * (k + 1) for k in range(4)], labels, xlabel="level", ylabel="move",
+                        logy=True, title="convergence", size=size)  # fmt: skip
+        border = np.concatenate([img[:2].reshape(-1, 3), img[-2:].reshape(-1, 3),
+                                 img[:, :2].reshape(-1, 3), img[:, -2:].reshape(-1, 3)])  # fmt: skip
+        assert (border == 255).all(), f"something drawn on the image edge at size {size}"
+
+
+def test_with_colorbar_puts_the_bar_beside_the_map():
+    from geomlib.plot import colorbar, with_colorbar
+
+    heat = np.zeros((100, 80, 3), np.uint8)
+    bar = colorbar(0, 1, "viridis", label="x", height=90)
+    both = with_colorbar(heat, bar, gap=6)
+    assert both.shape == (100, 80 + 6 + bar.shape[1], 3)
+    assert (both[:, :80] == 0).all()  # the map untouched, on the left
+
+
+def test_a_missing_task_becomes_a_labelled_placeholder(tmp_path):
+    from geomlib.plot import figures_or_placeholders, lab_package, save_png
+
+    def fig_done(out, quick):
+        return Figure(save_png(out / "done.png", np.zeros((8, 8, 3), np.uint8)), "done", "lab")
+
+    def fig_todo(out, quick):
+        raise NotImplementedError("Task 3b (odd vertices): E = ...")
+
+    fig_todo.figure_name = "todo_figure"
+    figs = figures_or_placeholders((fig_done, fig_todo), tmp_path, "lab", True)
+    assert [f.path.name for f in figs] == ["done.png", "todo_figure.png"]
+    assert figs[1].caption.startswith("Task 3b not implemented yet") and "odd vertices" in figs[1].caption
+    assert figs[1].path.is_file()
+    with pytest.raises(MeshError, match="lab must be a module"):
+        lab_package("subdivision", "solutions.subdivision")
+
+
+def test_the_index_frames_interactive_views(tmp_path):
+    png = Figure(save_png(tmp_path / "lab" / "a.png", np.zeros((8, 8, 3), np.uint8)), "a picture", "lab")
+    page = tmp_path / "lab" / "lab_3d.html"
+    page.write_text("<!DOCTYPE html><title>view</title>", encoding="utf-8")
+    index = write_index([png, Figure(page, "Turn it: a mesh", "lab")], tmp_path)
+    text = index.read_text(encoding="utf-8")
+    assert '<iframe src="lab/lab_3d.html"' in text and '<img src="lab/a.png"' in text
+    assert "[Interactive 3D view: lab/lab_3d.html](lab/lab_3d.html)" in (tmp_path / "index.md").read_text()

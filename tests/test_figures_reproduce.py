@@ -1,0 +1,64 @@
+"""The committed handout figures (``docs/figures/<lab>/``) are what the solutions draw today.
+
+Every lab's figures are regenerated at full size (about 10-30 s a lab) and compared with the
+committed PNGs, picture by picture. Tolerance: same size, and at most 0.2% of the pixels differ by
+more than 32 levels (of 255) in some channel. That absorbs what differs between machines (Mesa's
+OSMesa vs EGL rasterization and anti-aliasing along edges, and the 256-colour palette of the VDM
+figures shifting with it) but not a changed mesh, a moved colour bar or a new caption number drawn
+into the picture: the two stale figures this test was written for differed in 53,893
+(``series.png``) and 80,852 (``vdm_pipeline.png``) pixels.
+
+Every figure also keeps a white margin: nothing (a label, a legend) runs past the image edge.
+
+When it fails after an intended change, regenerate and commit the lab's figures:
+``uv run geomlib figures --lab <lab> --out docs/figures``.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+ROOT = Path(__file__).resolve().parents[1]
+LABS = sorted(p.name for p in (ROOT / "docs" / "figures").iterdir() if p.is_dir() and p.name != "gallery")
+LEVELS = 32
+MAX_FRACTION = 0.002
+
+
+def differing_pixels(a: np.ndarray, b: np.ndarray) -> int:
+    """Pixels where some channel differs by more than :data:`LEVELS`."""
+    return int((np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2) > LEVELS).sum())
+
+
+@pytest.mark.slow
+@pytest.mark.render
+@pytest.mark.parametrize("lab", LABS)
+def test_regenerated_figures_equal_the_committed_ones(lab, tmp_path):
+    figures = importlib.import_module(f"solutions.{lab}.figures")
+    made = {f.path.name: f.path for f in figures.make_figures(tmp_path) if f.path.suffix == ".png"}
+    committed = {p.name: p for p in (ROOT / "docs" / "figures" / lab).glob("*.png")}
+    assert set(made) == set(committed), (
+        f"{lab}: make_figures writes {sorted(made)}, docs/figures/{lab}/ holds {sorted(committed)}"
+    )
+    stale = []
+    for name, path in sorted(committed.items()):
+        old = np.asarray(Image.open(path).convert("RGB"))
+        new = np.asarray(Image.open(made[name]).convert("RGB"))
+        border = np.concatenate([new[:2].reshape(-1, 3), new[-2:].reshape(-1, 3),
+                                 new[:, :2].reshape(-1, 3), new[:, -2:].reshape(-1, 3)])  # fmt: skip
+        if (border.min(axis=1) < 200).any():
+            stale.append(f"{name}: something is drawn on the image edge (a label or legend cut off)")
+        if old.shape != new.shape:
+            stale.append(f"{name}: size {old.shape[1]}x{old.shape[0]} committed, {new.shape[1]}x{new.shape[0]} now")
+            continue
+        n = differing_pixels(old, new)
+        if n > MAX_FRACTION * old.shape[0] * old.shape[1]:
+            stale.append(f"{name}: {n:,} of {old.shape[0] * old.shape[1]:,} pixels differ by more than {LEVELS} levels")
+    assert not stale, (
+        f"docs/figures/{lab}/ is stale (regenerate: uv run geomlib figures --lab {lab} --out docs/figures):\n"
+        + "\n".join(stale)
+    )

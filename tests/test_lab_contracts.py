@@ -1,0 +1,116 @@
+"""Per-lab contracts, checked for every lab at once (issue 15, item 7; issue 14, item 5).
+
+- ``make_figures(out_dir, lab=None, quick=False)`` and ``make_view`` (same arguments: the lab's
+  interactive 3D page) in ``solutions/<lab>/figures.py`` and its copy in ``labs/<lab>/``; ``lab`` is
+  a module of the lab's functions, and passing one is honoured;
+- ``__all__`` of every lab package and figures module names things that exist, and the stubs
+  export exactly what the solution exports;
+- the handout's task list (section "Tasks": numbered items or a table) names the same tasks as
+  the stubs' ``NotImplementedError("Task N ...")`` messages;
+- ``make_figures`` and ``make_view`` on the untouched stubs finish, and draw one "Task N not implemented yet"
+  picture (naming a task the stubs really leave open) for each figure it cannot draw, under the
+  figure's own file name.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import re
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from geomlib.plot import Figure
+
+ROOT = Path(__file__).resolve().parents[1]
+LABS = sorted(p.name for p in (ROOT / "solutions").iterdir() if (p / "figures.py").is_file())
+TASK = re.compile(r"NotImplementedError\(\s*['\"]Task (\d+[a-z]?)\b")
+
+
+def stub_tasks(lab: str) -> set[str]:
+    """Task labels of the stubs' ``NotImplementedError`` messages (``"2"``, ``"1a"``)."""
+    found: set[str] = set()
+    for f in (ROOT / "labs" / lab).glob("*.py"):
+        found |= set(TASK.findall(f.read_text(encoding="utf-8")))
+    return found
+
+
+def handout_tasks(lab: str) -> set[str]:
+    """Task labels in the handout's "Tasks" section: ``1. **...**`` items or ``| 1a | ...`` rows."""
+    text = (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8")
+    m = re.search(r"^##[^#\n]*\b[Tt]asks\b[^\n]*\n(.*?)(?=^## )", text, re.M | re.S)
+    assert m, f"labs/{lab}/README.md has no '## ... Tasks' section"
+    section = m.group(1)
+    items = re.findall(r"^(\d+)\. ", section, re.M)
+    rows = re.findall(r"^\| *(\d+[a-z]?)\b", section, re.M)
+    return set(items) | set(rows)
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_make_figures_and_make_view_have_one_signature(lab):
+    for pkg in ("solutions", "labs"):
+        for name in ("make_figures", "make_view"):
+            fn = getattr(importlib.import_module(f"{pkg}.{lab}.figures"), name)
+            params = inspect.signature(fn).parameters
+            got = [(p.name, p.default) for p in params.values()]
+            assert got == [("out_dir", inspect.Parameter.empty), ("lab", None), ("quick", False)], (
+                f"{pkg}/{lab}/figures.py: {name}{inspect.signature(fn)}; expected (out_dir, lab=None, quick=False)"
+            )
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_all_names_exist_and_stubs_export_the_same(lab):
+    for module in ("", ".figures"):
+        sol = importlib.import_module(f"solutions.{lab}{module}")
+        stub = importlib.import_module(f"labs.{lab}{module}")
+        names = getattr(sol, "__all__", None)
+        assert names, f"solutions/{lab}{module.replace('.', '/')}: no __all__"
+        assert len(set(names)) == len(names), f"solutions.{lab}{module}.__all__ repeats a name"
+        missing = [n for n in names if not hasattr(sol, n)]
+        assert not missing, f"solutions.{lab}{module}.__all__ names missing objects: {missing}"
+        assert list(stub.__all__) == list(names), f"labs.{lab}{module}.__all__ differs from the solution's"
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_handout_task_table_matches_the_stubs(lab):
+    stubs, handout = stub_tasks(lab), handout_tasks(lab)
+    assert stubs, f"labs/{lab}: no NotImplementedError('Task N ...') in the stubs"
+    base = {re.match(r"\d+", t).group() for t in stubs}
+    # The handout may list sub-tasks (1a, 1b) or only their number (1 with parts (a), (b)).
+    expected = stubs if any(t[-1].isalpha() for t in handout) else base
+    assert handout == expected, (
+        f"labs/{lab}/README.md lists tasks {sorted(handout)}, the stubs raise for tasks {sorted(stubs)}"
+    )
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_figures_of_the_untouched_stubs_name_the_missing_tasks(lab, tmp_path):
+    from PIL import Image
+
+    figures = importlib.import_module(f"labs.{lab}.figures")
+    out = [*figures.make_figures(tmp_path, quick=True), figures.make_view(tmp_path, quick=True)]
+    assert out and all(isinstance(f, Figure) for f in out)
+    open_tasks = stub_tasks(lab)
+    documented = {p.stem for p in (ROOT / "docs" / "figures" / lab).glob("*.png")} | {f"{lab}_3d"}
+    for f in out:
+        assert f.path.is_file() and f.path.parent == tmp_path, f.path
+        assert f.path.stem in documented, f"{lab}: figure {f.path.name} is not in docs/figures/{lab}/"
+        m = re.match(r"Task (\d+[a-z]?) not implemented yet", f.caption)
+        assert m, f"{lab}: {f.path.name} drawn from the stubs without a missing task: {f.caption[:200]}"
+        assert m.group(1) in open_tasks, f"{lab}: {f.path.name} names Task {m.group(1)}, not a stub task"
+        img = np.asarray(Image.open(f.path).convert("RGB"))
+        assert img.shape[0] > 100 and (img < 200).any()  # a page with text, not an empty file
+
+
+def test_make_figures_draws_the_lab_it_is_given(tmp_path):
+    """``lab=`` is honoured: the solution's figures drawn with the stubs' functions show missing tasks."""
+    figures = importlib.import_module("solutions.vdm.figures")
+    stubs = importlib.import_module("labs.vdm")
+    out = figures.make_figures(tmp_path, lab=stubs, quick=True)
+    assert all("not implemented yet" in f.caption for f in out)
+    with pytest.raises(Exception, match="lab must be a module"):
+        figures.make_figures(tmp_path, lab="vdm", quick=True)
+    assert isinstance(stubs, types.ModuleType)
