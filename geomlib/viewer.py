@@ -416,7 +416,7 @@ def view(
 
 def view_file(path, *, html=None, up: str = "y", scalars=None, edges: bool | None = None):
     """:func:`view` of the mesh in an OBJ, OFF or PLY file (title: the file name)."""
-    from geomlib import io
+    from geomlib import mesh_io as io
 
     V, faces = io.read_mesh(path)
     return view(V, faces, scalars, html=html, title=Path(path).name, up=up, edges=edges)

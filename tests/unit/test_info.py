@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets, io
+from geomlib import datasets
+from geomlib import mesh_io as io
 from geomlib.cli import main
 from geomlib.info import summary
 

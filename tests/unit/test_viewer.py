@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 import geomlib
-from geomlib import datasets, io, viewer
+from geomlib import datasets, viewer
+from geomlib import mesh_io as io
 from geomlib.cli import main
 from geomlib.validate import MeshError
 
