@@ -51,17 +51,13 @@ class BVH:
 
 
 def bvh_arrays(bvh) -> tuple:
-    """The seven arrays of any object with the fields of :class:`BVH`, in kernel dtypes (given)."""
-    f = np.ascontiguousarray
-    return (
-        f(bvh.lo, np.float64),
-        f(bvh.hi, np.float64),
-        f(bvh.left, np.int64),
-        f(bvh.right, np.int64),
-        f(bvh.start, np.int64),
-        f(bvh.count, np.int64),
-        f(bvh.order, np.int64),
-    )
+    """The seven arrays of a :class:`BVH` (or any object or dict with its fields), in kernel dtypes (given)."""
+    names = ("lo", "hi", "left", "right", "start", "count", "order")
+    try:
+        raw = [bvh[k] if isinstance(bvh, dict) else getattr(bvh, k) for k in names]
+    except (KeyError, AttributeError) as e:
+        raise MeshError(f"bvh must have the fields {', '.join(names)}; missing {e}") from None
+    return tuple(np.ascontiguousarray(a, np.float64 if i < 2 else np.int64) for i, a in enumerate(raw))
 
 
 def build_bvh(V, F, leaf_size: int = 4) -> BVH:
