@@ -41,6 +41,17 @@ def wedge():
     return V, np.array(side + bottom + top, np.int64)
 
 
+def thin_prism():
+    """A closed prism over a 20-degree sliver triangle: its sharp edge fools the face-normal sign."""
+    T = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0 * np.tan(np.radians(20))]])
+    V = np.vstack([np.c_[T, np.zeros(3)], np.c_[T, np.full(3, 0.5)]])
+    F = [[0, 2, 1], [3, 4, 5]]
+    for i in range(3):
+        j = (i + 1) % 3
+        F += [[i, j, 3 + j], [i, 3 + j, 3 + i]]
+    return V, np.array(F, np.int64)
+
+
 def random_points(V, n, seed, margin=0.3):
     rng = np.random.default_rng(seed)
     lo, hi = V.min(0) - margin, V.max(0) + margin
