@@ -128,4 +128,6 @@ def bvh_closest(
         upper = band * band
     from . import kernels
 
-    return kernels.closest_kernel(P, V, F, *bvh_arrays(bvh), upper)
+    arrays = bvh_arrays(bvh)
+    T = np.ascontiguousarray(V[F[arrays[-1]]].reshape(-1, 9))  # corners in leaf order
+    return kernels.closest_kernel(P, T, *arrays, upper)

@@ -55,7 +55,7 @@ def outside_rule(P, Q, phi_q) -> np.ndarray:
     return np.where(phi_q >= 0, np.hypot(dq, phi_q), phi_q + dq)
 
 
-def trilinear(values, origin, spacing: float, P) -> np.ndarray:
+def trilinear(values, origin, spacing: float, P, *, validate: bool = True) -> np.ndarray:
     """Trilinear interpolation of a grid at points ``P`` (with the outside rule beyond the box).
 
     Parameters
@@ -65,6 +65,9 @@ def trilinear(values, origin, spacing: float, P) -> np.ndarray:
     origin : (3,) array_like
     spacing : float
     P : (n, 3) array_like
+    validate : bool
+        Check the grid (skipped by :class:`SDFGrid`, which checked it once when it was made: a
+        sphere tracer calls this for every step).
 
     Returns
     -------
@@ -77,12 +80,15 @@ def trilinear(values, origin, spacing: float, P) -> np.ndarray:
     weights ``prod_k (f_k if corner_k else 1 - f_k)``. Then apply :func:`outside_rule`.
     """
     where = "trilinear"
-    values, origin, spacing = check_grid(values, origin, spacing, where)
-    P = as_points(P, where)
+    if validate:
+        values, origin, spacing = check_grid(values, origin, spacing, where)
+        P = as_points(P, where)
+    else:
+        P = np.asarray(P, np.float64)
     shape = np.array(values.shape)
     hi = origin + spacing * (shape - 1)
     Q = np.clip(P, origin, hi)
-    raise NotImplementedError('Task 6 (trilinear): u = (Q - origin)/h, i0 = clip(floor(u), 0, shape-2), f = u - i0, blend the 8 corners, then outside_rule(P, Q, phi_q)')
+    raise NotImplementedError('Task 6 (trilinear): u = (Q - origin)/h, i0 = clip(floor(u), 0, shape-2), f = u - i0, blend the 8 corners with weights prod(f or 1 - f), then outside_rule(P, Q, phi_q)')
 
 
 @dataclass(frozen=True)
@@ -100,6 +106,12 @@ class SDFGrid:
     values: np.ndarray
     origin: np.ndarray
     spacing: float
+
+    def __post_init__(self):
+        values, origin, spacing = check_grid(self.values, self.origin, self.spacing, "SDFGrid")
+        object.__setattr__(self, "values", values)
+        object.__setattr__(self, "origin", origin)
+        object.__setattr__(self, "spacing", spacing)
 
     @property
     def shape(self) -> tuple[int, int, int]:
@@ -120,7 +132,7 @@ class SDFGrid:
 
     def sample(self, P) -> np.ndarray:
         """Trilinear lookup at ``P (n, 3)`` (see :func:`trilinear`)."""
-        return trilinear(self.values, self.origin, self.spacing, P)
+        return trilinear(self.values, self.origin, self.spacing, as_points(P, "SDFGrid.sample"), validate=False)
 
     def __call__(self, P) -> np.ndarray:
         return self.sample(P)

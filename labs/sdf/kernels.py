@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 STACK = 128  # deeper than any median-split tree over < 2**100 triangles needs
+BLOCK = 64  # consecutive query points walked by one thread, warm-started from each other
 
 
 @njit(cache=True)
@@ -39,7 +40,12 @@ def build_bvh_kernel(lo, hi, cen, leaf_size):
     raise NotImplementedError('Task 3 (BVH build): stack of (node, start, end); node box = union of its triangle boxes; leaf when end - start <= leaf_size, else sort the range by centroid along the longest centroid-box axis and split at the median')
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _corners(T, j):
+    return T[j, 0], T[j, 1], T[j, 2], T[j, 3], T[j, 4], T[j, 5], T[j, 6], T[j, 7], T[j, 8]
+
+
+@njit(cache=True, inline="always")
 def box_sq_dist(px, py, pz, node_lo, node_hi, k):
     """Squared distance from a point to the box of node ``k`` (0 inside)."""
     dx = max(node_lo[k, 0] - px, 0.0, px - node_hi[k, 0])
@@ -49,19 +55,31 @@ def box_sq_dist(px, py, pz, node_lo, node_hi, k):
 
 
 @njit(cache=True, parallel=True)
-def closest_kernel(P, V, F, node_lo, node_hi, left, right, start, count, order, upper_sq):
+def closest_kernel(P, T, node_lo, node_hi, left, right, start, count, order, upper_sq):
     """Closest point on the mesh for each row of ``P``, searching only within ``sqrt(upper_sq)``.
 
+    ``T (m, 9)`` holds the corners of the triangles **in leaf order**: row ``j`` is triangle
+    ``order[j]`` as ``(ax, ay, az, bx, by, bz, cx, cy, cz)`` (contiguous memory for the leaf loop).
+
     Returns ``(sq_dist, face, closest, region)``; points with nothing closer than the bound get
-    ``sq_dist = upper_sq``, ``face = -1`` and their own position as closest point.
+    ``sq_dist = upper_sq``, ``face = -1``, region ``-1`` and their own position as closest point.
+
+    Points are processed in blocks of :data:`BLOCK` consecutive rows (in parallel over blocks).
+    Consecutive rows are usually neighbours (grid samples, pixels), so each point first measures the
+    triangle that was closest to the previous point of its block: that warm start makes ``best``
+    small from the beginning, and the walk prunes far more.
     """
     n = P.shape[0]
     sq = np.empty(n)
     face = np.empty(n, np.int64)
     C = np.empty((n, 3))
     region = np.empty(n, np.int64)
-    for i in prange(n):
-        raise NotImplementedError('Task 3 (BVH query): best = upper_sq; pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the farther child first so the nearer one is visited next')
+    n_blocks = (n + BLOCK - 1) // BLOCK
+    for blk in prange(n_blocks):
+        stack = np.empty(STACK, np.int64)
+        prev = -1
+        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
+            raise NotImplementedError("Task 3 (BVH query): best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]")
     return sq, face, C, region
 
 

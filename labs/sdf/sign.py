@@ -78,7 +78,7 @@ def pseudonormals(V, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     where = "pseudonormals"
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
-    raise NotImplementedError('Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.add.at); vertex normals = sum of corner angle * face normal')
+    raise NotImplementedError('Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal')
 
 
 def _signs(x: np.ndarray) -> np.ndarray:

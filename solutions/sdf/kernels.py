@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 STACK = 128  # deeper than any median-split tree over < 2**100 triangles needs
+BLOCK = 64  # consecutive query points walked by one thread, warm-started from each other
 
 
 @njit(cache=True)
@@ -133,7 +134,12 @@ def build_bvh_kernel(lo, hi, cen, leaf_size):
     # END SOLUTION
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
+def _corners(T, j):
+    return T[j, 0], T[j, 1], T[j, 2], T[j, 3], T[j, 4], T[j, 5], T[j, 6], T[j, 7], T[j, 8]
+
+
+@njit(cache=True, inline="always")
 def box_sq_dist(px, py, pz, node_lo, node_hi, k):
     """Squared distance from a point to the box of node ``k`` (0 inside)."""
     dx = max(node_lo[k, 0] - px, 0.0, px - node_hi[k, 0])
@@ -143,55 +149,71 @@ def box_sq_dist(px, py, pz, node_lo, node_hi, k):
 
 
 @njit(cache=True, parallel=True)
-def closest_kernel(P, V, F, node_lo, node_hi, left, right, start, count, order, upper_sq):
+def closest_kernel(P, T, node_lo, node_hi, left, right, start, count, order, upper_sq):
     """Closest point on the mesh for each row of ``P``, searching only within ``sqrt(upper_sq)``.
 
+    ``T (m, 9)`` holds the corners of the triangles **in leaf order**: row ``j`` is triangle
+    ``order[j]`` as ``(ax, ay, az, bx, by, bz, cx, cy, cz)`` (contiguous memory for the leaf loop).
+
     Returns ``(sq_dist, face, closest, region)``; points with nothing closer than the bound get
-    ``sq_dist = upper_sq``, ``face = -1`` and their own position as closest point.
+    ``sq_dist = upper_sq``, ``face = -1``, region ``-1`` and their own position as closest point.
+
+    Points are processed in blocks of :data:`BLOCK` consecutive rows (in parallel over blocks).
+    Consecutive rows are usually neighbours (grid samples, pixels), so each point first measures the
+    triangle that was closest to the previous point of its block: that warm start makes ``best``
+    small from the beginning, and the walk prunes far more.
     """
     n = P.shape[0]
     sq = np.empty(n)
     face = np.empty(n, np.int64)
     C = np.empty((n, 3))
     region = np.empty(n, np.int64)
-    for i in prange(n):
-        # BEGIN SOLUTION: Task 3 (BVH query): best = upper_sq; pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the farther child first so the nearer one is visited next
-        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
-        best = upper_sq
-        bf = -1
-        bx, by, bz = px, py, pz
-        br = -1
+    n_blocks = (n + BLOCK - 1) // BLOCK
+    for blk in prange(n_blocks):
         stack = np.empty(STACK, np.int64)
-        stack[0] = 0
-        top = 1
-        while top > 0:
-            top -= 1
-            k = stack[top]
-            if box_sq_dist(px, py, pz, node_lo, node_hi, k) >= best:
-                continue
-            if left[k] < 0:
-                for j in range(start[k], start[k] + count[k]):
-                    t = order[j]
-                    a, b, c = F[t, 0], F[t, 1], F[t, 2]
-                    qx, qy, qz, r = closest_on_triangle(
-                        px, py, pz, V[a, 0], V[a, 1], V[a, 2], V[b, 0], V[b, 1], V[b, 2], V[c, 0], V[c, 1], V[c, 2]
-                    )
-                    d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
-                    if d < best or (d == best and bf >= 0 and t < bf):
-                        best, bf, bx, by, bz, br = d, t, qx, qy, qz, r
-            else:
-                dl = box_sq_dist(px, py, pz, node_lo, node_hi, left[k])
-                dr = box_sq_dist(px, py, pz, node_lo, node_hi, right[k])
-                if dl <= dr:
-                    stack[top] = right[k]
-                    stack[top + 1] = left[k]
+        prev = -1
+        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
+            # BEGIN SOLUTION: Task 3 (BVH query): best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]
+            px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+            best = upper_sq
+            bf = -1
+            bx, by, bz = px, py, pz
+            br = -1
+            if prev >= 0:
+                qx, qy, qz, r = closest_on_triangle(px, py, pz, *_corners(T, prev))
+                d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+                if d < best:
+                    best, bf, bx, by, bz, br = d, prev, qx, qy, qz, r
+            stack[0] = 0
+            top = 1
+            while top > 0:
+                top -= 1
+                k = stack[top]
+                if box_sq_dist(px, py, pz, node_lo, node_hi, k) >= best:
+                    continue
+                if left[k] < 0:
+                    for j in range(start[k], start[k] + count[k]):
+                        qx, qy, qz, r = closest_on_triangle(px, py, pz, *_corners(T, j))
+                        d = (qx - px) ** 2 + (qy - py) ** 2 + (qz - pz) ** 2
+                        if d < best:
+                            best, bf, bx, by, bz, br = d, j, qx, qy, qz, r
                 else:
-                    stack[top] = left[k]
-                    stack[top + 1] = right[k]
-                top += 2
-        sq[i], face[i], region[i] = best, bf, br
-        C[i, 0], C[i, 1], C[i, 2] = bx, by, bz
-        # END SOLUTION
+                    lk, rk = left[k], right[k]
+                    dl = box_sq_dist(px, py, pz, node_lo, node_hi, lk)
+                    dr = box_sq_dist(px, py, pz, node_lo, node_hi, rk)
+                    if dl > dr:
+                        lk, rk, dl, dr = rk, lk, dr, dl
+                    if dr < best:  # farther child first, so the nearer one is popped next
+                        stack[top] = rk
+                        top += 1
+                    if dl < best:
+                        stack[top] = lk
+                        top += 1
+            sq[i], face[i], region[i] = best, order[bf] if bf >= 0 else -1, br
+            C[i, 0], C[i, 1], C[i, 2] = bx, by, bz
+            if bf >= 0:
+                prev = bf
+            # END SOLUTION
     return sq, face, C, region
 
 

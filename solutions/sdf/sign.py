@@ -78,21 +78,22 @@ def pseudonormals(V, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     where = "pseudonormals"
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
-    # BEGIN SOLUTION: Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.add.at); vertex normals = sum of corner angle * face normal
+    # BEGIN SOLUTION: Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal
     FN = face_normals_unit(V, F)
     m = len(F)
     E = np.stack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]], axis=1).reshape(-1, 2)  # (3m, 2)
     key = np.sort(E, axis=1)
     _, inv = np.unique(key[:, 0] * len(V) + key[:, 1], return_inverse=True)
-    acc = np.zeros((inv.max() + 1, 3))
-    np.add.at(acc, inv, np.repeat(FN, 3, axis=0))
+    rep = np.repeat(FN, 3, axis=0)
+    acc = np.stack([np.bincount(inv, weights=rep[:, k]) for k in range(3)], axis=1)  # sum per edge
     EN = acc[inv].reshape(m, 3, 3)
-    VN = np.zeros((len(V), 3))
+    ang = np.empty((m, 3))
     for k in range(3):  # three corners: a loop over corners, not over faces
         p, q, r = V[F[:, k]], V[F[:, (k + 1) % 3]], V[F[:, (k + 2) % 3]]
         u, v = q - p, r - p
-        ang = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
-        np.add.at(VN, F[:, k], ang[:, None] * FN)
+        ang[:, k] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
+    W = (ang[:, :, None] * FN[:, None, :]).reshape(-1, 3)  # (3m, 3) corner contributions
+    VN = np.stack([np.bincount(F.ravel(), weights=W[:, k], minlength=len(V)) for k in range(3)], axis=1)
     return FN, EN, VN
     # END SOLUTION
 
