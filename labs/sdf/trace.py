@@ -95,7 +95,7 @@ def render_sdf(
     width: int,
     height: int,
     *,
-    light_dir=(0.4, 0.3, 0.85),
+    light_dir=(0.3, -0.6, 0.75),
     max_steps: int = 64,
     eps: float = 1e-4,
     h: float = 1e-3,
@@ -104,10 +104,13 @@ def render_sdf(
 
     Returns a dict: ``hit (H, W) bool``, ``depth (H, W)`` (distance along the ray, inf on misses),
     ``normal (H, W, 3)`` (4-tap gradient at hits), ``steps (H, W)``, ``image (H, W, 3)`` in [0, 1]
-    (``0.15 + 0.85 max(n . l, 0)`` on hits, white background) and ``points (H, W, 3)``.
+    (``0.15 + 0.85 max(n . l, 0)`` on hits, white background) and ``points (H, W, 3)``. Rays
+    stop beyond the camera's far plane.
     """
     O, D = camera_rays(M, width, height)
-    t, hit, steps = sphere_trace(sdf, O, D, max_steps=max_steps, eps=eps)
+    far = np.linalg.inv(np.asarray(M, float)) @ np.array([0.0, 0.0, 1.0, 1.0])
+    t_max = 2 * float(np.linalg.norm(far[:3] / far[3] - O.mean(axis=0)))  # beyond the far plane
+    t, hit, steps = sphere_trace(sdf, O, D, max_steps=max_steps, eps=eps, t_max=t_max)
     X = np.where(hit[:, None], O + np.where(hit, t, 0)[:, None] * D, np.nan)
     N = np.zeros_like(O)
     if hit.any():

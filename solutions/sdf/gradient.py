@@ -3,9 +3,13 @@
 ``grad phi`` is the outward unit normal on the surface. Two finite-difference stencils:
 
 * **central differences**, 6 taps: ``g_x = (phi(p + h e_x) - phi(p - h e_x)) / 2h`` and so on;
+  second-order accurate (error ``O(h^2)``).
 * **tetrahedral**, 4 taps: ``g = sum_i k_i phi(p + h k_i)`` with
-  ``k in {(1,-1,-1), (-1,-1,1), (-1,1,-1), (1,1,1)}``: the four corners of a tetrahedron, whose
-  pairwise cancellations leave ``4 h grad phi + O(h^3)``. Two thirds of the cost, same accuracy.
+  ``k in {(1,-1,-1), (-1,-1,1), (-1,1,-1), (1,1,1)}``, the corners of a tetrahedron. Taylor
+  expansion gives ``g = 4 h grad phi + 4 h^2 (phi_yz, phi_xz, phi_xy) + O(h^3)``: two thirds of
+  the lookups, but only first-order accurate where the mixed second derivatives are not zero
+  (curved surfaces seen diagonally, and every trilinear cell, whose ``xy``, ``xz``, ``yz`` terms
+  are exactly such derivatives). The handout's figure measures both.
 
 Both are normalised (``g / |g|``); a zero gradient (a point equidistant from everything) gives 0.
 """
