@@ -78,7 +78,7 @@ def closest_kernel(P, T, node_lo, node_hi, left, right, start, count, order, upp
     for blk in prange(n_blocks):
         stack = np.empty(STACK, np.int64)
         prev = -1
-        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
+        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):  # noqa: B007 (its body is your task)
             raise NotImplementedError("Task 3 (BVH query): best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]")
     return sq, face, C, region
 
@@ -109,8 +109,8 @@ def crossings_kernel(P, D, V, F, node_lo, node_hi, left, right, start, count, or
     """Number of triangles each ray ``P[i] + t D[j]`` (``t > 0``) crosses: ``(n, k)`` int64."""
     n, k = P.shape[0], D.shape[0]
     out = np.zeros((n, k), np.int64)
-    for i in prange(n):
+    for i in prange(n):  # noqa: B007 (its body is your task)
         stack = np.empty(STACK, np.int64)
-        for j in range(k):
+        for j in range(k):  # noqa: B007
             raise NotImplementedError('Task 4 (vote): walk the BVH with a slab test per box (t_far >= max(t_near, 0)); count every triangle hit with t > 0')
     return out

@@ -98,6 +98,4 @@ def brute_force_distance(V, F, P, *, chunk: int = 1 << 20) -> tuple[np.ndarray, 
     if n == 0:
         return sq, face, C, region
     step = max(1, chunk // len(F))
-    for s in range(0, n, step):  # bounded memory: step points x all triangles per pass
-        raise NotImplementedError('Task 2 (mesh distance): point_triangle_distance on a chunk of points, then argmin over triangles (the first on ties)')
-    return sq, face, C, region
+    raise NotImplementedError('Task 2 (mesh distance): for chunks of `step` points: point_triangle_distance against all triangles, then argmin over triangles (the first on ties)')

@@ -228,8 +228,8 @@ def winding_number(V, F, P, *, chunk: int = 1 << 20) -> np.ndarray:
     T = V[F]
     w = np.zeros(len(P))
     step = max(1, chunk // len(F))
+    # BEGIN SOLUTION: Task 4 (winding number): for chunks of `step` points: a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi
     for s in range(0, len(P), step):  # bounded memory: step points x all triangles per pass
-        # BEGIN SOLUTION: Task 4 (winding number): a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi
         X = T[None] - P[s : s + step, None, None, :]  # (k, m, 3, 3)
         a, b, c = X[:, :, 0], X[:, :, 1], X[:, :, 2]
         la, lb, lc = (np.linalg.norm(x, axis=-1) for x in (a, b, c))
@@ -241,5 +241,5 @@ def winding_number(V, F, P, *, chunk: int = 1 << 20) -> np.ndarray:
             + np.einsum("ijk,ijk->ij", c, a) * lb
         )
         w[s : s + step] = 2 * np.arctan2(num, den).sum(axis=1) / (4 * np.pi)
-        # END SOLUTION
     return w
+    # END SOLUTION

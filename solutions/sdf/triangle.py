@@ -140,8 +140,8 @@ def brute_force_distance(V, F, P, *, chunk: int = 1 << 20) -> tuple[np.ndarray, 
     if n == 0:
         return sq, face, C, region
     step = max(1, chunk // len(F))
+    # BEGIN SOLUTION: Task 2 (mesh distance): for chunks of `step` points: point_triangle_distance against all triangles, then argmin over triangles (the first on ties)
     for s in range(0, n, step):  # bounded memory: step points x all triangles per pass
-        # BEGIN SOLUTION: Task 2 (mesh distance): point_triangle_distance on a chunk of points, then argmin over triangles (the first on ties)
         d, Q, R = point_triangle_distance(P[s : s + step], T)
         j = np.argmin(d, axis=1)
         rows = np.arange(len(j))
@@ -149,5 +149,5 @@ def brute_force_distance(V, F, P, *, chunk: int = 1 << 20) -> tuple[np.ndarray, 
         face[s : s + step] = j
         C[s : s + step] = Q[rows, j]
         region[s : s + step] = R[rows, j]
-        # END SOLUTION
     return sq, face, C, region
+    # END SOLUTION
