@@ -152,15 +152,14 @@ def fig_csg(out: Path, quick: bool) -> Figure:
 def fig_slices(out: Path, quick: bool) -> Figure:
     def make():
         V, F, g = _torus_grid(quick)
-        n = g.shape[0]
         r = 0.6
-        a = _slice_image(
-            g.values[:, :, int(np.argmin(np.abs(g.origin[2] + g.spacing * np.arange(n) - 0.35)))],
-            r,
-            0.1,
-            4 if quick else 3,
-        )
-        b = _slice_image(g.values[:, n // 2, :], r, 0.1, 4 if quick else 3)
+        m = 120 if quick else 220
+        u = np.linspace(g.origin[0], g.upper[0], m)
+        A, B = np.meshgrid(u, u, indexing="ij")
+        top = g.sample(np.c_[A.ravel(), B.ravel(), np.full(A.size, 0.35)]).reshape(m, m)
+        side = g.sample(np.c_[A.ravel(), np.zeros(A.size), B.ravel() - g.origin[0] + g.origin[2]]).reshape(m, m)
+        a = _slice_image(top, r, 0.1, 2 if quick else 1)
+        b = _slice_image(side, r, 0.1, 2 if quick else 1)
         return [a, _with_bar(b, -r, r, "RdBu", "phi")], g
 
     try:
