@@ -306,3 +306,17 @@ def test_bad_input():
         sdf_grid(np.zeros((3, 3)), [[0, 1, 2]], 8)
     with pytest.raises(MeshError):
         signed_distance(V, np.array([[0, 0, 1]]), np.zeros((1, 3)))
+
+
+def test_zero_area_triangles_give_finite_distances():
+    """A sliver with three distinct but collinear corners: distances stay exact (edge regions), the vote still signs."""
+    V, F = datasets.icosphere(1)
+    V = np.vstack([V, [[2.0, 0, 0], [2.5, 0, 0], [3.0, 0, 0]]])
+    F = np.vstack([F, [[len(V) - 3, len(V) - 2, len(V) - 1]]])
+    P = _points(V, 300, 13)
+    sq, _, _, _ = brute_force_distance(V, F, P)
+    sq_i, _, _ = igl.point_mesh_squared_distance(P, V, F)
+    np.testing.assert_allclose(sq, sq_i, atol=1e-12)
+    d = signed_distance(V, F, P, sign="vote")
+    assert np.all(np.isfinite(d))
+    np.testing.assert_allclose(np.abs(d), np.sqrt(sq_i), atol=1e-12)
