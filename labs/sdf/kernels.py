@@ -23,22 +23,31 @@ from numba import njit, prange
 
 
 def _writable_cache() -> None:
-    """Keep ``cache=True`` working where this folder is read-only (given).
+    """Where ``cache=True`` keeps the compiled kernels (given).
 
-    numba caches next to the source file; an autograder may run your code as an unprivileged user
-    that cannot write there (nor to its home). Then the cache goes to a per-user folder in the
-    temporary directory, so every worker process still loads the kernels instead of compiling them.
+    numba's cache holds references to the module by its import name, and one file can be imported
+    under several names (``labs.sdf.kernels`` in your notebook, another name in the grader's
+    workers); a cache written under one name fails to load under another. So each import name gets
+    its own folder under ``__pycache__`` (or under ``NUMBA_CACHE_DIR`` if set). Where this folder is
+    read-only (an autograder may run your code as an unprivileged user), the cache goes to a per-user
+    folder in the temporary directory, so every worker process still loads the kernels instead of
+    compiling them.
     """
-    if os.environ.get("NUMBA_CACHE_DIR"):
+    name = "numba-" + __name__.replace(".", "_")
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    candidates = [Path(env) / name] if env else []
+    candidates += [
+        Path(__file__).resolve().parent / "__pycache__" / name,
+        Path(tempfile.gettempdir()) / f"geomlib-numba-{os.getuid()}" / name,
+    ]
+    for path in candidates:
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+            tempfile.TemporaryFile(dir=path).close()
+        except OSError:
+            continue
+        numba.config.CACHE_DIR = str(path)
         return
-    try:
-        here = Path(__file__).resolve().parent / "__pycache__"
-        here.mkdir(exist_ok=True)
-        tempfile.TemporaryFile(dir=here).close()
-    except OSError:
-        fallback = Path(tempfile.gettempdir()) / f"geomlib-numba-{os.getuid()}"
-        fallback.mkdir(mode=0o700, exist_ok=True)
-        numba.config.CACHE_DIR = str(fallback)
 
 
 _writable_cache()
