@@ -36,10 +36,14 @@ def _u8(img):
 
 def _missing(size, what: str) -> np.ndarray:
     """A grey panel standing in for a picture whose tasks are not implemented yet."""
+    import textwrap
+
     from PIL import Image, ImageDraw
 
-    im = Image.new("RGB", (size[1], size[0]), (235, 235, 235))
-    ImageDraw.Draw(im).multiline_text((10, 10), "not implemented yet:\n" + what, fill=(90, 90, 90))
+    h, w = max(size[0], 160), max(size[1], 260)
+    im = Image.new("RGB", (w, h), (235, 235, 235))
+    text = "not implemented yet:\n" + "\n".join(textwrap.wrap(what, max(20, w // 7)))
+    ImageDraw.Draw(im).multiline_text((10, 10), text, fill=(90, 90, 90))
     return np.asarray(im)
 
 

@@ -36,9 +36,9 @@ def _u8(img):
 
 def _missing(size, what: str) -> np.ndarray:
     """A grey panel standing in for a picture whose tasks are not implemented yet."""
-    from PIL import Image, ImageDraw
-
     import textwrap
+
+    from PIL import Image, ImageDraw
 
     h, w = max(size[0], 160), max(size[1], 260)
     im = Image.new("RGB", (w, h), (235, 235, 235))

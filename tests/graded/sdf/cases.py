@@ -28,6 +28,10 @@ from .support import (
     wedge,
 )
 
+#: Seconds allowed for calls that run the numba kernels: the first call of a fresh submission
+#: compiles them (10-30 s on a slow or busy machine); later calls load them from the cache.
+KERNEL_TIMEOUT = 180.0
+
 # hand-checkable points around the box centred at the origin with half sizes (1, 2, 3):
 # centre (-1), inside near the x face (-0.5), on a face (0), outside a face (+1), an edge (sqrt 2),
 # a corner (sqrt 3)
@@ -235,6 +239,7 @@ CASES = [
     Case(
         id="bvh-closest-torus",
         function="bvh_closest",
+        timeout=KERNEL_TIMEOUT,
         inputs=_bvh_inputs(torus_small, 200, 6),
         outputs=("sq_dist", "face", "closest", "region"),
         check=checks.Custom(close_outputs(("sq_dist", "closest"), 1e-9)),
@@ -245,6 +250,7 @@ CASES = [
     Case(
         id="bvh-band-torus",
         function="bvh_closest",
+        timeout=KERNEL_TIMEOUT,
         inputs=_with(_bvh_inputs(torus_small, 200, 7), band=0.15),
         outputs=("sq_dist", "face", "closest", "region"),
         check=checks.Custom(close_outputs(("sq_dist",), 1e-9)),
@@ -255,6 +261,7 @@ CASES = [
     Case(
         id="band-grid-sphere",
         function="grid_sdf_values",
+        timeout=KERNEL_TIMEOUT,
         inputs=lambda: {
             "V": sphere_small()[0],
             "F": sphere_small()[1],
@@ -301,6 +308,7 @@ CASES = [
     Case(
         id="vote-torus",
         function="sign_vote",
+        timeout=KERNEL_TIMEOUT,
         inputs=_pick(_mesh_points(torus_small, 200, 9), "V", "F", "P"),
         outputs=("s",),
         check=checks.Equal("s"),

@@ -7,6 +7,7 @@ import numpy as np
 from geomlib.grading import Case, checks
 
 from .cases import (
+    KERNEL_TIMEOUT,
     _ao_inputs,
     _bricks_sample,
     _bvh_inputs,
@@ -117,6 +118,7 @@ CASES = [
     Case(
         id="hidden-bvh-closest-box",
         function="bvh_closest",
+        timeout=KERNEL_TIMEOUT,
         inputs=_bvh_inputs(box_mesh, 300, 106),
         outputs=("sq_dist", "face", "closest", "region"),
         check=checks.Custom(close_outputs(("sq_dist", "closest"), 1e-9)),
@@ -127,6 +129,7 @@ CASES = [
     Case(
         id="hidden-bvh-band-wedge",
         function="bvh_closest",
+        timeout=KERNEL_TIMEOUT,
         inputs=_with(_bvh_inputs(wedge, 300, 107), band=0.1),
         outputs=("sq_dist", "face", "closest", "region"),
         check=checks.Custom(close_outputs(("sq_dist",), 1e-9)),
@@ -137,6 +140,7 @@ CASES = [
     Case(
         id="hidden-band-grid-torus",
         function="grid_sdf_values",
+        timeout=KERNEL_TIMEOUT,
         inputs=lambda: {
             "V": torus_small()[0],
             "F": torus_small()[1],
@@ -185,6 +189,7 @@ CASES = [
     Case(
         id="hidden-vote-wedge",
         function="sign_vote",
+        timeout=KERNEL_TIMEOUT,
         inputs=_pick(_mesh_points(wedge, 300, 109), "V", "F", "P"),
         outputs=("s",),
         check=checks.Equal("s"),

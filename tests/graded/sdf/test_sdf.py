@@ -7,7 +7,7 @@ import numpy as np
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
 
-from .cases import BOX_POINTS, CASES, TRI, TRI_POINTS
+from .cases import BOX_POINTS, CASES, KERNEL_TIMEOUT, TRI, TRI_POINTS
 from .support import check_bvh, scene, torus_small, wedge
 
 test_references = reference_tests(CASES)
@@ -42,13 +42,13 @@ def _bvh_test(lab, mesh, leaf):
         raise Mismatch(f"build_bvh(leaf_size={leaf}): {msg}")
 
 
-@graded(points=1, part="BVH")
+@graded(points=1, part="BVH", timeout=KERNEL_TIMEOUT)
 def test_bvh_is_valid_torus(lab):
     """build_bvh on a torus: boxes hold their triangles, children split their parent, leaves cover every triangle once"""
     _bvh_test(lab, torus_small, 4)
 
 
-@graded(points=1, part="sign")
+@graded(points=1, part="sign", timeout=KERNEL_TIMEOUT)
 def test_vote_on_an_open_mesh(lab):
     """sign_vote still answers on a mesh with a hole: far-inside points stay inside"""
     V, F = wedge()
