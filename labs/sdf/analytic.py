@@ -173,19 +173,19 @@ def _pair(a, b, where: str) -> tuple[np.ndarray, np.ndarray]:
 def op_union(a, b) -> np.ndarray:
     """Union of two solids: ``min(a, b)``."""
     a, b = _pair(a, b, "op_union")
-    raise NotImplementedError('Task 1 (CSG): union = min(a, b)')
+    raise NotImplementedError('Task 1 (analytic SDFs): CSG: union = min(a, b)')
 
 
 def op_intersection(a, b) -> np.ndarray:
     """Intersection of two solids: ``max(a, b)``."""
     a, b = _pair(a, b, "op_intersection")
-    raise NotImplementedError('Task 1 (CSG): intersection = max(a, b)')
+    raise NotImplementedError('Task 1 (analytic SDFs): CSG: intersection = max(a, b)')
 
 
 def op_difference(a, b) -> np.ndarray:
     """``a`` minus ``b``: ``max(a, -b)`` (inside ``a`` and outside ``b``)."""
     a, b = _pair(a, b, "op_difference")
-    raise NotImplementedError('Task 1 (CSG): difference = max(a, -b)')
+    raise NotImplementedError('Task 1 (analytic SDFs): CSG: difference = max(a, -b)')
 
 
 def smooth_union(a, b, k: float = 0.1) -> np.ndarray:

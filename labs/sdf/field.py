@@ -88,7 +88,7 @@ def trilinear(values, origin, spacing: float, P, *, validate: bool = True) -> np
     shape = np.array(values.shape)
     hi = origin + spacing * (shape - 1)
     Q = np.clip(P, origin, hi)
-    raise NotImplementedError('Task 6 (trilinear): u = (Q - origin)/h, i0 = clip(floor(u), 0, shape-2), f = u - i0, blend the 8 corners with weights prod(f or 1 - f), then outside_rule(P, Q, phi_q)')
+    raise NotImplementedError('Task 6 (queries): trilinear: u = (Q - origin)/h, i0 = clip(floor(u), 0, shape-2), f = u - i0, blend the 8 corners with weights prod(f or 1 - f), then outside_rule(P, Q, phi_q)')
 
 
 @dataclass(frozen=True)

@@ -62,7 +62,7 @@ def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
 
     Returns ``(qx, qy, qz, region)``.
     """
-    raise NotImplementedError('Task 3 (BVH query, leaf test): your Task 2 for one point and one triangle, in scalars: Voronoi regions of a, b, c, then edges ab, ca, bc, else the interior (barycentric v = vb/(va+vb+vc), w = vc/(va+vb+vc))')
+    raise NotImplementedError('Task 3 (BVH): BVH query, leaf test: your Task 2 for one point and one triangle, in scalars: Voronoi regions of a, b, c, then edges ab, ca, bc, else the interior (barycentric v = vb/(va+vb+vc), w = vc/(va+vb+vc))')
 
 
 @njit(cache=True)
@@ -73,7 +73,7 @@ def build_bvh_kernel(lo, hi, cen, leaf_size):
     whose triangles are ``order[start[k] : start[k] + count[k]]``. Node 0 is the root; nodes are
     numbered in depth-first order, left child first.
     """
-    raise NotImplementedError('Task 3 (BVH build): stack of (node, start, end); node box = union of its triangle boxes; leaf when end - start <= leaf_size, else sort the range by centroid along the longest centroid-box axis and split at the median')
+    raise NotImplementedError('Task 3 (BVH): BVH build: stack of (node, start, end); node box = union of its triangle boxes; leaf when end - start <= leaf_size, else sort the range by centroid along the longest centroid-box axis and split at the median')
 
 
 @njit(cache=True, inline="always")
@@ -115,7 +115,7 @@ def closest_kernel(P, T, node_lo, node_hi, left, right, start, count, order, upp
         stack = np.empty(STACK, np.int64)
         prev = -1
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):  # noqa: B007 (its body is your task)
-            raise NotImplementedError("Task 3 (BVH query): best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]")
+            raise NotImplementedError("Task 3 (BVH): BVH query: best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]")
     return sq, face, C, region
 
 
@@ -148,5 +148,5 @@ def crossings_kernel(P, D, V, F, node_lo, node_hi, left, right, start, count, or
     for i in prange(n):  # noqa: B007 (its body is your task)
         stack = np.empty(STACK, np.int64)
         for j in range(k):  # noqa: B007
-            raise NotImplementedError('Task 4 (vote): walk the BVH with a slab test per box (t_far >= max(t_near, 0)); count every triangle hit with t > 0')
+            raise NotImplementedError('Task 4 (sign): vote: walk the BVH with a slab test per box (t_far >= max(t_near, 0)); count every triangle hit with t > 0')
     return out

@@ -107,7 +107,7 @@ def grid_sdf_values(V, F, origin, spacing: float, shape, *, band: float | None =
         return (np.sqrt(sq) * _sign(V, F, P, face, C, region, sign, B)).reshape(shape)
     r = band * spacing
     sq, face, C, region = bvh_closest(B, V, F, P, band=r)
-    raise NotImplementedError('Task 3 (narrow band): exact signed distance where face >= 0; label the connected far regions (scipy.ndimage.label on face < 0) and sign each from one signed query of a representative sample')
+    raise NotImplementedError('Task 3 (BVH): narrow band: exact signed distance where face >= 0; label the connected far regions (scipy.ndimage.label on face < 0) and sign each from one signed query of a representative sample')
 
 
 def grid_box(V, res: int, padding: float = 0.1) -> tuple[np.ndarray, float]:

@@ -48,4 +48,4 @@ def instances_distance(sdf, P, translations, scales) -> np.ndarray:
         raise MeshError(f"{where}: at least one instance is needed")
     if np.any(S <= 0):
         raise MeshError(f"{where}: scales must be > 0 (uniform scale per instance), got {S}")
-    raise NotImplementedError('Task 6 (instancing): d = min over instances of s_k * phi((P - t_k) / s_k)')
+    raise NotImplementedError('Task 6 (queries): instancing: d = min over instances of s_k * phi((P - t_k) / s_k)')

@@ -95,7 +95,7 @@ def soft_shadow(
     Ldir = Lv / Dist[:, None]
     tan_a = R / np.sqrt(Dist**2 - R**2)
     t0 = 1e-3 * Dist if t_start is None else np.full(len(P), check_float(t_start, "t_start", minimum=0.0, where=where))
-    raise NotImplementedError('Task 9 (soft shadow): march active points; d = phi(p + t l); d < eps -> V = 0; V = min(V, d/(t tan a)) or the improved e/((t - y) tan a); t += max(d, eps) while t < D - R; clamp to [0, 1]')
+    raise NotImplementedError('Task 9 (soft shadows): soft shadow: march active points; d = phi(p + t l); d < eps -> V = 0; V = min(V, d/(t tan a)) or the improved e/((t - y) tan a); t += max(d, eps) while t < D - R; clamp to [0, 1]')
 
 
 def ambient_occlusion(sdf, P, N, *, taps: int = 5, delta: float = 0.05) -> np.ndarray:
@@ -123,7 +123,7 @@ def ambient_occlusion(sdf, P, N, *, taps: int = 5, delta: float = 0.05) -> np.nd
     delta = check_float(delta, "delta", where=where)
     if delta <= 0:
         raise MeshError(f"{where}: delta must be > 0, got {delta}")
-    raise NotImplementedError('Task 9 (AO): w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)')
+    raise NotImplementedError('Task 9 (soft shadows): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)')
 
 
 def push_out(sdf, P, *, radius: float = 0.0, iterations: int = 4, h: float = 1e-3) -> np.ndarray:
@@ -148,4 +148,4 @@ def push_out(sdf, P, *, radius: float = 0.0, iterations: int = 4, h: float = 1e-
     P = as_points(P, where).copy()
     radius = check_float(radius, "radius", minimum=0.0, where=where)
     iterations = check_int(iterations, "iterations", minimum=1, maximum=100, where=where)
-    raise NotImplementedError('Task 9 (push-out): repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points')
+    raise NotImplementedError('Task 9 (soft shadows): push-out: repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points')

@@ -78,7 +78,7 @@ def pseudonormals(V, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     where = "pseudonormals"
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
-    raise NotImplementedError('Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal')
+    raise NotImplementedError('Task 4 (sign): pseudonormal: face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal')
 
 
 def _signs(x: np.ndarray) -> np.ndarray:
@@ -105,7 +105,7 @@ def sign_normal(V, F, P, face, closest) -> np.ndarray:
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
     P = as_points(P, where)
     face, closest = _closest_args(face, closest, len(P), len(F), where)
-    raise NotImplementedError('Task 4 (normal sign): s = sign((p - q) . n_f), +1 when the dot product is 0')
+    raise NotImplementedError('Task 4 (sign): normal sign: s = sign((p - q) . n_f), +1 when the dot product is 0')
 
 
 def sign_pseudonormal(V, F, P, face, closest, region, normals=None) -> np.ndarray:
@@ -133,7 +133,7 @@ def sign_pseudonormal(V, F, P, face, closest, region, normals=None) -> np.ndarra
 
         raise MeshError(f"{where}: region must be ({len(P)},) integers in 0..6")
     FN, EN, VN = pseudonormals(V, F) if normals is None else normals
-    raise NotImplementedError('Task 4 (pseudonormal sign): N = face normal (region 0), vertex normal of F[face, region-1] (1-3), edge normal EN[face, region-4] (4-6); s = sign((p - q) . N)')
+    raise NotImplementedError('Task 4 (sign): pseudonormal sign: N = face normal (region 0), vertex normal of F[face, region-1] (1-3), edge normal EN[face, region-4] (4-6); s = sign((p - q) . N)')
 
 
 def _closest_args(face, closest, n: int, m: int, where: str):
@@ -176,7 +176,7 @@ def sign_vote(V, F, P, *, directions=None, bvh=None) -> np.ndarray:
     from .bvh import build_bvh, bvh_arrays
 
     B = build_bvh(V, F) if bvh is None else bvh
-    raise NotImplementedError('Task 4 (vote): crossings = kernels.crossings_kernel(...); inside when more than half of the rays cross an odd number of times')
+    raise NotImplementedError('Task 4 (sign): vote: crossings = kernels.crossings_kernel(...); inside when more than half of the rays cross an odd number of times')
 
 
 def winding_number(V, F, P, *, chunk: int = 1 << 20) -> np.ndarray:
@@ -199,4 +199,4 @@ def winding_number(V, F, P, *, chunk: int = 1 << 20) -> np.ndarray:
     T = V[F]
     w = np.zeros(len(P))
     step = max(1, chunk // len(F))
-    raise NotImplementedError('Task 4 (winding number): for chunks of `step` points: a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi')
+    raise NotImplementedError('Task 4 (sign): winding number: for chunks of `step` points: a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi')

@@ -63,7 +63,7 @@ def point_triangle_distance(P, T) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     where = "point_triangle_distance"
     P = as_points(P, where)
     T = as_array(T, "T", dtype=np.float64, shape=(None, 3, 3), where=where)
-    raise NotImplementedError('Task 2 (point-triangle): broadcast P[:, None] against T[None]; d1..d6, va, vb, vc as in the Notes; pick the first true region with np.select (vertex a, vertex b, edge ab, vertex c, edge ca, edge bc, interior)')
+    raise NotImplementedError('Task 2 (point-triangle distance): point-triangle: broadcast P[:, None] against T[None]; d1..d6, va, vb, vc as in the Notes; pick the first true region with np.select (vertex a, vertex b, edge ab, vertex c, edge ca, edge bc, interior)')
 
 
 def brute_force_distance(V, F, P, *, chunk: int = 1 << 20) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -98,4 +98,4 @@ def brute_force_distance(V, F, P, *, chunk: int = 1 << 20) -> tuple[np.ndarray, 
     if n == 0:
         return sq, face, C, region
     step = max(1, chunk // len(F))
-    raise NotImplementedError('Task 2 (mesh distance): for chunks of `step` points: point_triangle_distance against all triangles, then argmin over triangles (the first on ties)')
+    raise NotImplementedError('Task 2 (point-triangle distance): mesh distance: for chunks of `step` points: point_triangle_distance against all triangles, then argmin over triangles (the first on ties)')

@@ -188,7 +188,7 @@ def _pair(a, b, where: str) -> tuple[np.ndarray, np.ndarray]:
 def op_union(a, b) -> np.ndarray:
     """Union of two solids: ``min(a, b)``."""
     a, b = _pair(a, b, "op_union")
-    # BEGIN SOLUTION: Task 1 (CSG): union = min(a, b)
+    # BEGIN SOLUTION: Task 1 (analytic SDFs): CSG: union = min(a, b)
     return np.minimum(a, b)
     # END SOLUTION
 
@@ -196,7 +196,7 @@ def op_union(a, b) -> np.ndarray:
 def op_intersection(a, b) -> np.ndarray:
     """Intersection of two solids: ``max(a, b)``."""
     a, b = _pair(a, b, "op_intersection")
-    # BEGIN SOLUTION: Task 1 (CSG): intersection = max(a, b)
+    # BEGIN SOLUTION: Task 1 (analytic SDFs): CSG: intersection = max(a, b)
     return np.maximum(a, b)
     # END SOLUTION
 
@@ -204,7 +204,7 @@ def op_intersection(a, b) -> np.ndarray:
 def op_difference(a, b) -> np.ndarray:
     """``a`` minus ``b``: ``max(a, -b)`` (inside ``a`` and outside ``b``)."""
     a, b = _pair(a, b, "op_difference")
-    # BEGIN SOLUTION: Task 1 (CSG): difference = max(a, -b)
+    # BEGIN SOLUTION: Task 1 (analytic SDFs): CSG: difference = max(a, -b)
     return np.maximum(a, -b)
     # END SOLUTION
 

@@ -137,7 +137,7 @@ def brick_sample(codes, table, origin, spacing: float, band_voxels: float, shape
         raise MeshError(f"{where}: shape {shape} does not match a brick table of shape {table.shape}")
     P = as_points(P, where)
     Q = np.clip(P, origin, origin + spacing * (shape - 1))
-    # BEGIN SOLUTION: Task 6 (brick lookup): u = (Q - origin)/h; brick B = min(floor(u/7), n-1); local l = u - 7B; cell c = min(floor(l), 6), f = l - c; stored bricks: trilinear of s/255*2r - r; dropped: -1 -> +r, -2 -> -r; then outside_rule
+    # BEGIN SOLUTION: Task 6 (queries): brick lookup: u = (Q - origin)/h; brick B = min(floor(u/7), n-1); local l = u - 7B; cell c = min(floor(l), 6), f = l - c; stored bricks: trilinear of s/255*2r - r; dropped: -1 -> +r, -2 -> -r; then outside_rule
     n = np.array(table.shape)
     u = (Q - origin) / spacing
     Bk = np.minimum(np.floor(u / 7).astype(np.int64), n - 1)

@@ -59,7 +59,7 @@ def gradient_central(sdf, P, h: float = 1e-3) -> np.ndarray:
     phi = as_field(sdf, where)
     P = as_points(P, where)
     h = _h(h, where)
-    # BEGIN SOLUTION: Task 7 (6-tap): g_k = phi(p + h e_k) - phi(p - h e_k), k = x, y, z; normalise (0 stays 0)
+    # BEGIN SOLUTION: Task 7 (gradients): 6-tap: g_k = phi(p + h e_k) - phi(p - h e_k), k = x, y, z; normalise (0 stays 0)
     G = np.stack([phi(P + h * e) - phi(P - h * e) for e in np.eye(3)], axis=1)
     return _unit(G)
     # END SOLUTION
@@ -76,7 +76,7 @@ def gradient_tetra(sdf, P, h: float = 1e-3) -> np.ndarray:
     phi = as_field(sdf, where)
     P = as_points(P, where)
     h = _h(h, where)
-    # BEGIN SOLUTION: Task 7 (4-tap): g = sum_i k_i phi(p + h k_i) over the 4 tetrahedron corners; normalise (0 stays 0)
+    # BEGIN SOLUTION: Task 7 (gradients): 4-tap: g = sum_i k_i phi(p + h k_i) over the 4 tetrahedron corners; normalise (0 stays 0)
     G = sum(k[None, :] * np.asarray(phi(P + h * k), np.float64)[:, None] for k in TETRA)
     return _unit(G)
     # END SOLUTION

@@ -62,7 +62,7 @@ def closest_on_triangle(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
 
     Returns ``(qx, qy, qz, region)``.
     """
-    # BEGIN SOLUTION: Task 3 (BVH query, leaf test): your Task 2 for one point and one triangle, in scalars: Voronoi regions of a, b, c, then edges ab, ca, bc, else the interior (barycentric v = vb/(va+vb+vc), w = vc/(va+vb+vc))
+    # BEGIN SOLUTION: Task 3 (BVH): BVH query, leaf test: your Task 2 for one point and one triangle, in scalars: Voronoi regions of a, b, c, then edges ab, ca, bc, else the interior (barycentric v = vb/(va+vb+vc), w = vc/(va+vb+vc))
     abx, aby, abz = bx - ax, by - ay, bz - az
     acx, acy, acz = cx - ax, cy - ay, cz - az
     apx, apy, apz = px - ax, py - ay, pz - az
@@ -109,7 +109,7 @@ def build_bvh_kernel(lo, hi, cen, leaf_size):
     whose triangles are ``order[start[k] : start[k] + count[k]]``. Node 0 is the root; nodes are
     numbered in depth-first order, left child first.
     """
-    # BEGIN SOLUTION: Task 3 (BVH build): stack of (node, start, end); node box = union of its triangle boxes; leaf when end - start <= leaf_size, else sort the range by centroid along the longest centroid-box axis and split at the median
+    # BEGIN SOLUTION: Task 3 (BVH): BVH build: stack of (node, start, end); node box = union of its triangle boxes; leaf when end - start <= leaf_size, else sort the range by centroid along the longest centroid-box axis and split at the median
     m = lo.shape[0]
     cap = 2 * m + 1
     node_lo = np.empty((cap, 3))
@@ -209,7 +209,7 @@ def closest_kernel(P, T, node_lo, node_hi, left, right, start, count, order, upp
         stack = np.empty(STACK, np.int64)
         prev = -1
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):  # noqa: B007 (its body is your task)
-            # BEGIN SOLUTION: Task 3 (BVH query): best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]
+            # BEGIN SOLUTION: Task 3 (BVH): BVH query: best = upper_sq (warm start: first test the previous point's triangle prev, a row of T); pop a node, skip it when its box is at least best away; leaves test their triangles with closest_on_triangle; inner nodes push the children closer than best, the farther first; set prev to the row found; face = order[row]
             px, py, pz = P[i, 0], P[i, 1], P[i, 2]
             best = upper_sq
             bf = -1
@@ -282,7 +282,7 @@ def crossings_kernel(P, D, V, F, node_lo, node_hi, left, right, start, count, or
     for i in prange(n):  # noqa: B007 (its body is your task)
         stack = np.empty(STACK, np.int64)
         for j in range(k):  # noqa: B007
-            # BEGIN SOLUTION: Task 4 (vote): walk the BVH with a slab test per box (t_far >= max(t_near, 0)); count every triangle hit with t > 0
+            # BEGIN SOLUTION: Task 4 (sign): vote: walk the BVH with a slab test per box (t_far >= max(t_near, 0)); count every triangle hit with t > 0
             ox, oy, oz = P[i, 0], P[i, 1], P[i, 2]
             dx, dy, dz = D[j, 0], D[j, 1], D[j, 2]
             ix = 1.0 / dx if dx != 0.0 else np.inf

@@ -107,7 +107,7 @@ def grid_sdf_values(V, F, origin, spacing: float, shape, *, band: float | None =
         return (np.sqrt(sq) * _sign(V, F, P, face, C, region, sign, B)).reshape(shape)
     r = band * spacing
     sq, face, C, region = bvh_closest(B, V, F, P, band=r)
-    # BEGIN SOLUTION: Task 3 (narrow band): exact signed distance where face >= 0; label the connected far regions (scipy.ndimage.label on face < 0) and sign each from one signed query of a representative sample
+    # BEGIN SOLUTION: Task 3 (BVH): narrow band: exact signed distance where face >= 0; label the connected far regions (scipy.ndimage.label on face < 0) and sign each from one signed query of a representative sample
     near = face >= 0
     d = np.empty(len(P))
     d[near] = np.sqrt(sq[near]) * _sign(V, F, P[near], face[near], C[near], region[near], sign, B)

@@ -48,7 +48,7 @@ def instances_distance(sdf, P, translations, scales) -> np.ndarray:
         raise MeshError(f"{where}: at least one instance is needed")
     if np.any(S <= 0):
         raise MeshError(f"{where}: scales must be > 0 (uniform scale per instance), got {S}")
-    # BEGIN SOLUTION: Task 6 (instancing): d = min over instances of s_k * phi((P - t_k) / s_k)
+    # BEGIN SOLUTION: Task 6 (queries): instancing: d = min over instances of s_k * phi((P - t_k) / s_k)
     d = np.full(len(P), np.inf)
     for t, s in zip(T, S, strict=True):  # a loop over the few instances, each vectorised over points
         d = np.minimum(d, s * np.asarray(phi((P - t) / s), np.float64))

@@ -78,7 +78,7 @@ def pseudonormals(V, F) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """
     where = "pseudonormals"
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
-    # BEGIN SOLUTION: Task 4 (pseudonormal): face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal
+    # BEGIN SOLUTION: Task 4 (sign): pseudonormal: face normals; edge normals = sum over faces sharing the undirected edge (np.unique on sorted edge keys + np.bincount); vertex normals = sum of corner angle * face normal
     FN = face_normals_unit(V, F)
     m = len(F)
     E = np.stack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]], axis=1).reshape(-1, 2)  # (3m, 2)
@@ -122,7 +122,7 @@ def sign_normal(V, F, P, face, closest) -> np.ndarray:
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
     P = as_points(P, where)
     face, closest = _closest_args(face, closest, len(P), len(F), where)
-    # BEGIN SOLUTION: Task 4 (normal sign): s = sign((p - q) . n_f), +1 when the dot product is 0
+    # BEGIN SOLUTION: Task 4 (sign): normal sign: s = sign((p - q) . n_f), +1 when the dot product is 0
     return _signs(np.einsum("ij,ij->i", P - closest, face_normals_unit(V, F)[face]))
     # END SOLUTION
 
@@ -152,7 +152,7 @@ def sign_pseudonormal(V, F, P, face, closest, region, normals=None) -> np.ndarra
 
         raise MeshError(f"{where}: region must be ({len(P)},) integers in 0..6")
     FN, EN, VN = pseudonormals(V, F) if normals is None else normals
-    # BEGIN SOLUTION: Task 4 (pseudonormal sign): N = face normal (region 0), vertex normal of F[face, region-1] (1-3), edge normal EN[face, region-4] (4-6); s = sign((p - q) . N)
+    # BEGIN SOLUTION: Task 4 (sign): pseudonormal sign: N = face normal (region 0), vertex normal of F[face, region-1] (1-3), edge normal EN[face, region-4] (4-6); s = sign((p - q) . N)
     N = FN[face].copy()
     vert = (region >= 1) & (region <= 3)
     edge = region >= 4
@@ -202,7 +202,7 @@ def sign_vote(V, F, P, *, directions=None, bvh=None) -> np.ndarray:
     from .bvh import build_bvh, bvh_arrays
 
     B = build_bvh(V, F) if bvh is None else bvh
-    # BEGIN SOLUTION: Task 4 (vote): crossings = kernels.crossings_kernel(...); inside when more than half of the rays cross an odd number of times
+    # BEGIN SOLUTION: Task 4 (sign): vote: crossings = kernels.crossings_kernel(...); inside when more than half of the rays cross an odd number of times
     odd = kernels.crossings_kernel(P, np.ascontiguousarray(D), V, F, *bvh_arrays(B)) % 2
     return np.where(2 * odd.sum(axis=1) > len(D), -1.0, 1.0)
     # END SOLUTION
@@ -228,7 +228,7 @@ def winding_number(V, F, P, *, chunk: int = 1 << 20) -> np.ndarray:
     T = V[F]
     w = np.zeros(len(P))
     step = max(1, chunk // len(F))
-    # BEGIN SOLUTION: Task 4 (winding number): for chunks of `step` points: a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi
+    # BEGIN SOLUTION: Task 4 (sign): winding number: for chunks of `step` points: a, b, c = corners - p; Omega = 2 atan2(a.(b x c), |a||b||c| + (a.b)|c| + (b.c)|a| + (c.a)|b|); w = sum Omega / 4 pi
     for s in range(0, len(P), step):  # bounded memory: step points x all triangles per pass
         X = T[None] - P[s : s + step, None, None, :]  # (k, m, 3, 3)
         a, b, c = X[:, :, 0], X[:, :, 1], X[:, :, 2]
