@@ -260,8 +260,10 @@ def main() -> None:
     ap.add_argument("--only", nargs="*", help="substrings of mesh names to run")
     ap.add_argument("--levels", nargs="*", type=float, default=[0.1, 0.01])
     ap.add_argument("--breakdown", action="store_true", help="where the fast path's time goes, against igl.qslim")
+    ap.add_argument("--repeats", type=int, help="timed runs per contender, best kept (default 3, 1 with --quick)")
+    ap.add_argument("--no-compile-time", action="store_true", help="skip the compile-time probe")
     args = ap.parse_args()
-    repeats = 1 if args.quick else 3
+    repeats = args.repeats or (1 if args.quick else 3)
     n_samples = 20_000 if args.quick else 50_000
     meshes = {**builtin_meshes(args.quick), **shared_meshes(args.quick)}
     if args.only:
@@ -273,7 +275,8 @@ def main() -> None:
             for level in args.levels:
                 breakdown(name, V, F, max(4, int(round(level * len(F)))), repeats)
         return
-    compile_time()
+    if not args.no_compile_time:
+        compile_time()
     contenders = {
         "ours fast": ours_fast,
         "fast+refit": ours_fast_refit,
