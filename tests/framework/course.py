@@ -35,3 +35,32 @@ def grade(root: Path, impl: str, *extra: str, env: dict | None = None) -> dict:
     results = root / "results" / f"{Path(impl).name}.json"
     run_geomlib(root, "grade", "--impl", impl, "--results", str(results), *extra, env=env)
     return json.loads(results.read_text())
+
+
+def sandbox_user_problem(user: str = "nobody") -> str | None:
+    """Why grading as ``user`` cannot work here (not root, no such user, Python unreadable), or None."""
+    import pwd
+
+    import numpy
+
+    if os.geteuid() != 0:
+        return "dropping to a sandbox user needs root"
+    try:
+        pw = pwd.getpwnam(user)
+    except KeyError:
+        return f"no user {user!r}"
+    paths = [os.path.dirname(os.__file__), os.path.dirname(numpy.__file__)]
+    pid = os.fork()
+    if pid == 0:
+        try:
+            os.setgroups([])
+            os.setgid(pw.pw_gid)
+            os.setuid(pw.pw_uid)
+            ok = all(os.access(p, os.R_OK | os.X_OK) for p in paths)
+        except BaseException:  # noqa: BLE001
+            ok = False
+        os._exit(0 if ok else 1)
+    _, st = os.waitpid(pid, 0)
+    if os.waitstatus_to_exitcode(st) != 0:
+        return f"user {user!r} cannot read this Python ({paths[0]}); install Python where it can (docs/autograder.md)"
+    return None

@@ -8,9 +8,11 @@ import tempfile
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from geomlib.grading.results import validate_results
 
-from .course import grade, run_geomlib
+from .course import grade, run_geomlib, sandbox_user_problem
 
 GOOD_OPS = (Path(__file__).parent / "sample_course" / "solutions" / "sample" / "ops.py").read_text()
 
@@ -112,6 +114,9 @@ def test_missing_function_and_missing_lab(sample_course, tmp_path):
 
 
 def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_course, tmp_path):
+    problem = sandbox_user_problem("nobody")
+    if problem:
+        pytest.skip(problem)
     results = sample_course / "results" / "submission.json"
     hidden = next((sample_course / "tests" / "reference" / "sample" / "hidden").glob("*.npz"))
     src = GOOD_OPS.replace(
