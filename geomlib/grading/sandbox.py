@@ -278,7 +278,7 @@ class _Zygote:
                     continue
                 total += st.st_size
                 shutil.copyfile(src, dest / rel / name, follow_symlinks=False)
-        for dirpath, dirnames, filenames in os.walk(dest.parent):
+        for dirpath, _dirnames, filenames in os.walk(dest.parent):
             os.chmod(dirpath, 0o555)
             for name in filenames:
                 os.chmod(os.path.join(dirpath, name), 0o444)
