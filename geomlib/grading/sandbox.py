@@ -78,7 +78,7 @@ def clean_text(text, limit: int = tolerances.MESSAGE_CHARS) -> str:
         text = str(text)
     if len(text) > 4 * limit:
         text = text[: 4 * limit]
-    text = text.encode("utf-8", errors="replace").decode("utf-8", errors="replace")
+    text = text.encode("utf-8", errors="surrogatepass").decode("utf-8", errors="replace")
     text = "".join(c for c in text if c in "\n\t" or (c >= " " and c != "\x7f"))
     if len(text) > limit:
         text = text[:limit] + " …"

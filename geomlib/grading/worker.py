@@ -191,8 +191,8 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
             continue  # the module docstring
         if isinstance(s, ast.ImportFrom) and s.module == "__future__":
             continue
-        if getattr(s, "name", None) in student_defs and student_defs[s.name] is s:
-            continue  # already placed where the stub has it
+        if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef) and s.name in student_defs:
+            continue  # the (last) definition is placed where the stub has it
         bound = _bound_names(s)
         if isinstance(s, ast.ImportFrom | ast.Import) and bound & given:
             keep = [a for a in s.names if (a.asname or a.name).split(".")[0] not in given]
