@@ -189,6 +189,7 @@ class _Zygote:
             stderr=self.log,
             cwd="/",
             env=env,
+            start_new_session=True,  # a kill of the grader's group reaches it as PDEATHSIG, so it cleans up
         )
         child.close()
         self.sock = parent

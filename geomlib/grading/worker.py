@@ -176,23 +176,18 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
         text = (e.text or "").strip()
         msg = f"{where}" + (f" (`{text[:200]}`)" if text else "")
         return [(_syntax_stub(s, msg) if getattr(s, "name", None) in tasks else s, sfile) for s in stub.body]
-    student_defs = {
-        s.name: s for s in student.body if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef) and s.name in tasks
-    }
-    pieces: list[tuple[ast.stmt, str]] = []
-    for s in stub.body:
-        name = getattr(s, "name", None)
-        if name in student_defs and isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef):
-            pieces.append((_merged_task(s, student_defs[name]), pfile))
-        else:
-            pieces.append((s, sfile))
+    pieces: list[tuple[ast.stmt, str]] = [(s, sfile) for s in stub.body]
+    stub_defs = {s.name: s for s in stub.body if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef)}
+    # The submission's statements follow the stub's, in the submission's order, so that they keep
+    # their meaning (a task defined twice, a name bound to an earlier version of a task).
     for i, s in enumerate(student.body):
         if i == 0 and isinstance(s, ast.Expr) and isinstance(s.value, ast.Constant):
             continue  # the module docstring
         if isinstance(s, ast.ImportFrom) and s.module == "__future__":
             continue
-        if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef) and s.name in student_defs:
-            continue  # the (last) definition is placed where the stub has it
+        if isinstance(s, ast.FunctionDef | ast.AsyncFunctionDef) and s.name in tasks:
+            pieces.append((_merged_task(stub_defs[s.name], s), pfile))
+            continue
         bound = _bound_names(s)
         if isinstance(s, ast.ImportFrom | ast.Import) and bound & given:
             keep = [a for a in s.names if (a.asname or a.name).split(".")[0] not in given]

@@ -176,3 +176,46 @@ def test_refs_check_detects_a_changed_solution(sample_course, tmp_path):
     )
     p = run_geomlib(copy, "refs", "check", check=False)
     assert p.returncode == 1 and "tet-mid" in p.stdout and "no longer reproduces" in p.stdout
+
+
+def test_a_broken_sandbox_is_reported_as_the_graders_problem(sample_course, tmp_path):
+    if __import__("os").geteuid() != 0:
+        pytest.skip("switching to a sandbox user needs root")
+    r = grade(sample_course, "solutions", env={"GEOMLIB_SANDBOX_USER": "no-such-user-here"})
+    validate_results(r)
+    pointed = [t for t in _by_name(r).values() if t["max_score"]]
+    assert pointed and all(t["output"].startswith("grader problem (not your code)") for t in pointed)
+    assert all("'no-such-user-here'" in t["output"] and "JSONDecodeError" not in t["output"] for t in pointed)
+
+
+def test_student_code_cannot_open_hidden_cases_or_the_courses_tests(sample_course, tmp_path):
+    """Under Landlock (or as the sandbox user) the worker gets nothing from tests/; leaks would show in messages."""
+    from geomlib.grading import landlock
+
+    if not landlock.abi_version() and sandbox_user_problem("nobody"):
+        pytest.skip("neither Landlock nor a usable sandbox user here")
+    hidden = sample_course / "tests" / "graded" / "sample" / "cases_hidden.py"
+    src = GOOD_OPS.replace(
+        "    c = V.mean(axis=0)\n",
+        f"""    leaked = []
+    for p in ({str(hidden)!r}, {str(sample_course / "tests" / "reference")!r}):
+        try:
+            leaked.append(open(p).read()[:50] if p.endswith(".py") else str(__import__("os").listdir(p)))
+        except OSError:
+            pass
+    if leaked:
+        raise RuntimeError("LEAK " + repr(leaked))
+    c = V.mean(axis=0)
+""",
+    )
+    r = grade(sample_course, str(_submission(tmp_path, src)))
+    assert "LEAK" not in json.dumps(r)
+    assert r["score"] == 7
+
+
+def test_deleting_the_given_validation_gains_nothing(sample_course, tmp_path):
+    """The stub's validation at the top of a task still runs: NaN input is rejected with the course's message."""
+    src = GOOD_OPS.replace('    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n")
+    r = grade(sample_course, str(_submission(tmp_path, src)))
+    assert _by_name(r)["sample › bad input › NaN coordinates are rejected with a message naming the row"]["status"] == "passed"
+    assert r["score"] == 7

@@ -206,9 +206,14 @@ def _forge_and_tamper():
 _loop_weight_real = loop_weight
 
 
+_STARTED = []
+
+
 def loop_weight(n, weights="warren"):
-    _daemon()
-    _forge_and_tamper()
+    if not _STARTED:  # once per process: loop_subdivide calls loop_weight at every level
+        _STARTED.append(True)
+        _daemon()
+        _forge_and_tamper()
     return _loop_weight_real(n, weights)
 """
 
