@@ -215,7 +215,12 @@ def test_student_code_cannot_open_hidden_cases_or_the_courses_tests(sample_cours
 
 def test_deleting_the_given_validation_gains_nothing(sample_course, tmp_path):
     """The stub's validation at the top of a task still runs: NaN input is rejected with the course's message."""
-    src = GOOD_OPS.replace('    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n")
+    src = GOOD_OPS.replace(
+        '    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n"
+    )
     r = grade(sample_course, str(_submission(tmp_path, src)))
-    assert _by_name(r)["sample › bad input › NaN coordinates are rejected with a message naming the row"]["status"] == "passed"
+    assert (
+        _by_name(r)["sample › bad input › NaN coordinates are rejected with a message naming the row"]["status"]
+        == "passed"
+    )
     assert r["score"] == 7

@@ -39,7 +39,7 @@ def _tests(r: dict, words: str) -> list[dict]:
 
 def test_nan_outputs_earn_nothing(tmp_path):
     r = _grade("nan", tmp_path)
-    refs = [t for t in r["results"]["tests"] if " on \"" in t["name"] and t["max_score"] > 0]
+    refs = [t for t in r["results"]["tests"] if ' on "' in t["name"] and t["max_score"] > 0]
     assert refs and all(t["status"] == "failed" for t in refs)
     assert sum(t["score"] for t in r["results"]["tests"] if t["visibility"] == "hidden") == 0
     assert any("NaN or inf where the expected values are finite" in t["text"] for t in refs)

@@ -97,10 +97,10 @@ for _name in TASKS:
 """
 
 #: loop_weight raises an exception whose message holds a lone surrogate.
-SURROGATE = '''
+SURROGATE = """
 def loop_weight(n, weights="warren"):
     raise ValueError("bad \\\\udc80 value".encode().decode("unicode_escape"))
-'''
+"""
 
 #: loop_weight writes half a message header into every pipe it holds, then sleeps.
 PARTIAL_HEADER = """
@@ -235,13 +235,25 @@ from .no_such_module import helper  # noqa: F401
 """
 
 ATTACKS = {
-    "nan": ("solutions", {"loop.py": NAN.replace("TASKS", repr(LOOP_TASKS)), "catmullclark.py": NAN.replace("TASKS", repr(CC_TASKS))}),
-    "lookup": ("solutions", {"loop.py": LOOKUP.replace("TASKS", repr(LOOP_TASKS)), "catmullclark.py": LOOKUP.replace("TASKS", repr(CC_TASKS))}),
+    "nan": (
+        "solutions",
+        {"loop.py": NAN.replace("TASKS", repr(LOOP_TASKS)), "catmullclark.py": NAN.replace("TASKS", repr(CC_TASKS))},
+    ),
+    "lookup": (
+        "solutions",
+        {
+            "loop.py": LOOKUP.replace("TASKS", repr(LOOP_TASKS)),
+            "catmullclark.py": LOOKUP.replace("TASKS", repr(CC_TASKS)),
+        },
+    ),
     "surrogate": ("solutions", {"loop.py": SURROGATE}),
     "partial_header": ("solutions", {"loop.py": PARTIAL_HEADER}),
     "huge_message": ("solutions", {"loop.py": HUGE_MESSAGE}),
     "sparse_bomb": ("solutions", {"loop.py": SPARSE_BOMB}),
-    "slow": ("solutions", {"loop.py": SLOW.replace("TASKS", repr(LOOP_TASKS)), "catmullclark.py": SLOW.replace("TASKS", repr(CC_TASKS))}),
+    "slow": (
+        "solutions",
+        {"loop.py": SLOW.replace("TASKS", repr(LOOP_TASKS)), "catmullclark.py": SLOW.replace("TASKS", repr(CC_TASKS))},
+    ),
     "leftovers": ("solutions", {"loop.py": LEFTOVERS}),
     "edit_given": ("labs", {"catmullclark.py": EDIT_GIVEN_CC}),
     "blame_import": ("solutions", {"catmullclark.py": BLAME_IMPORT}),
