@@ -12,7 +12,7 @@ import pytest
 
 from geomlib.grading.results import plain_text, validate_results
 
-from .course import grade, run_geomlib, sandbox_user_problem
+from .course import grade, run_geomlib, sandbox_python, sandbox_user_problem
 
 GOOD_OPS = (Path(__file__).parent / "sample_course" / "solutions" / "sample" / "ops.py").read_text()
 
@@ -139,7 +139,13 @@ def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_
     )
     hidden.parent.chmod(0o700)
     try:
-        r = grade(sample_course, str(_submission(tmp_path, src)), env={"GEOMLIB_SANDBOX_USER": "nobody"})
+        python, extra = sandbox_python("nobody")
+        r = grade(
+            sample_course,
+            str(_submission(tmp_path, src)),
+            env={"GEOMLIB_SANDBOX_USER": "nobody", **extra},
+            python=python,
+        )
     finally:
         hidden.parent.chmod(0o755)
     assert r["score"] == 7
