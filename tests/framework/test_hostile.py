@@ -15,15 +15,17 @@ import pytest
 
 from geomlib.grading.results import plain_text, validate_results
 
+from .course import sandbox_python, sandbox_user_problem
 from .hostile import grade_planted
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")
 
 
-def _grade(kind: str, tmp_path: Path, **env) -> dict:
+def _grade(kind: str, tmp_path: Path, python: str | None = None, **env) -> dict:
     work = Path(tempfile.mkdtemp(prefix=f"geomlib-hostile-{kind}-"))
     work.chmod(0o755)
-    r = grade_planted(kind, Path(__file__).resolve().parents[2], work, python=sys.executable, env=env, timeout=600)
+    course = Path(__file__).resolve().parents[2]
+    r = grade_planted(kind, course, work, python=python or sys.executable, env=env, timeout=600)
     assert not r["hung"], r["log"]
     assert r["results"] is not None, r["log"]
     validate_results(r["results"])
@@ -49,6 +51,19 @@ def test_nan_outputs_earn_nothing(tmp_path):
 def test_looking_up_stored_outputs_earns_nothing(tmp_path):
     """The worker holds no case list and cannot open the cases or references (Landlock or the sandbox user)."""
     r = _grade("lookup", tmp_path)
+    assert r["score"] == 0
+    assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
+
+
+@pytest.mark.parametrize("landlock", ["1", "0"], ids=["with-landlock", "file-permissions-only"])
+def test_as_the_sandbox_user_looking_up_stored_outputs_earns_nothing(tmp_path, landlock):
+    """Gradescope's set-up: root drops to nobody; hidden cases and references are root-only."""
+    found = sandbox_python("nobody")
+    if found is None:
+        pytest.skip(sandbox_user_problem("nobody"))
+    python, extra = found
+    env = {"GEOMLIB_SANDBOX_USER": "nobody", "GEOMLIB_LANDLOCK": landlock, **extra}
+    r = _grade("lookup", tmp_path, python=python, **env)
     assert r["score"] == 0
     assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
 

@@ -304,8 +304,8 @@ def grade_planted(
     root = course_copy(work / "course", course)
     sub = plant(kind, work / "submission")
     results = work / "results.json"
-    e = {**os.environ, "GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1", **(env or {})}
-    e.pop("PYTHONPATH", None)
+    e = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    e.update({"GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1", **(env or {})})
     cmd = [python, "-m", "geomlib.cli", "grade", "--impl", str(sub), "--lab", "subdivision", "--results", str(results)]
     t0 = time.monotonic()
     hung = False
