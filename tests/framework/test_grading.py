@@ -230,3 +230,12 @@ def test_deleting_the_given_validation_gains_nothing(sample_course, tmp_path):
         == "passed"
     )
     assert r["score"] == 7
+
+
+def test_symbolic_links_in_a_submission_are_not_followed(sample_course, tmp_path):
+    """A submission whose ops.py links to the course's solution gets nothing from it."""
+    sub = _submission(tmp_path, "")
+    (sub / "sample" / "ops.py").unlink()
+    (sub / "sample" / "ops.py").symlink_to(sample_course / "solutions" / "sample" / "ops.py")
+    r = grade(sample_course, str(sub))
+    assert r["score"] == 0
