@@ -18,7 +18,7 @@ from geomlib.grading.results import plain_text, validate_results
 from .course import sandbox_python, sandbox_user_problem
 from .hostile import grade_planted
 
-pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")
+pytestmark = [pytest.mark.slow, pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")]
 
 
 def _grade(kind: str, tmp_path: Path, python: str | None = None, **env) -> dict:
