@@ -11,6 +11,8 @@ from geomlib.grading import checks, tolerances
 from geomlib.grading.cases import Case, expect_close, expect_raises, graded, load_cases, reference_tests, run_case
 from geomlib.grading.errors import (
     BadReturn,
+    BudgetSpent,
+    GraderError,
     GradingFailure,
     Mismatch,
     NotImplementedYet,
@@ -55,4 +57,6 @@ __all__ = [
     "StudentCrash",
     "StudentTimeout",
     "BadReturn",
+    "BudgetSpent",
+    "GraderError",
 ]

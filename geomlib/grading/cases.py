@@ -19,7 +19,7 @@ import pytest
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import tolerances as tol
-from geomlib.grading.checks import Context, compare_arrays
+from geomlib.grading.checks import Context, compare_arrays, nonfinite_problem
 from geomlib.grading.errors import BadReturn, Mismatch, StudentError
 
 __all__ = [
@@ -187,6 +187,7 @@ def run_case(lab, case: Case, *, feedback_dir: Path | None = None, diagnose_comp
     expected = load_reference(lab.name, case)  # loaded only after the student's call has returned
     ctx = Context(label=case.label, lab=lab.name, case_id=case.id, feedback_dir=feedback_dir)
     try:
+        _screen_outputs(expected, got, ctx)
         case.check(expected, got, ctx)
     except Mismatch as e:
         # The hint, or for a composite the building block that is wrong (geomlib.grading.diagnose).
@@ -195,6 +196,30 @@ def run_case(lab, case: Case, *, feedback_dir: Path | None = None, diagnose_comp
         if not diagnose_composites:
             raise type(e)(e.message + (f" — {case.hint}" if case.hint else ""), e.feedback) from None
         raise diagnose.enrich(e, lab, case, kwargs, expected, got, ctx) from None
+
+
+def _screen_outputs(expected: dict, got: dict, ctx: Context) -> None:
+    """Reject non-finite or non-real outputs, and outputs far larger than the reference, before any check.
+
+    Runs for every case whatever its check, so a lab's own comparison (``checks.Custom``) cannot be
+    fooled by NaN (``NaN > tol`` is False) or made to densify a forged (3e8, n) sparse matrix.
+    """
+    for name, e in expected.items():
+        if name not in got:
+            continue
+        e = np.asarray(e)
+        g = got[name]
+        if hasattr(g, "toarray") and hasattr(g, "shape"):
+            if int(np.prod(g.shape)) > 4 * e.size + 1000:
+                raise BadReturn(f"{ctx.label}: {name} has shape {tuple(g.shape)}, expected {e.shape}")
+            g = getattr(g, "data", np.zeros(0))
+            problem = nonfinite_problem(name, np.zeros(1, e.dtype) if e.dtype.kind in "biuf" else e, g)
+        else:
+            if isinstance(g, np.ndarray) and g.size > 4 * e.size + 1000:
+                raise BadReturn(f"{ctx.label}: {name} has shape {g.shape}, expected {e.shape}")
+            problem = nonfinite_problem(name, e, g)
+        if problem:
+            ctx.fail(problem)
 
 
 def reference_tests(cases: list[Case]):
@@ -226,7 +251,11 @@ def expect_close(
     ctx = Context(label=label, hint=hint)
     e = np.asarray(expected, dtype=np.float64)
     try:
-        g = np.asarray(got, dtype=np.float64)
+        g = np.asarray(got)
+        problem = nonfinite_problem(name, e, g) if g.dtype != object else None
+        if problem:
+            raise Mismatch(f"{label}: {problem}" + (f" — {hint}" if hint else ""))
+        g = g.astype(np.float64)
     except (TypeError, ValueError):
         raise BadReturn(f"{label}: {name} is not a numeric array (got {type(got).__name__})") from None
     compare_arrays(name, np.atleast_1d(e), np.atleast_1d(g), ctx, atol=atol, rtol=rtol)

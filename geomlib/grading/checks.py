@@ -27,6 +27,7 @@ __all__ = [
     "Custom",
     "All",
     "as_output_array",
+    "nonfinite_problem",
     "format_vec",
 ]
 
@@ -73,6 +74,38 @@ def format_vec(x) -> str:
     return "(" + ", ".join(f"{v:.6g}" for v in x.ravel()) + ")" if x.size > 1 else f"{x.ravel()[0]:.6g}"
 
 
+def nonfinite_problem(name: str, expected, got) -> str | None:
+    """Why ``got`` cannot match a real, finite ``expected`` (NaN, inf, complex, strings), or None.
+
+    Every comparison calls this first: ``NaN > tol`` is False, so without it an output of NaNs of
+    the right shape would pass any tolerance test.
+    """
+    e = np.asarray(expected)
+    try:
+        g = np.asarray(got)
+    except Exception:  # noqa: BLE001 - odd objects are reported by the shape/type checks
+        return None
+    if e.dtype.kind not in "biuf":
+        return None
+    if g.dtype.kind == "c":
+        return f"{name} holds complex numbers (dtype {g.dtype}); expected real values"
+    if g.dtype.kind not in "biuf":
+        return f"{name} is not an array of real numbers (dtype {g.dtype})"
+    if g.dtype.kind != "f":
+        return None
+    bad = ~np.isfinite(g)
+    if e.dtype.kind == "f" and e.shape == g.shape:
+        bad &= np.isfinite(e)
+    if not bad.any():
+        return None
+    where = np.unravel_index(int(np.flatnonzero(bad.ravel())[0]), g.shape) if g.ndim else ()
+    at = f" (first at index {tuple(int(i) for i in where)})" if g.ndim else ""
+    return (
+        f"{name} contains NaN or inf where the expected values are finite{at}; "
+        f"{int(bad.sum())} of {g.size} entries are not finite numbers"
+    )
+
+
 def as_output_array(value, name: str, ctx: Context, *, like: np.ndarray | None = None) -> np.ndarray:
     """Convert a submitted output to an array, failing with a message naming ``name``."""
     try:
@@ -84,9 +117,9 @@ def as_output_array(value, name: str, ctx: Context, *, like: np.ndarray | None =
     if like is not None:
         if a.shape != like.shape:
             raise BadReturn(f"{ctx.label}: {name} has shape {a.shape}, expected {like.shape}")
-        if like.dtype.kind == "f" and a.dtype.kind in "f" and not np.all(np.isfinite(a)):
-            r = int(np.flatnonzero(~np.isfinite(a).reshape(len(a), -1).all(axis=1))[0]) if a.ndim else 0
-            ctx.fail(f"{name} contains NaN or inf (first at row {r})")
+        problem = nonfinite_problem(name, like, a)
+        if problem:
+            ctx.fail(problem)
     return a
 
 
@@ -117,6 +150,9 @@ class Allclose:
 def compare_arrays(name: str, e: np.ndarray, g: np.ndarray, ctx: Context, *, atol: float, rtol: float = 0.0) -> None:
     if g.shape != e.shape:
         raise BadReturn(f"{ctx.label}: {name} has shape {g.shape}, expected {e.shape}")
+    problem = nonfinite_problem(name, e, g)
+    if problem:
+        ctx.fail(problem)
     if e.size == 0:
         return
     diff = np.abs(g.astype(np.float64) - e.astype(np.float64))
@@ -167,6 +203,14 @@ def _mesh_outputs(expected: dict, got: dict, vname: str, fname: str, ctx: Contex
         raise BadReturn(f"{ctx.label}: {vname} has shape {Vg.shape}, expected (n, {Ve.shape[1]})")
     if Fg.ndim != 2 or Fg.shape[1] != Fe.shape[1]:
         raise BadReturn(f"{ctx.label}: {fname} has shape {Fg.shape}, expected (m, {Fe.shape[1]})")
+    for n, e, g in ((vname, Ve, Vg), (fname, Fe, Fg)):
+        problem = nonfinite_problem(n, e, g)
+        if problem:
+            ctx.fail(problem)
+    if Fg.dtype.kind == "f":
+        if not np.all(Fg == np.round(Fg)):
+            ctx.fail(f"{fname} holds non-integer vertex indices")
+        Fg = Fg.astype(np.int64)
     return Ve, Fe, Vg, Fg
 
 

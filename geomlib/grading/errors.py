@@ -65,3 +65,14 @@ class StudentTimeout(GradingFailure):
 
 class BadReturn(GradingFailure):
     """Student code returned something of the wrong kind, shape or type."""
+
+
+class BudgetSpent(GradingFailure):
+    """The whole submission's time budget ran out before this test could call student code."""
+
+
+class GraderError(GradingFailure):
+    """The grader itself failed (the sandbox could not start, a set-up problem): never the student's fault.
+
+    Its message starts with "grader problem (not your code)" and asks the student to tell the staff.
+    """

@@ -1,7 +1,8 @@
 """Feedback pictures for failed graded checks: reference | submission | difference heat map.
 
 Pictures are a help, never a requirement: any problem making one (no OpenGL, a broken mesh) is
-swallowed and the text message stands alone.
+swallowed and the text message stands alone. Each picture is drawn in a forked child under a time
+limit (:func:`_drawn_in_time`), so a huge wrong mesh costs seconds, not the run.
 """
 
 from __future__ import annotations
@@ -18,6 +19,39 @@ def _relpath(p) -> str:
         return os.path.relpath(p)
     except ValueError:
         return str(p)
+
+
+def _drawn_in_time(path, draw) -> str | None:
+    """Run ``draw()`` (which writes ``path``) in a forked child, stopped after
+    :data:`~geomlib.grading.tolerances.PICTURE_TIME_S` or the rest of the run's time budget."""
+    import time
+
+    from geomlib.grading import sandbox, tolerances
+
+    limit = tolerances.PICTURE_TIME_S
+    left = sandbox.remaining_time()
+    if left is not None:
+        limit = min(limit, left - 1.0)
+    if limit <= 0:
+        return None
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - child
+        code = 1
+        try:
+            draw()
+            code = 0
+        finally:
+            os._exit(code)
+    deadline = time.monotonic() + limit
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return _relpath(path) if os.waitstatus_to_exitcode(status) == 0 and os.path.exists(path) else None
+        if time.monotonic() > deadline:
+            os.kill(pid, 9)
+            os.waitpid(pid, 0)
+            return None
+        time.sleep(0.02)
 
 
 def _beside(img: np.ndarray, bar: np.ndarray, gap: int = 8) -> np.ndarray:
@@ -51,7 +85,8 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
     path = ctx.feedback_path()
     if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
         return None
-    try:
+
+    def draw(Vg=Vg):  # defaults: the body rebinds these names
         from scipy.spatial import cKDTree
 
         from geomlib import plot
@@ -69,9 +104,8 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
         captions = ["expected", "submitted", f"distance to the nearest expected vertex (max {d.max():.3g})"]
         img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
-        return _relpath(path)
-    except Exception:
-        return None
+
+    return _drawn_in_time(path, draw)
 
 
 def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel: np.ndarray) -> str | None:
@@ -79,7 +113,8 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
     path = ctx.feedback_path()
     if path is None:
         return None
-    try:
+
+    def draw(expected=expected, got=got, per_pixel=per_pixel):  # the body rebinds these names
         from geomlib import plot
 
         def to_rgb(x):
@@ -99,9 +134,8 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
         captions = ["expected", "submitted", "|difference| per pixel"]
         img = plot.panels([to_rgb(expected), to_rgb(got), _beside(heat, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
-        return _relpath(path)
-    except Exception:
-        return None
+
+    return _drawn_in_time(path, draw)
 
 
 def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str = "") -> str | None:
@@ -110,7 +144,8 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
     path = ctx.feedback_path(suffix)
     if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
         return None
-    try:
+
+    def draw(V=V):  # the body rebinds V
         from geomlib import plot
 
         V = np.asarray(V, float)
@@ -125,9 +160,8 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
         ]
         img = plot.panels(views, [caption, "seen from above"], title=ctx.label)
         plot.save_png(path, img)
-        return _relpath(path)
-    except Exception:
-        return None
+
+    return _drawn_in_time(path, draw)
 
 
 def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -> str | None:
@@ -135,7 +169,8 @@ def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -
     path = ctx.feedback_path()
     if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
         return None
-    try:
+
+    def draw(values=values):  # the body rebinds values
         from geomlib import plot
 
         values = np.asarray(values, float)
@@ -146,6 +181,5 @@ def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -
         bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
         img = plot.panels([views[0], _beside(views[1], bar)], [caption, "seen from above"], title=ctx.label)
         plot.save_png(path, img)
-        return _relpath(path)
-    except Exception:
-        return None
+
+    return _drawn_in_time(path, draw)

@@ -19,7 +19,8 @@ from pathlib import Path
 import pytest
 
 from geomlib.grading import impl as _impl
-from geomlib.grading.errors import GradingFailure, NotImplementedYet
+from geomlib.grading import sandbox, tolerances
+from geomlib.grading.errors import GraderError, GradingFailure, NotImplementedYet
 from geomlib.grading.sandbox import LabProxy
 
 
@@ -59,6 +60,13 @@ def pytest_addoption(parser):
         "--feedback-dir", default="feedback", help="where failing checks write feedback pictures (default: feedback/)"
     )
     g.addoption(
+        "--time-budget",
+        type=float,
+        default=float(os.environ["GEOMLIB_TIME_BUDGET"]) if os.environ.get("GEOMLIB_TIME_BUDGET") else None,
+        help="seconds for the whole run; later tests fail at once with a message saying so "
+        f"(default {tolerances.TIME_BUDGET_S:g} when --impl is given, else none; 0 = none; env GEOMLIB_TIME_BUDGET)",
+    )
+    g.addoption(
         "--time-limit",
         type=float,
         default=float(os.environ["GEOMLIB_TIME_LIMIT"]) if os.environ.get("GEOMLIB_TIME_LIMIT") else None,
@@ -66,8 +74,15 @@ def pytest_addoption(parser):
     )
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_configure(config):
     RECORDS.clear()
+    # The whole-run budget protects grading runs (`geomlib grade`, the autograder: both name --impl);
+    # a plain `pytest tests` (CI, students) has none unless asked for.
+    budget = config.getoption("--time-budget", None)
+    if budget is None and config.getoption("--impl", None) is not None:
+        budget = tolerances.TIME_BUDGET_S
+    sandbox.set_deadline(budget)
     config.addinivalue_line("markers", "graded(points, part, visibility, timeout, memory_mb): a graded test")
 
 
@@ -146,10 +161,11 @@ def pytest_runtest_makereport(item, call):
             points=float(marker.kwargs.get("points", 0)),
             visibility=marker.kwargs.get("visibility", "visible"),
             passed=passed,
-            message=message,
+            message=sandbox.clean_text(message),
             duration=getattr(rep, "duration", 0.0),
             not_implemented=isinstance(exc, NotImplementedYet),
-            error=exc is not None and not isinstance(exc, GradingFailure | AssertionError),
+            error=exc is not None
+            and (isinstance(exc, GraderError) or not isinstance(exc, GradingFailure | AssertionError)),
         )
     )
 

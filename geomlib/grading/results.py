@@ -3,17 +3,22 @@
 The fields follow Gradescope's autograder specification: top-level ``score``, ``execution_time``,
 ``output``, ``visibility``, ``stdout_visibility`` and ``tests``; each test has ``name``,
 ``number``, ``score``, ``max_score``, ``status`` (``passed``/``failed``), ``output`` and
-``visibility`` (plus ``name_format``/``output_format``).
+``visibility`` (plus ``name_format``/``output_format``). Messages are Markdown (``output_format: md``);
+the top-level ``output`` holds a per-part table of the *visible* tests only, so hidden and
+after-due-date tests follow their own visibility. Feedback pictures are not embedded: they are files
+for local runs (``geomlib grade``), and Gradescope's image would only show a path.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
-from geomlib.grading.plugin import Record, score_table
+from geomlib.grading.plugin import Record
+from geomlib.grading.sandbox import clean_text
 
-__all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results"]
+__all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results", "markdown_text", "plain_text"]
 
 _VIS = ["visible", "hidden", "after_due_date", "after_published"]
 
@@ -56,8 +61,57 @@ RESULTS_SCHEMA = {
 }
 
 
+_MD_SPECIAL = str.maketrans({c: "\\" + c for c in "\\`*_[]<>#|~"})
+
+#: Longest test output / top-level output kept in results.json (characters).
+TEST_OUTPUT_CHARS = 6000
+TOP_OUTPUT_CHARS = 20000
+
+
+def markdown_text(text: str, limit: int = TEST_OUTPUT_CHARS) -> str:
+    """Text (from messages that may quote student code) as literal Markdown: sanitised, escaped, cut."""
+    return clean_text(text, limit).translate(_MD_SPECIAL).replace("\n", "  \n")
+
+
+def plain_text(markdown: str) -> str:
+    """The text of a test output written by :func:`markdown_text` (escapes removed)."""
+    return re.sub(r"\\(.)", r"\1", markdown.replace("  \n", "\n"))
+
+
+def visible_summary(records: list[Record]) -> str:
+    """A Markdown per-lab, per-part table of the tests a student may see now (visibility ``visible``).
+
+    Tests that are hidden or shown only after the due date are left out of the counts (and their
+    number is not given), so the table never reveals hidden results.
+    """
+    shown = [r for r in records if r.visibility == "visible"]
+    if not shown:
+        return "No graded results are shown before the due date."
+    parts: dict[tuple[str, str], list[float]] = {}
+    for r in shown:
+        s = parts.setdefault((r.lab, r.part), [0.0, 0.0, 0, 0])
+        s[0] += r.score
+        s[1] += r.points
+        s[2] += 1
+        s[3] += r.passed
+    lines = ["| lab | part | tests passed | score |", "|---|---|---:|---:|"]
+    for (lab, part), (sc, mx, n, ok) in parts.items():
+        lines.append(f"| {markdown_text(lab, 100)} | {markdown_text(part, 100)} | {ok}/{n} | {sc:g} / {mx:g} |")
+    total = sum(v[0] for v in parts.values())
+    maxtotal = sum(v[1] for v in parts.values())
+    lines.append(f"| **total shown** | | | **{total:g} / {maxtotal:g}** |")
+    if len(shown) < len(records):
+        lines.append("")
+        lines.append("Some tests are not shown yet; they count towards the final score.")
+    return "\n".join(lines)
+
+
 def build_results(records: list[Record], execution_time: float, output: str = "") -> dict:
-    """The ``results.json`` dict for graded records (test numbers are ``<lab>.<part>.<k>``)."""
+    """The ``results.json`` dict for graded records (test numbers are ``<lab>.<part>.<k>``).
+
+    Everything that may come from student code is sanitised (lone surrogates, control characters),
+    escaped for Markdown (``output_format: md``) and cut to a bounded length.
+    """
     tests = []
     labs: dict[str, int] = {}
     parts: dict[tuple[str, str], int] = {}
@@ -68,23 +122,25 @@ def build_results(records: list[Record], execution_time: float, output: str = ""
         k = count[(r.lab, r.part)] = count.get((r.lab, r.part), 0) + 1
         tests.append(
             {
-                "name": f"{r.lab} › {r.part} › {r.name}",
+                "name": clean_text(f"{r.lab} › {r.part} › {r.name}", 300),
                 "number": f"{li}.{pi}.{k}",
                 "score": round(r.score, 6),
                 "max_score": round(r.points, 6),
                 "status": "passed" if r.passed else "failed",
-                "output": r.message,
+                "output": markdown_text(r.message),
+                "output_format": "md",
                 "visibility": r.visibility,
-                "tags": [r.lab, r.part],
+                "tags": [clean_text(r.lab, 100), clean_text(r.part, 100)],
             }
         )
     score = round(sum(r.score for r in records), 6)
-    summary = score_table(records) if records else "no graded tests ran"
+    summary = visible_summary(records) if records else "No graded tests ran."
+    note = markdown_text(output, 4000) + "\n\n" if output else ""
     return {
         "score": score,
         "execution_time": round(execution_time, 3),
-        "output": (output + "\n\n" if output else "") + summary,
-        "output_format": "text",
+        "output": clean_text(note + summary, TOP_OUTPUT_CHARS),
+        "output_format": "md",
         "visibility": "visible",
         "stdout_visibility": "hidden",
         "tests": tests,
@@ -102,6 +158,7 @@ def write_results(data: dict, path: str | Path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False) + "\n")
+    # ensure_ascii: a lone surrogate that slipped through is written as an escape, never crashes.
+    tmp.write_text(json.dumps(data, indent=1, ensure_ascii=True) + "\n")
     tmp.replace(path)
     return path

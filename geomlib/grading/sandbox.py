@@ -1,12 +1,26 @@
-"""Run student code in worker processes with a time and memory limit.
+"""Run student code in sandboxed worker processes with a time, memory and total-time limit.
 
-Each call forks a fresh worker from the grader (which has NumPy, SciPy and geomlib imported
-already), so a call costs a few milliseconds plus the student's own work, and nothing a call does
-(global state, ``sys.exit``, a segfault, an infinite loop, printing garbage) survives it or
-reaches the grader. Results come back through :mod:`geomlib.grading.wire` (no pickle).
-Plain ``fork`` rather than a fork server or spawn: those re-import the ``__main__`` module (pytest,
-a notebook, a user's script) in every worker. The grader loads a case's expected output only after
-the student's call has returned, so a worker never holds it.
+The grader starts a *zygote* (:mod:`geomlib.grading.zygote`): a fresh interpreter with NumPy, SciPy,
+libigl and geomlib imported, which never sees a case, a reference or the grader's open files. For
+each call the grader sends it the function's name and its inputs (pickled: grader → sandbox only);
+the zygote forks a confined worker (own session, closed descriptors, resource limits, the sandbox
+user when root, Landlock where the kernel has it), and the worker sends its result back through
+:mod:`geomlib.grading.wire` (never pickle). The grader reads that reply under the call's time limit
+and size limit, then waits until the zygote has killed every process the call started.
+
+Protection levels (reported by :func:`status`):
+
+- root with ``GEOMLIB_SANDBOX_USER`` (Gradescope): student code runs as that user; hidden cases and
+  references are made readable by root only; with Landlock also nothing outside Python, geomlib,
+  the stubs and its own lab is readable and nothing but a scratch folder writable;
+- any user with Landlock (``geomlib grade`` / ``grade-all`` by an instructor): the same file-system
+  confinement, no TCP, no signals to the grader;
+- neither: only the process isolation (fresh zygote, closed descriptors, limits, killed
+  descendants); student code can read and write whatever the grading user can.
+
+Before a student's code runs, its lab folder is copied (plain files only, never following links)
+into a private read-only snapshot, and each module is merged with the course's stub so that given
+code stays the course's (see :mod:`geomlib.grading.worker`).
 
 :class:`LabProxy` makes this look like a module: ``lab.loop_subdivide(V, F)`` runs the student's
 ``loop_subdivide`` in a worker and returns its result, or raises a
@@ -15,80 +29,440 @@ the student's call has returned, so a worker never holds it.
 
 from __future__ import annotations
 
+import atexit
 import json
-import multiprocessing as mp
 import os
+import pickle
+import select
+import shutil
 import signal
+import socket
+import stat
+import struct
+import subprocess
+import sys
+import sysconfig
 import tempfile
+import threading
+import time
 from pathlib import Path
 
 from geomlib.grading import tolerances, wire
 from geomlib.grading.errors import (
     BadReturn,
+    BudgetSpent,
+    GraderError,
     GradingFailure,
     NotImplementedYet,
     StudentCrash,
     StudentError,
     StudentTimeout,
 )
-from geomlib.grading.worker import run_call
 
-__all__ = ["call", "LabProxy"]
+__all__ = ["call", "LabProxy", "status", "set_deadline", "remaining_time", "clean_text", "shutdown"]
 
-# Imported once in the grader so that every forked worker starts with them loaded (a worker that
-# imported SciPy or libigl itself would pay that on every call).
-_PRELOAD = (
-    "numpy",
-    "scipy.sparse",
-    "scipy.sparse.linalg",
-    "scipy.spatial",
-    "igl",
-    "geomlib.validate",
-    "geomlib.topology",
-    "geomlib.geometry",
-)
-_preloaded = False
+_LOCK = threading.Lock()
+_STATE: dict = {"deadline": None, "budget": None}
 
 
-def _context():
-    global _preloaded
-    if not _preloaded:
-        import importlib
+# ---------------------------------------------------------------------------------- text from students
 
-        for name in _PRELOAD:
+
+def clean_text(text, limit: int = tolerances.MESSAGE_CHARS) -> str:
+    """Text from student code made safe for messages and results.json.
+
+    Lone surrogates and other unencodable characters become U+FFFD, control characters other than
+    newline and tab are dropped, and the text is cut to ``limit`` characters.
+    """
+    if not isinstance(text, str):
+        text = str(text)
+    if len(text) > 4 * limit:
+        text = text[: 4 * limit]
+    text = text.encode("utf-8", errors="surrogatepass").decode("utf-8", errors="replace")
+    text = "".join(c for c in text if c in "\n\t" or (c >= " " and c != "\x7f"))
+    if len(text) > limit:
+        text = text[:limit] + " …"
+    return text
+
+
+# ---------------------------------------------------------------------------------- time budget
+
+
+def set_deadline(budget_s: float | None) -> None:
+    """Start the whole-run time budget: calls after ``budget_s`` seconds from now fail at once."""
+    _STATE["budget"] = budget_s
+    _STATE["deadline"] = None if not budget_s else time.monotonic() + budget_s
+
+
+def remaining_time() -> float | None:
+    """Seconds left of the whole-run budget (None: no budget)."""
+    d = _STATE["deadline"]
+    return None if d is None else d - time.monotonic()
+
+
+def _budget_message() -> str:
+    return (
+        f"not run: grading stopped after the time budget of {_STATE['budget']:g} s for the whole submission "
+        f"was used up (by earlier slow or timed-out calls); make the slow functions faster"
+    )
+
+
+# ---------------------------------------------------------------------------------- the zygote
+
+
+def _course_root() -> Path:
+    from geomlib.grading import impl
+
+    return impl.course_root()
+
+
+def _geomlib_dir() -> Path:
+    import geomlib
+
+    return Path(geomlib.__file__).resolve().parent
+
+
+def _hidden_paths() -> list[Path]:
+    """Course files student code must never read (hidden cases and references)."""
+    tests = _course_root() / "tests"
+    out = list((tests / "reference").glob("*/hidden"))
+    for p in (tests / "graded").glob("*/*_hidden*.py"):
+        out.append(p)
+    for p in (tests / "graded").glob("*/__pycache__/*_hidden*.pyc"):
+        out.append(p)
+    return out
+
+
+def _forbidden() -> list[Path]:
+    root = _course_root()
+    extra = [Path(p) for p in os.environ.get("GEOMLIB_SANDBOX_HIDE", "").split(os.pathsep) if p]
+    return [root / "tests", root / "solutions", root / ".git", *extra]
+
+
+def _readable_paths() -> list[str]:
+    """What a Landlock-confined worker may read: Python, the libraries, geomlib, system folders."""
+    cands = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
+    cands |= {p for k, p in sysconfig.get_paths().items() if k in ("stdlib", "platstdlib", "purelib", "platlib")}
+    cands |= {p for p in sys.path if p and os.path.isdir(p)}
+    cands |= {str(_geomlib_dir())}
+    cands |= {"/usr", "/lib", "/lib64", "/lib32", "/bin", "/sbin", "/etc", "/proc", "/sys", "/dev", "/opt"}
+    forbidden = [f.resolve() for f in _forbidden()]
+    out = set()
+    for c in cands:
+        for p in {Path(c).absolute(), Path(c).resolve()}:
+            if any(f == p or f.is_relative_to(p) or p.is_relative_to(f) for f in forbidden):
+                continue
+            if p == Path("/") or Path(tempfile.gettempdir()).resolve().is_relative_to(p):
+                continue
+            out.add(str(p))
+    return sorted(out)
+
+
+def _protect_hidden() -> None:
+    """As root, make hidden cases and references readable by root only (a sandbox user cannot read them)."""
+    for p in _hidden_paths():
+        try:
+            if p.is_dir():
+                for q in [p, *p.rglob("*")]:
+                    q.chmod(q.stat().st_mode & ~0o077)
+            else:
+                p.chmod(p.stat().st_mode & ~0o077)
+        except OSError:
+            pass
+
+
+class _Zygote:
+    def __init__(self):
+        parent, child = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+        self.log = tempfile.TemporaryFile(prefix="geomlib-zygote-")
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join([str(_geomlib_dir().parent), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        env.setdefault("OPENBLAS_NUM_THREADS", "1")
+        env.setdefault("OMP_NUM_THREADS", "1")
+        env.setdefault("MKL_NUM_THREADS", "1")
+        code = "import sys; from geomlib.grading.zygote import main; main()"
+        self.proc = subprocess.Popen(
+            [sys.executable, "-s", "-c", code, str(child.fileno())],
+            pass_fds=[child.fileno()],
+            stdin=subprocess.DEVNULL,
+            stdout=self.log,
+            stderr=self.log,
+            cwd="/",
+            env=env,
+            start_new_session=True,  # a kill of the grader's group reaches it as PDEATHSIG, so it cleans up
+        )
+        child.close()
+        self.sock = parent
+        self.sock.settimeout(120)
+        try:
+            from geomlib.grading.zygote import recv_msg
+
+            ready, _, _ = recv_msg(self.sock)
+        except (OSError, EOFError, ValueError) as e:
+            raise GraderError(f"the sandbox could not start ({e}): {self.log_tail()}") from None
+        # GEOMLIB_LANDLOCK=0 turns Landlock off (to test the protection of a kernel without it).
+        self.landlock = 0 if os.environ.get("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
+        self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
+        self.is_root = os.geteuid() == 0
+        if self.user and not self.is_root:
+            self.user = None  # only root can switch users; say so in status()
+        self.scratch_root = Path(tempfile.mkdtemp(prefix="geomlib-sandbox-"))
+        self.scratch_root.chmod(0o711)
+        self.snapshots: dict[str, Path] = {}
+        self.problems: list[str] = []
+        if self.user:
             try:
-                importlib.import_module(name)
-            except Exception:  # a missing optional module only makes workers slower
-                pass
-        _preloaded = True
-    return mp.get_context("fork")
+                import pwd
+
+                pwd.getpwnam(self.user)
+            except KeyError:
+                self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
+            _protect_hidden()
+        if not self.problems:
+            self._probe()
+
+    def log_tail(self) -> str:
+        try:
+            self.log.seek(0)
+            return self.log.read()[-1500:].decode("utf-8", "replace").strip()
+        except OSError:
+            return ""
+
+    def request(self, req: dict) -> dict:
+        req = {
+            **req,
+            "user": self.user,
+            "landlock": self.landlock > 0,
+            "read": _readable_paths() + req.get("read", []),
+        }
+        return req
+
+    def _probe(self) -> None:
+        import numpy
+
+        must_read = [
+            ("Python's standard library", os.path.dirname(os.__file__)),
+            ("NumPy", os.path.dirname(numpy.__file__)),
+            ("geomlib", str(_geomlib_dir())),
+        ]
+        must_hide = [str(p) for p in _hidden_paths()] if (self.user or self.landlock) else []
+        try:
+            reply = self.run(self.request({"op": "probe", "must_read": must_read, "must_hide": must_hide}), b"", 60)
+        except GradingFailure as e:
+            self.problems.append(str(e))
+            return
+        data = reply.get("data") or b""
+        try:
+            info = json.loads(data[1:].decode()) if data[:1] in (b"P", b"E") else {}
+        except ValueError:
+            info = {}
+        if info.get("kind") != "probe":
+            why = info.get("message") or reply.get("why")
+            self.problems.append(f"sandbox self-test failed ({why}): {self.log_tail()}".rstrip(": "))
+        else:
+            self.problems += info.get("problems", [])
+
+    def snapshot(self, lab_dir: Path) -> Path:
+        """A private, read-only copy of a lab folder: plain files only, links never followed."""
+        key = str(lab_dir.resolve())
+        if key in self.snapshots:
+            return self.snapshots[key]
+        dest = Path(tempfile.mkdtemp(prefix="lab-", dir=self.scratch_root)) / lab_dir.name
+        total = 0
+        for dirpath, dirnames, filenames in os.walk(lab_dir, followlinks=False):
+            rel = Path(dirpath).relative_to(lab_dir)
+            dirnames[:] = [d for d in dirnames if d not in ("__pycache__", ".git", ".ipynb_checkpoints")]
+            (dest / rel).mkdir(parents=True, exist_ok=True)
+            for name in filenames:
+                src = Path(dirpath) / name
+                st = os.lstat(src)
+                if not stat.S_ISREG(st.st_mode) or st.st_size > 64 << 20 or total > 512 << 20:
+                    continue
+                total += st.st_size
+                shutil.copyfile(src, dest / rel / name, follow_symlinks=False)
+        for dirpath, _dirnames, filenames in os.walk(dest.parent):
+            os.chmod(dirpath, 0o555)
+            for name in filenames:
+                os.chmod(os.path.join(dirpath, name), 0o444)
+        self.snapshots[key] = dest
+        return dest
+
+    def run(self, req: dict, blob: bytes, timeout: float, max_bytes: int | None = None, on_pid=None) -> dict:
+        """Send one request; returns ``{"data": bytes|None, "why": ..., "status": ..., "printed": str}``."""
+        from geomlib.grading.zygote import recv_msg, send_msg
+
+        r, w = os.pipe()
+        out_fd, out_path = tempfile.mkstemp(prefix="geomlib-out-", dir=self.scratch_root)
+        scratch = tempfile.mkdtemp(prefix="call-", dir=self.scratch_root)
+        os.chmod(scratch, 0o700)
+        req = {**req, "scratch": scratch, "write": [scratch, os.devnull]}
+        pid = None
+        try:
+            try:
+                send_msg(self.sock, req, blob, fds=[w, out_fd])
+                os.close(w)
+                w = -1
+                self.sock.settimeout(60)
+                head, _, _ = recv_msg(self.sock)
+                pid = head["pid"]
+            except (OSError, EOFError, ValueError, KeyError) as e:
+                raise GraderError(f"the sandbox stopped working ({e}): {self.log_tail()}") from None
+            data, why = _read_frame(r, time.monotonic() + timeout, max_bytes)
+            if why == "timeout":
+                for kill in (lambda: os.killpg(pid, signal.SIGKILL), lambda: os.kill(pid, signal.SIGKILL)):
+                    try:
+                        kill()
+                    except (ProcessLookupError, PermissionError):
+                        pass
+            try:
+                self.sock.settimeout(60)
+                done, _, _ = recv_msg(self.sock)
+            except (OSError, EOFError, ValueError) as e:
+                raise GraderError(f"the sandbox stopped working ({e}): {self.log_tail()}") from None
+            os.lseek(out_fd, 0, 0)
+            printed = os.read(out_fd, 4 * tolerances.OUTPUT_CHARS).decode("utf-8", "replace")
+            return {"data": data, "why": why, "status": done.get("status", 0), "printed": printed}
+        finally:
+            for fd in (r, w, out_fd):
+                if fd >= 0:
+                    try:
+                        os.close(fd)
+                    except OSError:
+                        pass
+            for p in (out_path,):
+                try:
+                    os.unlink(p)
+                except OSError:
+                    pass
+            shutil.rmtree(scratch, ignore_errors=True)
+
+    def close(self) -> None:
+        try:
+            from geomlib.grading.zygote import send_msg
+
+            send_msg(self.sock, {"op": "exit"})
+            self.sock.close()
+            self.proc.wait(10)
+        except Exception:  # noqa: BLE001
+            self.proc.kill()
+        for snap in self.snapshots.values():
+            for dirpath, _, _ in os.walk(snap.parent):
+                os.chmod(dirpath, 0o755)
+        shutil.rmtree(self.scratch_root, ignore_errors=True)
+
+
+def _read_frame(fd: int, deadline: float, max_bytes: int | None) -> tuple[bytes | None, str]:
+    """Read one ``<Q``-length-prefixed message before ``deadline``: (data, "ok"), or (None, why)."""
+    os.set_blocking(fd, False)
+    buf = bytearray()
+    need = 8
+    length = None
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return None, "timeout"
+        ready, _, _ = select.select([fd], [], [], min(left, 1.0))
+        if not ready:
+            continue
+        try:
+            chunk = os.read(fd, min(need - len(buf), 1 << 22))
+        except BlockingIOError:
+            continue
+        if not chunk:
+            return None, "eof"
+        buf += chunk
+        if len(buf) < need:
+            continue
+        if length is None:
+            (length,) = struct.unpack("<Q", bytes(buf[:8]))
+            limit = (max_bytes or 1 << 40) + (1 << 20)
+            if length > limit:
+                return None, "too_big"
+            buf = bytearray()
+            need = length
+            if need == 0:
+                return b"", "ok"
+            continue
+        return bytes(buf), "ok"
+
+
+def _zygote() -> _Zygote:
+    with _LOCK:
+        z = _STATE.get("zygote")
+        if z is None or z.proc.poll() is not None:
+            z = _STATE["zygote"] = _Zygote()
+        return z
+
+
+def status() -> str:
+    """One line saying how student code is confined in this run."""
+    z = _zygote()
+    if z.problems:
+        return "sandbox NOT working: " + "; ".join(z.problems)
+    parts = []
+    if z.user:
+        parts.append(f"runs as user {z.user}")
+    if z.landlock:
+        parts.append(f"Landlock file-system confinement (ABI {z.landlock})")
+    if not parts:
+        return (
+            "student code is process-isolated only (not root and no Landlock): it can read and write "
+            "whatever this user can"
+        )
+    return "student code " + " with ".join(parts)
+
+
+def shutdown() -> None:
+    """Stop the zygote and remove the snapshots (also done at exit)."""
+    z = _STATE.pop("zygote", None)
+    if z is not None:
+        z.close()
+
+
+atexit.register(shutdown)
+
+
+# ---------------------------------------------------------------------------------- one call
 
 
 def _signal_name(code: int) -> str:
     try:
-        return signal.Signals(-code).name
+        return signal.Signals(code).name
     except ValueError:
-        return f"signal {-code}"
-
-
-def _read_output(path: str) -> str:
-    try:
-        with open(path, errors="replace") as f:
-            text = f.read(tolerances.OUTPUT_CHARS + 1)
-    except OSError:
-        return ""
-    if len(text) > tolerances.OUTPUT_CHARS:
-        text = text[: tolerances.OUTPUT_CHARS] + " …"
-    return text.strip()
+        return f"signal {code}"
 
 
 def _format_student_exception(function: str, info: dict) -> str:
     where = ""
-    if info.get("frames"):
-        f = info["frames"][-1]
-        code = f" `{f['code'].strip()}`" if f.get("code") else ""
-        where = f" at {f['file']}, line {f['line']} (in {f['function']}):{code}"
-    return f"{function} raised {info['type']}{where}: {info['message']}"
+    frames = info.get("frames") if isinstance(info.get("frames"), list) else []
+    if frames and isinstance(frames[-1], dict):
+        f = frames[-1]
+        code = f" `{clean_text(f.get('code', ''), 300).strip()}`" if f.get("code") else ""
+        where = (
+            f" at {clean_text(f.get('file', '?'), 200)}, line {clean_text(f.get('line', '?'), 20)} "
+            f"(in {clean_text(f.get('function', '?'), 200)}):{code}"
+        )
+    return f"{function} raised {clean_text(info.get('type', '?'), 200)}{where}: {clean_text(info.get('message', ''))}"
+
+
+def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
+    base = os.environ.get("GEOMLIB_STUBS")
+    stubs = Path(base) / lab if base else _course_root() / "labs" / lab
+    if not stubs.is_dir() or stubs.resolve() == lab_dir.resolve():
+        return None
+    return stubs
+
+
+def _input_bytes(args, kwargs) -> int:
+    import numpy as np
+
+    total = 0
+    for v in [*args, *kwargs.values()]:
+        if isinstance(v, np.ndarray):
+            total += v.nbytes
+        elif isinstance(v, tuple | list):
+            total += sum(x.nbytes for x in v if isinstance(x, np.ndarray))
+    return total
 
 
 def call(
@@ -107,82 +481,118 @@ def call(
     ------
     NotImplementedYet, StudentError, StudentCrash, StudentTimeout, BadReturn
         With a message naming the function and what happened.
+    BudgetSpent
+        The whole run's time budget is used up (the call is not made).
+    GraderError
+        The sandbox itself failed: the grader's problem, never the student's.
     """
     timeout = tolerances.TIME_LIMIT_S if timeout is None else timeout
     memory_mb = tolerances.MEMORY_LIMIT_MB if memory_mb is None else memory_mb
-    ctx = _context()
-    recv, send = ctx.Pipe(duplex=False)
-    fd, out_path = tempfile.mkstemp(prefix="geomlib-out-", suffix=".txt")
-    os.close(fd)
-    proc = ctx.Process(
-        target=run_call,
-        args=(send, str(lab_dir), lab, function, tuple(args), dict(kwargs or {}), memory_mb, timeout, out_path),
-        daemon=True,
-    )
+    left = remaining_time()
+    if left is not None:
+        if left <= 0.5:
+            raise BudgetSpent(_budget_message())
+        timeout = min(timeout, left)
+    kwargs = dict(kwargs or {})
+    z = _zygote()
+    if z.problems:
+        raise GraderError("grader problem (not your code): " + "; ".join(z.problems) + "; please tell the course staff")
     try:
-        proc.start()
-        send.close()
-        data = None
-        if recv.poll(timeout):
-            try:
-                data = recv.recv_bytes()
-            except (EOFError, OSError):
-                data = None
-        else:
-            proc.kill()
-            proc.join(5)
-            raise StudentTimeout(
-                f"{function} did not finish within {timeout:g} s (time limit); look for an infinite loop "
-                f"or a Python loop over every vertex/pixel that should be vectorised"
-            )
-        proc.join(10)
-        if proc.is_alive():
-            proc.kill()
-            proc.join(5)
-        printed = _read_output(out_path)
-    finally:
-        recv.close()
-        try:
-            os.unlink(out_path)
-        except OSError:
-            pass
+        blob = pickle.dumps((tuple(args), kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception as e:  # noqa: BLE001
+        raise GraderError(f"grader problem (not your code): cannot pass the inputs of {function} ({e})") from None
+    lab_dir = Path(lab_dir)
+    snap = z.snapshot(lab_dir)
+    stubs = _stubs_dir(lab, lab_dir)
+    max_bytes = max(tolerances.RESULT_MIN_MB << 20, tolerances.RESULT_INPUT_FACTOR * _input_bytes(args, kwargs))
+    req = z.request(
+        {
+            "op": "call",
+            "lab_dir": str(snap),
+            "lab": lab,
+            "function": function,
+            "stubs_dir": str(stubs) if stubs else None,
+            "memory_mb": memory_mb,
+            "cpu_s": timeout,
+            "cwd": str(snap),
+            "read": [str(snap)] + ([str(stubs)] if stubs else []),
+        }
+    )
+    reply = z.run(req, blob, timeout, max_bytes)
+    return _outcome(function, reply, timeout, memory_mb, max_bytes)
+
+
+def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_bytes: int):
+    printed = clean_text(reply["printed"], tolerances.OUTPUT_CHARS).strip()
     tail = f" Your code printed: {printed!r}" if printed else ""
+    data, why = reply["data"], reply["why"]
+    if why == "timeout":
+        left = remaining_time()
+        if left is not None and left <= 0.5:
+            raise StudentTimeout(
+                f"{function} was stopped after {timeout:.3g} s when the time budget for the whole submission "
+                f"({_STATE['budget']:g} s) ran out; make the slow functions faster"
+            )
+        raise StudentTimeout(
+            f"{function} did not finish within {timeout:g} s (time limit); look for an infinite loop "
+            f"or a Python loop over every vertex/pixel that should be vectorised"
+        )
+    if why == "too_big":
+        raise BadReturn(f"{function} sent back more than {max_bytes >> 20} MiB, more than this call may return")
     if data is None:
-        code = proc.exitcode
-        if code is not None and code < 0:
-            sig = _signal_name(code)
-            why = {
+        st = reply["status"]
+        if os.WIFSIGNALED(st):
+            sig = _signal_name(os.WTERMSIG(st))
+            what = {
                 "SIGSEGV": "a segmentation fault",
                 "SIGXCPU": "exceeding the CPU-time limit",
+                "SIGXFSZ": "writing more output than allowed",
                 "SIGKILL": "being killed (out of memory?)",
                 "SIGABRT": "an abort",
             }.get(sig, sig)
-            raise StudentCrash(f"{function} crashed the worker process with {why}.{tail}")
+            raise StudentCrash(f"{function} crashed the worker process with {what}.{tail}")
+        code = os.WEXITSTATUS(st) if os.WIFEXITED(st) else "?"
         raise StudentCrash(
             f"{function} ended the process (exit code {code}, e.g. os._exit) without returning a result.{tail}"
         )
     tag, body = data[:1], data[1:]
     if tag == b"R":
         try:
-            return wire.decode(body)
-        except Exception as e:  # malformed data from the worker
-            raise BadReturn(f"{function} sent back data the grader could not read ({e})") from None
-    info = json.loads(body.decode())
+            return wire.decode(body, max_bytes=max_bytes, max_dense_elements=tolerances.SPARSE_MAX_DENSE)
+        except wire.WireError as e:
+            raise BadReturn(f"{function} sent back data the grader could not read ({clean_text(e, 300)})") from None
+    if len(body) > 1 << 20:
+        raise BadReturn(f"{function} sent back a message of {len(body)} bytes, more than the grader reads")
+    try:
+        info = json.loads(body.decode("utf-8", "replace"))
+        if not isinstance(info, dict):
+            raise ValueError
+    except (ValueError, RecursionError):
+        raise BadReturn(f"{function} sent back data the grader could not read (not a result message)") from None
     kind = info.get("kind")
-    if kind == "exception" and info["type"] == "NotImplementedError":
-        task = f" ({info['message']})" if info["message"] else ""
+    if tag == b"E" and kind == "internal":
+        raise GraderError(
+            f"grader problem (not your code) while calling {function}: {clean_text(info.get('message', ''), 500)}; "
+            f"please tell the course staff"
+        )
+    message = clean_text(info.get("message", ""))
+    if kind == "exception" and info.get("type") == "NotImplementedError":
+        task = f" ({message})" if message else ""
         raise NotImplementedYet(f"{function}: not implemented yet{task}")
     if kind == "exception":
-        raise StudentError(_format_student_exception(function, info) + tail, info["type"], info["mro"], info["message"])
+        mro = [clean_text(m, 200) for m in info.get("mro", [])[:20]] if isinstance(info.get("mro"), list) else []
+        raise StudentError(
+            _format_student_exception(function, info) + tail, clean_text(info.get("type", "?"), 200), mro, message
+        )
     if kind == "memory":
         raise StudentCrash(f"{function} ran out of memory (limit {memory_mb} MiB).{tail}")
     if kind == "exit":
-        raise StudentCrash(f"{function} {info['message']} instead of returning a result.{tail}")
+        raise StudentCrash(f"{function} {message} instead of returning a result.{tail}")
     if kind == "missing":
-        raise StudentError(info["message"], "LookupError", ["LookupError", "Exception"], info["message"])
+        raise StudentError(message, "LookupError", ["LookupError", "Exception"], message)
     if kind == "bad_return":
-        raise BadReturn(info["message"] + "." + tail)
-    raise GradingFailure(f"internal grader problem while calling {function}: {info.get('message')}")
+        raise BadReturn(message + "." + tail)
+    raise BadReturn(f"{function} sent back a message the grader does not know ({clean_text(kind, 100)})")
 
 
 class LabProxy:

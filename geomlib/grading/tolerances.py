@@ -35,3 +35,23 @@ MEMORY_LIMIT_MB = 4096
 
 #: Characters of a student's printed output shown in feedback.
 OUTPUT_CHARS = 1500
+
+#: Wall-clock seconds for grading a whole submission. Gradescope stops an autograder after 10 minutes
+#: by default and then keeps no result at all, so once this budget is spent the remaining tests fail
+#: at once with a message saying so, and results.json is still written (env GEOMLIB_TIME_BUDGET).
+TIME_BUDGET_S = 480.0
+
+#: Seconds one feedback picture may take to draw (it is skipped after that).
+PICTURE_TIME_S = 20.0
+
+#: Largest result one call may send back: the larger of this many MiB and RESULT_INPUT_FACTOR times
+#: the size of the call's inputs. Checked by the grader before it allocates anything.
+RESULT_MIN_MB = 256
+RESULT_INPUT_FACTOR = 64
+
+#: Largest rows x cols of a returned sparse matrix (checks densify small ones; the largest stored
+#: reference matrix has 5.1e6 entries).
+SPARSE_MAX_DENSE = 2**25
+
+#: Characters of one message from student code (exception text, printed output) kept by the grader.
+MESSAGE_CHARS = 4000

@@ -8,15 +8,18 @@ import tempfile
 import textwrap
 from pathlib import Path
 
-from geomlib.grading.results import validate_results
+import pytest
 
-from .course import grade, run_geomlib
+from geomlib.grading.results import plain_text, validate_results
+
+from .course import grade, run_geomlib, sandbox_python, sandbox_user_problem
 
 GOOD_OPS = (Path(__file__).parent / "sample_course" / "solutions" / "sample" / "ops.py").read_text()
 
 
 def _by_name(results: dict) -> dict[str, dict]:
-    return {t["name"]: t for t in results["tests"]}
+    """Tests by name, their Markdown output turned back into plain text."""
+    return {t["name"]: {**t, "output": plain_text(t.get("output", ""))} for t in results["tests"]}
 
 
 def test_solutions_score_full_marks_and_results_follow_the_schema(sample_course):
@@ -108,10 +111,15 @@ def test_missing_function_and_missing_lab(sample_course, tmp_path):
     empty = tmp_path / "empty"
     empty.mkdir()
     r = grade(sample_course, str(empty))
-    assert r["score"] == 0 and all("missing from the submission" in t["output"] for t in r["tests"] if t["max_score"])
+    assert r["score"] == 0 and all(
+        "missing from the submission" in t["output"] for t in _by_name(r).values() if t["max_score"]
+    )
 
 
 def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_course, tmp_path):
+    problem = sandbox_user_problem("nobody")
+    if problem:
+        pytest.skip(problem)
     results = sample_course / "results" / "submission.json"
     hidden = next((sample_course / "tests" / "reference" / "sample" / "hidden").glob("*.npz"))
     src = GOOD_OPS.replace(
@@ -131,7 +139,13 @@ def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_
     )
     hidden.parent.chmod(0o700)
     try:
-        r = grade(sample_course, str(_submission(tmp_path, src)), env={"GEOMLIB_SANDBOX_USER": "nobody"})
+        python, extra = sandbox_python("nobody")
+        r = grade(
+            sample_course,
+            str(_submission(tmp_path, src)),
+            env={"GEOMLIB_SANDBOX_USER": "nobody", **extra},
+            python=python,
+        )
     finally:
         hidden.parent.chmod(0o755)
     assert r["score"] == 7
@@ -168,3 +182,60 @@ def test_refs_check_detects_a_changed_solution(sample_course, tmp_path):
     )
     p = run_geomlib(copy, "refs", "check", check=False)
     assert p.returncode == 1 and "tet-mid" in p.stdout and "no longer reproduces" in p.stdout
+
+
+def test_a_broken_sandbox_is_reported_as_the_graders_problem(sample_course, tmp_path):
+    if __import__("os").geteuid() != 0:
+        pytest.skip("switching to a sandbox user needs root")
+    r = grade(sample_course, "solutions", env={"GEOMLIB_SANDBOX_USER": "no-such-user-here"})
+    validate_results(r)
+    pointed = [t for t in _by_name(r).values() if t["max_score"]]
+    assert pointed and all(t["output"].startswith("grader problem (not your code)") for t in pointed)
+    assert all("'no-such-user-here'" in t["output"] and "JSONDecodeError" not in t["output"] for t in pointed)
+
+
+def test_student_code_cannot_open_hidden_cases_or_the_courses_tests(sample_course, tmp_path):
+    """Under Landlock (or as the sandbox user) the worker gets nothing from tests/; leaks would show in messages."""
+    from geomlib.grading import landlock
+
+    if not landlock.abi_version() and sandbox_user_problem("nobody"):
+        pytest.skip("neither Landlock nor a usable sandbox user here")
+    hidden = sample_course / "tests" / "graded" / "sample" / "cases_hidden.py"
+    src = GOOD_OPS.replace(
+        "    c = V.mean(axis=0)\n",
+        f"""    leaked = []
+    for p in ({str(hidden)!r}, {str(sample_course / "tests" / "reference")!r}):
+        try:
+            leaked.append(open(p).read()[:50] if p.endswith(".py") else str(__import__("os").listdir(p)))
+        except OSError:
+            pass
+    if leaked:
+        raise RuntimeError("LEAK " + repr(leaked))
+    c = V.mean(axis=0)
+""",
+    )
+    r = grade(sample_course, str(_submission(tmp_path, src)))
+    assert "LEAK" not in json.dumps(r)
+    assert r["score"] == 7
+
+
+def test_deleting_the_given_validation_gains_nothing(sample_course, tmp_path):
+    """The stub's validation at the top of a task still runs: NaN input is rejected with the course's message."""
+    src = GOOD_OPS.replace(
+        '    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n"
+    )
+    r = grade(sample_course, str(_submission(tmp_path, src)))
+    assert (
+        _by_name(r)["sample › bad input › NaN coordinates are rejected with a message naming the row"]["status"]
+        == "passed"
+    )
+    assert r["score"] == 7
+
+
+def test_symbolic_links_in_a_submission_are_not_followed(sample_course, tmp_path):
+    """A submission whose ops.py links to the course's solution gets nothing from it."""
+    sub = _submission(tmp_path, "")
+    (sub / "sample" / "ops.py").unlink()
+    (sub / "sample" / "ops.py").symlink_to(sample_course / "solutions" / "sample" / "ops.py")
+    r = grade(sample_course, str(sub))
+    assert r["score"] == 0

@@ -14,7 +14,7 @@ import pytest
 
 from geomlib.grading.results import validate_results
 
-from .course import run_geomlib
+from .course import run_geomlib, sandbox_python
 
 
 @pytest.fixture(scope="module")
@@ -85,6 +85,11 @@ def _autograder(release: Path, submission_labs: Path | None) -> dict:
     run.chmod(0o755)
     env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
     env.update(GEOMLIB_AUTOGRADER_ROOT=str(root), GEOMLIB_PYTHON=sys.executable, PYTHONPATH=str(root / "source"))
+    python = sandbox_python("nobody")
+    if python is None:  # not root, or no Python `nobody` can read: grade without the user drop
+        env["GEOMLIB_SANDBOX_USER"] = ""
+    elif python[1]:  # the system's Python with this environment's packages (as on Gradescope)
+        env.update(GEOMLIB_PYTHON=python[0], PYTHONPATH=os.pathsep.join([env["PYTHONPATH"], python[1]["PYTHONPATH"]]))
     p = subprocess.run(["bash", str(run)], env=env, capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stdout + p.stderr
     return json.loads((root / "results" / "results.json").read_text())

@@ -71,6 +71,43 @@ def returns_sparse():
 def deep_recursion(n=0):
     return deep_recursion(n + 1)
 
+def _result_pipes():
+    import stat
+    return [fd for fd in range(3, 64) if _is_fifo(fd)]
+
+def _is_fifo(fd):
+    import stat
+    try:
+        return stat.S_ISFIFO(os.fstat(fd).st_mode)
+    except OSError:
+        return False
+
+def forged_length():
+    import struct
+    for fd in _result_pipes():
+        os.write(fd, struct.pack("<Q", 2**40) + b"R")
+    os._exit(0)
+
+def forged_array():
+    import json, struct
+    meta = json.dumps({"__nd__": 0, "dtype": "f8", "shape": [10**9]}).encode()
+    body = b"R" + b"GW1" + struct.pack("<Q", len(meta)) + meta + bytes(64)
+    for fd in _result_pipes():
+        os.write(fd, struct.pack("<Q", len(body)) + body)
+    os._exit(0)
+
+def forged_sparse():
+    import json, struct
+    nd = lambda i, n: {"__nd__": i, "dtype": "i8", "shape": [n]}
+    meta = json.dumps({"__sparse__": [nd(0, 0), nd(1, 0), {"__nd__": 2, "dtype": "f8", "shape": [0]}], "shape": [300_000_000, 10**6]}).encode()
+    body = b"R" + b"GW1" + struct.pack("<Q", len(meta)) + meta
+    for fd in _result_pipes():
+        os.write(fd, struct.pack("<Q", len(body)) + body)
+    os._exit(0)
+
+def returns_nan():
+    return np.full(3, np.nan)
+
 def mutates_global_state():
     np.set_printoptions(precision=1)
     sys.modules["numpy"].pi = 3
@@ -114,6 +151,9 @@ def test_sparse_results_come_back_as_sparse(planted):
         ("deep_recursion", StudentError, "RecursionError"),
         ("broken", StudentError, "broken.py line 1: invalid syntax"),
         ("no_such_function", StudentError, "could not find a function named 'no_such_function'"),
+        ("forged_length", BadReturn, "more than this call may return"),
+        ("forged_array", BadReturn, "more data than this call may return"),
+        ("forged_sparse", BadReturn, "far larger than this call's inputs allow"),
     ],
 )
 def test_hostile_behaviour_costs_one_call_with_a_clear_message(planted, function, error, words):
@@ -159,3 +199,23 @@ def test_wire_refuses_what_it_cannot_represent_safely():
     data = wire.encode((np.inf, -np.nan if False else 1, {"k": np.zeros((2, 2), np.float32)}))
     a, b, c = wire.decode(data)
     assert a == np.inf and b == 1 and c["k"].dtype == np.float32
+
+
+def test_checks_refuse_nan_inf_complex_and_strings_where_the_reference_is_finite(planted):
+    from geomlib.grading import checks, expect_close
+    from geomlib.grading.errors import GradingFailure
+
+    got = planted.returns_nan()
+    ctx = checks.Context(label="f on case")
+    e = {"x": np.zeros(3)}
+    for bad in (got, np.array([1, np.inf, 0]), np.zeros(3) + 0j, np.array(["0", "0", "0"])):
+        for check in (checks.Allclose("x"), checks.Equal("x"), checks.Allclose("x", atol=np.inf)):
+            with pytest.raises(GradingFailure, match="NaN or inf|complex|not an array of real numbers|numeric"):
+                check(e, {"x": bad}, ctx)
+        with pytest.raises(GradingFailure):
+            expect_close("f", bad, np.zeros(3), atol=1e9)
+    img = {"image": np.zeros((4, 4, 3), np.uint8)}
+    with pytest.raises(GradingFailure, match="NaN or inf"):
+        checks.ImageMatch()(img, {"image": np.full((4, 4, 3), np.nan)}, ctx)
+    # NaN where the reference holds NaN too is not a problem of its own.
+    checks.Allclose("x", atol=np.inf)({"x": np.array([np.nan, 0.0])}, {"x": np.array([np.nan, 0.0])}, ctx)

@@ -11,7 +11,7 @@ import numpy as np
 
 from geomlib import datasets
 from geomlib.grading import tolerances as tol
-from geomlib.grading.checks import format_vec
+from geomlib.grading.checks import format_vec, nonfinite_problem
 
 # --------------------------------------------------------------------------------------------
 # tiny meshes (by hand)
@@ -71,7 +71,7 @@ def as_dense(S, name: str = "S") -> np.ndarray:
     if hasattr(S, "toarray"):
         S = S.toarray()
     A = np.asarray(S)
-    if A.dtype == object or A.ndim != 2:
+    if A.dtype.kind not in "biuf" or A.ndim != 2:
         from geomlib.grading.errors import BadReturn
 
         raise BadReturn(f"{name} should be a 2-D matrix (scipy.sparse or ndarray), got {type(S).__name__}")
@@ -95,6 +95,9 @@ def matrix_mismatch(name: str, expected, got, *, atol: float = tol.EXACT, what_r
     G = as_dense(got, name)
     if G.shape != E.shape:
         return f"{name} has shape {G.shape}, expected {E.shape}"
+    problem = nonfinite_problem(name, E, G)
+    if problem:
+        return problem
     bad = (np.abs(G - E) > atol).any(axis=1)
     if not bad.any():
         return None

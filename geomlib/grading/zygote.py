@@ -1,0 +1,297 @@
+"""The zygote: a clean process that forks one sandboxed worker per call into student code.
+
+The grader starts it as a fresh interpreter (``python -c ...``) before it loads any case or
+reference, so nothing a worker inherits holds the case list, the expected outputs or the grader's
+open files: a worker gets the call's *inputs* only, pickled by the grader (trusted → untrusted), and
+sends its result back through :mod:`geomlib.grading.wire` (never pickle).
+
+For each request the zygote forks a worker that
+
+1. starts its own session (its own process group) and closes every descriptor but the result pipe
+   and the file its prints go to;
+2. limits its address space, CPU time, file size, core dumps and (as a user other than root) the
+   number of processes;
+3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``);
+4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
+   and its own lab, write only a private scratch folder, and neither open TCP connections nor signal
+   processes outside its sandbox.
+
+The zygote is a child subreaper: anything the student's code started and detached is re-parented
+to it, and after each call it kills and reaps every remaining descendant before it tells the grader
+the call is over.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib
+import json
+import os
+import pickle
+import resource
+import signal
+import socket
+import struct
+import sys
+import time
+
+from geomlib.grading import landlock
+from geomlib.grading import worker as _worker
+
+_PR_SET_PDEATHSIG = 1
+_PR_SET_CHILD_SUBREAPER = 36
+
+#: Imported once in the zygote so every forked worker starts with them loaded.
+PRELOAD = (
+    "numpy",
+    "scipy.sparse",
+    "scipy.sparse.linalg",
+    "scipy.spatial",
+    "scipy.ndimage",
+    "igl",
+    "geomlib.validate",
+    "geomlib.topology",
+    "geomlib.geometry",
+    "geomlib.camera",
+    "geomlib.raster",
+    "geomlib.datasets",
+)
+
+#: Processes (threads) a worker may add to what its user already runs.
+NPROC_EXTRA = 256
+#: Largest file a worker may write (its printed output included), bytes.
+FSIZE_LIMIT = 256 << 20
+
+
+# ---------------------------------------------------------------------------------- framing
+
+
+def send_msg(sock: socket.socket, obj: dict, blob: bytes = b"", fds: list[int] | None = None) -> None:
+    head = json.dumps(obj).encode()
+    data = struct.pack("<IQ", len(head), len(blob)) + head + blob
+    if fds:
+        socket.send_fds(sock, [data[:4096]], fds)
+        sock.sendall(data[4096:])
+    else:
+        sock.sendall(data)
+
+
+def _recv_exact(sock: socket.socket, n: int, fds: list[int] | None = None) -> bytes:
+    parts, got = [], 0
+    while got < n:
+        if fds is not None and not fds and got == 0:
+            chunk, new_fds, _, _ = socket.recv_fds(sock, min(n - got, 4096), 4)
+            fds.extend(new_fds)
+        else:
+            chunk = sock.recv(min(n - got, 1 << 20))
+        if not chunk:
+            raise EOFError("connection closed")
+        parts.append(chunk)
+        got += len(chunk)
+    return b"".join(parts)
+
+
+def recv_msg(sock: socket.socket, with_fds: bool = False) -> tuple[dict, bytes, list[int]]:
+    fds: list[int] = []
+    hdr = _recv_exact(sock, 12, fds if with_fds else None)
+    nh, nb = struct.unpack("<IQ", hdr)
+    head = json.loads(_recv_exact(sock, nh).decode())
+    blob = _recv_exact(sock, nb) if nb else b""
+    return head, blob, fds
+
+
+# ---------------------------------------------------------------------------------- processes
+
+
+def _children() -> list[int]:
+    me = os.getpid()
+    try:
+        with open(f"/proc/{me}/task/{me}/children") as f:
+            return [int(p) for p in f.read().split()]
+    except OSError:
+        pass
+    kids = []
+    for name in os.listdir("/proc"):
+        if name.isdigit():
+            try:
+                with open(f"/proc/{name}/stat", "rb") as f:
+                    if int(f.read().rsplit(b")", 1)[1].split()[1]) == me:
+                        kids.append(int(name))
+            except (OSError, ValueError, IndexError):
+                pass
+    return kids
+
+
+def kill_descendants() -> int:
+    """SIGKILL and reap every descendant (orphans come back to us as subreaper); returns how many."""
+    killed = 0
+    for _ in range(1000):
+        kids = _children()
+        if not kids:
+            break
+        for pid in kids:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        for pid in kids:
+            try:
+                os.waitpid(pid, 0)
+                killed += 1
+            except ChildProcessError:
+                pass
+    return killed
+
+
+# ---------------------------------------------------------------------------------- the worker
+
+
+def confine(req: dict, result_fd: int, out_fd: int) -> None:
+    """Everything a worker does to itself before student code runs (see the module docstring)."""
+    os.setsid()
+    devnull = os.open(os.devnull, os.O_RDONLY)
+    os.dup2(devnull, 0)
+    os.dup2(out_fd, 1)
+    os.dup2(out_fd, 2)
+    keep = {0, 1, 2, result_fd}
+    for name in os.listdir("/proc/self/fd"):
+        fd = int(name)
+        if fd not in keep:
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+    sys.stdin = open(0, closefd=False)  # noqa: SIM115
+    sys.stdout = open(1, "w", closefd=False, errors="replace")  # noqa: SIM115
+    sys.stderr = open(2, "w", closefd=False, errors="replace")  # noqa: SIM115
+    memory_mb, cpu_s = req.get("memory_mb"), req.get("cpu_s")
+    if memory_mb:
+        limit = _worker.vm_size_bytes() + int(memory_mb) * 2**20
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    if cpu_s:
+        cpu = int(cpu_s) + 2
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 2))
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    resource.setrlimit(resource.RLIMIT_FSIZE, (FSIZE_LIMIT, FSIZE_LIMIT))
+    scratch = req.get("scratch")
+    user = req.get("user")
+    uid = os.geteuid()
+    if user and uid == 0:
+        import pwd
+
+        pw = pwd.getpwnam(user)
+        if scratch:
+            os.chown(scratch, pw.pw_uid, pw.pw_gid)
+        n = _worker.tasks_of_user(pw.pw_uid) + NPROC_EXTRA
+        resource.setrlimit(resource.RLIMIT_NPROC, (n, n))
+        os.setgroups([])
+        os.setgid(pw.pw_gid)
+        os.setuid(pw.pw_uid)
+        os.environ["HOME"] = scratch or "/nonexistent"
+        os.environ["USER"] = os.environ["LOGNAME"] = user
+    elif uid != 0:
+        n = _worker.tasks_of_user(uid) + NPROC_EXTRA
+        resource.setrlimit(resource.RLIMIT_NPROC, (n, n))
+    if scratch:
+        os.environ["TMPDIR"] = scratch
+    if req.get("landlock"):
+        landlock.restrict(req.get("read", []), req.get("write", []))
+    os.chdir(req.get("cwd") or "/")
+
+
+def _probe(req: dict) -> dict:
+    """What the sandboxed user can and cannot read (run inside a confined worker)."""
+    problems = []
+    for what, path in req.get("must_read", []):
+        try:
+            if os.path.isdir(path):
+                os.listdir(path)
+            else:
+                with open(path, "rb") as f:
+                    f.read(1)
+        except OSError as e:
+            problems.append(f"the sandbox cannot read {what} ({path}: {e.strerror})")
+    for path in req.get("must_hide", []):
+        try:
+            if os.path.isdir(path):
+                os.listdir(path)
+            else:
+                with open(path, "rb") as f:
+                    f.read(1)
+        except OSError:
+            continue
+        problems.append(f"student code could read {path}, which must stay hidden")
+    return {"kind": "probe", "problems": problems, "uid": os.getuid()}
+
+
+def _worker_main(req: dict, blob: bytes, result_fd: int, out_fd: int) -> None:
+    try:
+        confine(req, result_fd, out_fd)
+        if req.get("op") == "probe":
+            _worker.send_json(result_fd, b"P", _probe(req))
+            os._exit(0)
+        args, kwargs = pickle.loads(blob)
+    except BaseException as e:  # noqa: BLE001 - the sandbox itself failed: the grader's problem
+        try:
+            _worker.send_json(result_fd, b"E", {"kind": "internal", "message": f"sandbox set-up failed: {e!r}"[:2000]})
+        finally:
+            os._exit(0)
+    _worker.run_call(result_fd, req["lab_dir"], req["lab"], req["function"], args, kwargs, req.get("stubs_dir"))
+
+
+# ---------------------------------------------------------------------------------- the server
+
+
+def serve(sock: socket.socket) -> None:
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0)
+    libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM), 0, 0, 0)
+
+    def on_term(signum, frame):
+        kill_descendants()
+        os._exit(0)
+
+    signal.signal(signal.SIGTERM, on_term)
+    for name in PRELOAD:
+        try:
+            importlib.import_module(name)
+        except Exception:  # noqa: BLE001 - a missing optional module only makes workers slower
+            pass
+    send_msg(sock, {"ready": True, "pid": os.getpid(), "landlock": landlock.abi_version()})
+    while True:
+        try:
+            req, blob, fds = recv_msg(sock, with_fds=True)
+        except (EOFError, OSError, ValueError):
+            break
+        if req.get("op") == "exit" or len(fds) != 2:
+            for fd in fds:
+                os.close(fd)
+            break
+        result_fd, out_fd = fds
+        t0 = time.monotonic()
+        pid = os.fork()
+        if pid == 0:
+            sock.close()
+            _worker_main(req, blob, result_fd, out_fd)
+            os._exit(0)
+        os.close(result_fd)
+        os.close(out_fd)
+        send_msg(sock, {"pid": pid})
+        _, status = os.waitpid(pid, 0)
+        try:
+            os.killpg(pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        leftovers = kill_descendants()
+        send_msg(sock, {"done": True, "status": status, "leftovers": leftovers, "seconds": time.monotonic() - t0})
+    kill_descendants()
+
+
+def main() -> None:
+    fd = int(sys.argv[1])
+    sock = socket.socket(fileno=fd)
+    serve(sock)
+
+
+if __name__ == "__main__":
+    main()
