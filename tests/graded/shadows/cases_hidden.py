@@ -26,7 +26,7 @@ CASES = [
         outputs=("M",),
         check=checks.Allclose(atol=1e-10),
         part="light matrix",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -42,7 +42,7 @@ CASES = [
         outputs=("M",),
         check=checks.Allclose(atol=1e-10),
         part="light matrix",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
     Case(
@@ -53,7 +53,7 @@ CASES = [
         outputs=("D",),
         check=MapClose("D", atol=1e-9),
         part="depth pass",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -63,7 +63,7 @@ CASES = [
         outputs=("lit",),
         check=checks.Allclose(atol=1e-12),
         part="comparison",
-        points=1,
+        points=12,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +73,7 @@ CASES = [
         outputs=("g",),
         check=checks.Allclose(atol=1e-10),
         part="bias",
-        points=1,
+        points=11,
         visibility="hidden",
     ),
     Case(
@@ -84,7 +84,7 @@ CASES = [
         outputs=("F",),
         check=SameRows("F"),
         part="culling",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -94,7 +94,7 @@ CASES = [
         outputs=("outside",),
         check=checks.Equal("outside"),
         part="frustum handling",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
     Case(
@@ -105,7 +105,7 @@ CASES = [
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
         part="PCF",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -116,7 +116,7 @@ CASES = [
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
         part="cube map",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -131,7 +131,7 @@ CASES = [
         outputs=("image",),
         check=checks.ImageMatch(),
         part="all together",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
 ]

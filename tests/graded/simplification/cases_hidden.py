@@ -42,7 +42,7 @@ CASES = [
         outputs=("K",),
         check=checks.Allclose(atol=tol.EXACT),
         part="quadrics",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -53,7 +53,7 @@ CASES = [
         outputs=("Q",),
         check=checks.Allclose(atol=tol.EXACT),
         part="quadrics",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -63,7 +63,7 @@ CASES = [
         outputs=("position", "cost"),
         check=checks.All(checks.Allclose("position", atol=tol.GEOMETRY), checks.Allclose("cost", atol=tol.EXACT)),
         part="placement",
-        points=1,
+        points=12,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +73,7 @@ CASES = [
         outputs=("link_ok", "flips"),
         check=checks.Equal(),
         part="contraction",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -85,7 +85,7 @@ CASES = [
             checks.Equal(("F", "removed")), checks.Allclose("V", atol=tol.EXACT), checks.Allclose("Q", atol=tol.EXACT)
         ),
         part="contraction",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -95,7 +95,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(ant, 180), 180, flips=False),  # thin legs: see validity_problem
         part="greedy loop",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -105,7 +105,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(rock, 100), 100),
         part="greedy loop",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -115,7 +115,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(ico_noisy(3, 0.02, 11), 64), 64),
         part="greedy loop",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
 ]

@@ -33,7 +33,7 @@ CASES = [
         outputs=("UV",),
         check=checks.Allclose(atol=1e-8),
         part="parameterization",
-        points=2,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -44,7 +44,7 @@ CASES = [
         outputs=("UV",),
         check=checks.Allclose(atol=1e-8),
         part="parameterization",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -54,7 +54,7 @@ CASES = [
         outputs=("P",),
         check=checks.Allclose(atol=1e-10),
         part="sampling",
-        points=2,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -65,7 +65,7 @@ CASES = [
         outputs=("D",),
         check=TexelClose("D", atol=1e-10),
         part="naive VDM",
-        points=2,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -75,7 +75,7 @@ CASES = [
         outputs=("I",),
         check=checks.Allclose(atol=1e-12),
         part="importance",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -86,7 +86,7 @@ CASES = [
         outputs=("field",),
         check=TexelClose("field", atol=1e-12),
         part="field",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -97,7 +97,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-6),
         part="transport grid",
-        points=2,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -108,7 +108,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-6),
         part="transport grid",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -119,7 +119,7 @@ CASES = [
         outputs=("edges", "corners"),
         check=checks.All(SameRows("edges"), SameRows("corners")),
         part="alignment",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -129,7 +129,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-9),
         part="alignment",
-        points=2,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -139,7 +139,7 @@ CASES = [
         outputs=("diagonals",),
         check=checks.Equal(),
         part="diagonals",
-        points=2,
+        points=5,
         visibility="hidden",
     ),
     Case(
@@ -150,7 +150,7 @@ CASES = [
         outputs=("diagonals",),
         check=checks.Equal(),
         part="diagonals",
-        points=1,
+        points=4,
         visibility="hidden",
     ),
 ]
