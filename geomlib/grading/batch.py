@@ -13,11 +13,13 @@ Writes ``DIR/<submission>/results.json`` (and ``grader-output.txt``) per submiss
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -143,14 +145,19 @@ def _grade_one(sub: Submission, lab: str, out: Path, timeout: float) -> tuple[di
             if skipped:
                 log.write("".join(f"not copied: {s}\n" for s in skipped))
                 log.flush()
+            p = subprocess.Popen(
+                cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, env=env, start_new_session=True
+            )
             try:
-                p = subprocess.run(
-                    cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, timeout=timeout,
-                    env=env, start_new_session=True,
-                )  # fmt: skip
-                status = "ok" if p.returncode == 0 else f"grader exit {p.returncode}"
+                code = p.wait(timeout=timeout)
+                status = "ok" if code == 0 else f"grader exit {code}"
             except subprocess.TimeoutExpired:
                 status = f"timed out after {timeout:g} s"
+            finally:
+                # Whatever it started (grader, workers, their children) goes with it.
+                with contextlib.suppress(ProcessLookupError, PermissionError):
+                    os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
         try:
             data = json.loads(results.read_text())
         except (OSError, ValueError):
