@@ -9,7 +9,7 @@ from .cases import (
     TexelClose,
     align_inputs,
     blob_field,
-    box_with_uv,
+    features_entry,
     height_field_with_uv,
     line_field,
     open_box,
@@ -24,6 +24,8 @@ from .cases import (
 def _mesh(d: dict) -> dict:
     return {"V": d["V"], "F": d["F"]}
 
+
+STORED = [features_entry("box4", visibility="hidden")]
 
 CASES = [
     Case(
@@ -145,7 +147,7 @@ CASES = [
     Case(
         id="hidden-diagonals-box-uniform-9",
         function="choose_diagonals",
-        inputs=lambda: {k: v for k, v in align_inputs(box_with_uv(4), uniform(9)).items() if k != "corners"},
+        inputs=lambda: {k: v for k, v in align_inputs("box4", uniform(9)).items() if k != "corners"},
         params={"default": False},
         outputs=("diagonals",),
         check=checks.Equal(),
