@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import sys
 from collections import OrderedDict
 
 from geomlib.grading import impl as _impl
@@ -47,8 +48,15 @@ def graded_items(labs: list[str] | None = None) -> list[tuple[str, str, str, flo
     c = _Collector()
     args = [str(graded / n) for n in names]
     args += ["--collect-only", "-qq", "-p", "no:cacheprovider", f"--rootdir={_impl.course_root()}"]
-    with contextlib.redirect_stdout(io.StringIO()) as out:
-        code = pytest.main(args, plugins=[c])
+    # Another course's `graded` package (a test session may hold one) would shadow this one's.
+    saved = {k: sys.modules.pop(k) for k in list(sys.modules) if k == "graded" or k.startswith("graded.")}
+    try:
+        with contextlib.redirect_stdout(io.StringIO()) as out:
+            code = pytest.main(args, plugins=[c])
+    finally:
+        for k in [k for k in sys.modules if k == "graded" or k.startswith("graded.")]:
+            del sys.modules[k]
+        sys.modules.update(saved)
     if code not in (0, 5):
         raise RuntimeError(f"collecting the graded tests of {', '.join(names)} failed:\n{out.getvalue()[-2000:]}")
     return c.items

@@ -267,11 +267,18 @@ def _lookup_submission(student: Path, sub: Path) -> None:
         f.write_text(f.read_text() + extra)
 
 
-def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
-    from geomlib.grading.cases import load_cases
+def _public_reference_points() -> float:
+    """Points of the public reference cases (in a subprocess: this session may hold another course's `graded`)."""
+    code = (
+        f"from geomlib.grading.cases import load_cases; print(sum(c.points for c in load_cases({LAB!r}, hidden=False)))"
+    )
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True, check=True)
+    return float(p.stdout.strip())
 
+
+def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
     r, _ = _run(autograder, lambda sub: _lookup_submission(released / "student", sub))
-    public_refs = sum(c.points for c in load_cases(LAB, hidden=False))
+    public_refs = _public_reference_points()
     total = sum(p + h for p, h in points.values())
     # The look-up really works: it earns every public reference case, and nothing else.
     missed = [
