@@ -121,6 +121,35 @@ def _failure(message: str) -> dict:
     }
 
 
+def sandbox_user() -> str:
+    """The user student code runs as: ``GEOMLIB_SANDBOX_USER``, else ``nobody`` when root, else none."""
+    default = "nobody" if os.geteuid() == 0 else ""
+    return os.environ.get("GEOMLIB_SANDBOX_USER", default)
+
+
+def check_sandbox_user(user: str) -> None:
+    """Fail clearly unless ``user`` can run this Python and import the grader's worker.
+
+    A Python the sandbox user cannot read (one installed under ``/root``, say) would otherwise make
+    student code fail on its first import, and the message would blame the student.
+    """
+    if not user or os.geteuid() != 0:
+        return
+    try:
+        p = subprocess.run(
+            ["runuser", "-u", user, "--", sys.executable, "-c", "import numpy, geomlib.grading.worker"],
+            cwd="/", capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        ok, why = p.returncode == 0, (p.stderr.strip().splitlines() or ["?"])[-1]
+    except (OSError, subprocess.TimeoutExpired) as e:
+        ok, why = False, str(e)
+    if not ok:
+        raise BatchError(
+            f"the sandbox user {user!r} cannot run {sys.executable} ({why}); install the course where {user} "
+            f"can read it (see docs/autograder.md), or set GEOMLIB_SANDBOX_USER= to grade without a sandbox user"
+        )
+
+
 def _grade_one(sub: Submission, lab: str, out: Path, timeout: float) -> tuple[dict, str]:
     """Grade one submission in its own process; returns (results, status) and writes them under ``out``."""
     out.mkdir(parents=True, exist_ok=True)
@@ -135,10 +164,8 @@ def _grade_one(sub: Submission, lab: str, out: Path, timeout: float) -> tuple[di
             data = _failure(f"Nothing was graded: {e}.")
             results.write_text(json.dumps(data, indent=1) + "\n")
             return data, "no lab"
-        env = {**os.environ}
+        env = {**os.environ, "GEOMLIB_SANDBOX_USER": sandbox_user()}
         env.setdefault("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
-        if os.geteuid() == 0:
-            env.setdefault("GEOMLIB_SANDBOX_USER", "nobody")
         cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work / "labs"), "--lab", lab]
         cmd += ["--results", str(results), "--feedback", str(out / "feedback")]
         with open(out / "grader-output.txt", "w") as log:
@@ -186,6 +213,7 @@ def grade_all(
     if lab not in _impl.lab_names():
         raise BatchError(f"unknown lab {lab!r}; known: {', '.join(_impl.lab_names())}")
     subs = discover(Path(submissions))
+    check_sandbox_user(sandbox_user())
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     parts = points_by_part([lab]).get(lab, {})

@@ -4,13 +4,20 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import shutil
 from pathlib import Path
+
+import pytest
 
 from geomlib.grading import batch
 from geomlib.grading.results import validate_results
 
 from .course import run_geomlib
+
+# The sandbox user's drop is exercised on the real course, with a Python `nobody` can read
+# (test_release_course.py); this interpreter may live under /root.
+NO_SANDBOX = {"GEOMLIB_SANDBOX_USER": ""}
 
 METADATA = """\
 submission_101:
@@ -57,7 +64,9 @@ def test_metadata_parser_reads_every_submitter(tmp_path):
 def test_grade_all_on_a_gradescope_export(sample_course, tmp_path):
     exp = _export(sample_course, tmp_path)
     out = tmp_path / "out"
-    p = run_geomlib(sample_course, "grade-all", str(exp), "--lab", "sample", "--out", str(out), "--jobs", "2")
+    p = run_geomlib(
+        sample_course, "grade-all", str(exp), "--lab", "sample", "--out", str(out), "--jobs", "2", env=NO_SANDBOX
+    )
     assert "[3/3]" in p.stdout and "scores.csv" in p.stdout
     rows = list(csv.DictReader((out / "scores.csv").open()))
     by = {r["submission"]: r for r in rows}
@@ -82,6 +91,7 @@ def test_a_crash_costs_only_its_own_submission(sample_course, tmp_path, monkeypa
         return real(sub, lab, out, timeout)
 
     monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
+    monkeypatch.setenv("GEOMLIB_SANDBOX_USER", "")
     monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
     monkeypatch.setattr(batch, "_grade_one", flaky)
     summary = batch.grade_all(exp, "sample", tmp_path / "out", jobs=2, log=lambda *a: None)
@@ -102,3 +112,14 @@ def test_a_folder_per_student_and_a_timeout(sample_course, tmp_path):
     assert rows["alice"]["status"].startswith("timed out") and rows["bob"]["status"].startswith("timed out")
     assert p.returncode == 1  # nothing could be graded
     validate_results(json.loads((out / "alice" / "results.json").read_text()))
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the sandbox user is used as root only")
+def test_a_sandbox_user_that_cannot_run_the_grader_stops_grade_all_with_one_line(sample_course, tmp_path):
+    subs = tmp_path / "subs"
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "alice" / "sample")
+    p = run_geomlib(sample_course, "grade-all", str(subs), "--lab", "sample", "--out", str(tmp_path / "out"),
+                    check=False, env={"GEOMLIB_SANDBOX_USER": "no-such-user-xyz"})  # fmt: skip
+    assert p.returncode == 1 and "Traceback" not in p.stderr
+    assert p.stderr.startswith("geomlib grade-all: error: the sandbox user 'no-such-user-xyz' cannot run")
+    assert not (tmp_path / "out" / "alice").exists()
