@@ -106,7 +106,17 @@ def test_a_folder_per_student_and_a_timeout(sample_course, tmp_path):
     shutil.copytree(sample_course / "solutions" / "sample", subs / "bob" / "labs" / "sample")
     out = tmp_path / "out"
     p = run_geomlib(
-        sample_course, "grade-all", str(subs), "--lab", "sample", "--out", str(out), "--timeout", "0.01", check=False
+        sample_course,
+        "grade-all",
+        str(subs),
+        "--lab",
+        "sample",
+        "--out",
+        str(out),
+        "--timeout",
+        "0.01",
+        check=False,
+        env=NO_SANDBOX,
     )
     rows = {r["submission"]: r for r in csv.DictReader((out / "scores.csv").open())}
     assert rows["alice"]["status"].startswith("timed out") and rows["bob"]["status"].startswith("timed out")
