@@ -6,7 +6,7 @@ from geomlib import datasets
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
-from .cases import edge_pairs, edge_quadrics, ico_noisy, simplify
+from .cases import edge_pairs, edge_quadrics, ico_noisy, quadrics_entry, simplify
 from .support import random_quadrics, simplification_check
 
 
@@ -34,6 +34,8 @@ def ant_chain():
     return {**d, "Q": random_quadrics(len(d["V"]), seed=9), "pairs": pairs, "positions": d["V"][[0, 10, 100]] * 1.01}
 
 
+STORED = [quadrics_entry("quadrics-torus-fine", torus_fine, visibility="hidden")]
+
 CASES = [
     Case(
         id="hidden-face-quadrics-ant",
@@ -59,7 +61,7 @@ CASES = [
     Case(
         id="hidden-placement-torus-edges",
         function="optimal_contraction",
-        inputs=edge_quadrics(torus_fine),
+        inputs=edge_quadrics(torus_fine, "quadrics-torus-fine"),
         outputs=("position", "cost"),
         check=checks.All(checks.Allclose("position", atol=tol.GEOMETRY), checks.Allclose("cost", atol=tol.EXACT)),
         part="placement",
