@@ -1,7 +1,7 @@
 """The ``geomlib`` command.
 
 Students:      geomlib grade --impl labs --lab subdivision
-Instructors:   geomlib figures | refs build | refs check | stubs build | stubs check | release OUT
+Instructors:   geomlib figures | refs build | refs check | stubs build | stubs check | release OUT | grade-all DIR
 Anyone:        geomlib info mesh.obj | geomlib view mesh.obj [--html out.html] | geomlib render mesh.obj -o mesh.png
 """
 
@@ -20,7 +20,8 @@ examples:
   geomlib grade --impl path/to/submission --results results.json
   geomlib refs build --lab subdivision         store reference outputs from solutions/
   geomlib stubs build                          regenerate labs/ from solutions/
-  geomlib release dist/                        student bundle + Gradescope autograder zip
+  geomlib release dist/ --lab subdivision      student bundle + dist/autograder-subdivision.zip
+  geomlib grade-all exports/ --lab subdivision --out regrade/   batch grading (instructors)
   geomlib info mesh.obj                        counts, defects (duplicate, degenerate, non-manifold), genus, bbox
   geomlib view mesh.obj                        turn the mesh in a window (needs a display)
   geomlib view mesh.obj --html mesh.html       the same as one self-contained page (works offline)
@@ -136,10 +137,25 @@ def _cmd_grade(a) -> int:
 def _cmd_release(a) -> int:
     from geomlib.grading import release
 
-    out = release.release(Path(a.out))
-    for k, v in out.items():
-        print(f"{k}: {v}")
+    t = time.time()
+    try:
+        release.release(Path(a.out), a.lab)
+    except (release.ReleaseError, OSError) as e:
+        print(f"geomlib release: error: {e}", file=sys.stderr)
+        return 1
+    print(f"released in {time.time() - t:.0f} s into {a.out}")
     return 0
+
+
+def _cmd_grade_all(a) -> int:
+    from geomlib.grading import batch
+
+    try:
+        summary = batch.grade_all(Path(a.submissions), a.lab, Path(a.out), jobs=a.jobs, timeout=a.timeout)
+    except batch.BatchError as e:
+        print(f"geomlib grade-all: error: {e}", file=sys.stderr)
+        return 1
+    return 0 if summary["graded"] else 1
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -228,9 +244,20 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("-v", "--verbose", action="store_true")
     g.set_defaults(func=_cmd_grade)
 
-    rl = sub.add_parser("release", help="write the student bundle and the Gradescope autograder zip")
+    rl = sub.add_parser("release", help="write the student bundle and one Gradescope autograder zip per lab")
     rl.add_argument("out", help="output folder")
+    rl.add_argument("--lab", action="append", help="only this lab (repeatable; default: every lab)")
     rl.set_defaults(func=_cmd_release)
+
+    ga = sub.add_parser(
+        "grade-all", help="grade many submissions of one lab in parallel: a results.json each and one CSV"
+    )
+    ga.add_argument("submissions", help="a folder per student, or Gradescope's export (submission_metadata.yml)")
+    ga.add_argument("--lab", required=True, help="the lab to grade")
+    ga.add_argument("--out", required=True, help="output folder: <student>/results.json and scores.csv")
+    ga.add_argument("--jobs", type=int, default=None, help="submissions graded at once (default: CPU count, max 4)")
+    ga.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per submission (default 1800)")
+    ga.set_defaults(func=_cmd_grade_all)
     return p
 
 

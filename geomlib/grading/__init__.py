@@ -4,7 +4,7 @@ What a graded test module imports::
 
     from geomlib.grading import Case, checks, graded, reference_tests, expect_close, expect_raises
 
-See ``docs/adding-a-lab.md`` (instructors) and ``docs/grading.md`` (how grading works).
+See ``docs/adding-a-lab.md`` (instructors) and ``docs/autograder.md`` (running the autograder).
 """
 
 from geomlib.grading import checks, tolerances

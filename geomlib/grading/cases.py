@@ -33,6 +33,9 @@ __all__ = [
     "reference_path",
     "load_reference",
     "inputs_digest",
+    "stored_input",
+    "stored_path",
+    "load_stored",
 ]
 
 VISIBILITIES = ("visible", "after_due_date", "hidden", "after_published")
@@ -299,3 +302,48 @@ def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Ca
         mod = importlib.import_module(f"graded.{lab}.{mod_name}")
         cases.extend(getattr(mod, "CASES", []))
     return cases
+
+
+# ------------------------------------------------------------------------------ stored inputs
+# A test often needs, as its input, what an earlier task produces (a depth map for the shadow
+# test, a mesh's sharp edges for the alignment). Test helpers never compute those with solution
+# code: a lab's case module lists them in ``STORED`` (cases without points, of the solution's
+# functions), ``geomlib refs build`` runs the solution once and stores their outputs under
+# ``tests/reference/<lab>/inputs/`` (``hidden/inputs/`` for those of ``cases_hidden.py``), and
+# the helpers read them with :func:`stored_input`.
+
+
+def stored_path(lab: str, case: Case) -> Path:
+    """Where ``geomlib refs build`` stores the outputs of a ``STORED`` entry."""
+    sub = ("hidden", "inputs") if case.hidden else ("inputs",)
+    return _impl.reference_dir().joinpath(lab, *sub, f"{case.id}.npz")
+
+
+def stored_input(lab: str, id: str) -> dict:
+    """The stored outputs (``{name: array}``) of the ``STORED`` entry ``id`` of ``lab`` (public or hidden)."""
+    for sub in (("inputs",), ("hidden", "inputs")):
+        path = _impl.reference_dir().joinpath(lab, *sub, f"{id}.npz")
+        if path.is_file():
+            with np.load(path, allow_pickle=False) as z:
+                return {name: z[name] for name in z.files}
+    raise FileNotFoundError(
+        f"stored input {lab}/inputs/{id}.npz is missing: run `geomlib refs build --lab {lab}` (instructors)"
+    )
+
+
+def load_stored(lab: str, *, hidden: bool = True) -> list[Case]:
+    """The ``STORED`` entries of a lab's case modules (public first), in the order they are built."""
+    tests = str(_impl.tests_dir())
+    if tests not in sys.path:
+        sys.path.insert(0, tests)
+    out: list[Case] = []
+    folder = _impl.tests_dir() / "graded" / lab
+    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True)):
+        if (is_hidden and not hidden) or not (folder / f"{mod_name}.py").is_file():
+            continue
+        mod = importlib.import_module(f"graded.{lab}.{mod_name}")
+        for c in getattr(mod, "STORED", []):
+            if c.hidden != is_hidden:
+                raise ValueError(f"{lab}: STORED entry {c.id} in {mod_name}.py has visibility {c.visibility!r}")
+            out.append(c)
+    return out

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib.grading import impl as _impl
-from geomlib.grading.cases import Case, inputs_digest, load_cases, reference_path
+from geomlib.grading.cases import Case, inputs_digest, load_cases, load_stored, reference_path, stored_path
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import GradingFailure
 
@@ -63,8 +63,17 @@ def _to_arrays(case: Case, result) -> dict[str, np.ndarray]:
 
 
 def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
+    """A compressed ``.npz`` whose bytes depend on the arrays only (no time stamps): a rebuild that
+    reproduces the outputs leaves the files, and git, unchanged."""
+    import zipfile
+
     buf = io.BytesIO()
-    np.savez_compressed(buf, **arrays)
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as z:
+        for name, a in arrays.items():
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            with z.open(info, "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(a), allow_pickle=False)
     return buf.getvalue()
 
 
@@ -76,55 +85,79 @@ def _run_solution(lab: str, case: Case) -> tuple[dict, str]:
     return _to_arrays(case, fn(**inputs, **case.params)), digest
 
 
+def _entry(case: Case, digest: str, arrays: dict) -> dict:
+    return {
+        "function": case.function,
+        "params": case.params,
+        "part": case.part,
+        "points": case.points,
+        "visibility": case.visibility,
+        "inputs_sha256": digest,
+        "outputs": {
+            k: {
+                "shape": list(a.shape),
+                "dtype": str(a.dtype),
+                "sha256": hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest(),
+            }
+            for k, a in arrays.items()
+        },
+    }
+
+
+def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> None:
+    for key, entries in manifests.items():
+        folder = folders[key]
+        if not entries:
+            continue
+        for old in folder.glob("*.npz"):  # drop stale files of cases that no longer exist
+            if old.stem not in entries:
+                old.unlink()
+        manifest = {
+            "generated_by": f"geomlib refs build --lab {lab}",
+            "note": note,
+            "versions": _versions(),
+            "cases": entries,
+        }
+        (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+
+
 def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
-    """Run the solutions on every declared case and store the outputs; returns the files written."""
+    """Run the solutions on every stored input and every declared case and store the outputs.
+
+    Stored inputs (``STORED``) are built first, in order, since cases' inputs may read them.
+    Returns the files written.
+    """
     labs = labs or _impl.lab_names()
     written = []
+    ref = _impl.reference_dir()
     for lab in labs:
+        stored = load_stored(lab)
+        if stored:
+            manifests = {False: {}, True: {}}
+            for case in stored:
+                arrays, digest = _run_solution(lab, case)
+                path = stored_path(lab, case)
+                path.parent.mkdir(parents=True, exist_ok=True)
+                path.write_bytes(_npz_bytes(arrays))
+                written.append(path)
+                manifests[case.hidden][case.id] = _entry(case, digest, arrays)
+                log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
+            folders = {False: ref / lab / "inputs", True: ref / lab / "hidden" / "inputs"}
+            _write_manifests(lab, manifests, folders, "inputs of graded tests, from solutions/; do not edit by hand")
         cases = load_cases(lab)
         if not cases:
             continue
-        manifests: dict[bool, dict] = {False: {}, True: {}}
+        manifests = {False: {}, True: {}}
         for case in cases:
             arrays, digest = _run_solution(lab, case)
             path = reference_path(lab, case)
             path.parent.mkdir(parents=True, exist_ok=True)
             path.write_bytes(_npz_bytes(arrays))
             written.append(path)
-            manifests[case.hidden][case.id] = {
-                "function": case.function,
-                "params": case.params,
-                "part": case.part,
-                "points": case.points,
-                "visibility": case.visibility,
-                "inputs_sha256": digest,
-                "outputs": {
-                    k: {
-                        "shape": list(a.shape),
-                        "dtype": str(a.dtype),
-                        "sha256": hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest(),
-                    }
-                    for k, a in arrays.items()
-                },
-            }
-            log(
-                f"  {lab}/{'hidden/' if case.hidden else ''}{case.id}.npz  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}"
-            )
-        for hidden, entries in manifests.items():
-            folder = _impl.reference_dir() / lab / ("hidden" if hidden else "")
-            if not entries:
-                continue
-            # Drop stale reference files of cases that no longer exist.
-            for old in folder.glob("*.npz"):
-                if old.stem not in entries:
-                    old.unlink()
-            manifest = {
-                "generated_by": f"geomlib refs build --lab {lab}",
-                "note": "generated from solutions/; do not edit by hand",
-                "versions": _versions(),
-                "cases": entries,
-            }
-            (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+            manifests[case.hidden][case.id] = _entry(case, digest, arrays)
+            log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
+        folders = {False: ref / lab, True: ref / lab / "hidden"}
+        _write_manifests(lab, manifests, folders, "generated from solutions/; do not edit by hand")
     return written
 
 
@@ -133,9 +166,10 @@ def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
     labs = labs or _impl.lab_names()
     problems: list[RefProblem] = []
     for lab in labs:
+        inputs = load_stored(lab)
         cases = load_cases(lab)
-        for case in cases:
-            path = reference_path(lab, case)
+        for case in inputs + cases:
+            path = stored_path(lab, case) if any(case is c for c in inputs) else reference_path(lab, case)
             if not path.is_file():
                 problems.append(RefProblem(lab, case.id, f"missing {path.name}: run `geomlib refs build --lab {lab}`"))
                 continue
@@ -159,10 +193,14 @@ def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
                 problems.append(RefProblem(lab, case.id, f"the solution no longer reproduces the reference: {e}"))
         # Reference files for which no case exists any more.
         known = {(c.hidden, c.id) for c in cases}
+        known_inputs = {(c.hidden, c.id) for c in inputs}
         for hidden in (False, True):
             folder = _impl.reference_dir() / lab / ("hidden" if hidden else "")
             for f in folder.glob("*.npz"):
                 if (hidden, f.stem) not in known:
                     problems.append(RefProblem(lab, f.stem, f"stale reference file {f.name} has no case"))
-        log(f"  {lab}: {len(cases)} cases checked")
+            for f in (folder / "inputs").glob("*.npz"):
+                if (hidden, f.stem) not in known_inputs:
+                    problems.append(RefProblem(lab, f.stem, f"stale stored input {f.name} has no STORED entry"))
+        log(f"  {lab}: {len(inputs)} stored inputs and {len(cases)} cases checked")
     return problems

@@ -1,121 +1,252 @@
-"""``geomlib release OUT``: the student bundle and the Gradescope autograder zip.
+"""``geomlib release OUT [--lab NAME ...]``: the student bundle and one Gradescope autograder zip per lab.
 
 ``OUT/student/`` (and ``OUT/student.zip``)
-    geomlib, the stubs in labs/, public graded tests and public references, notebooks without
-    outputs, the student README and guide, pyproject.toml, uv.lock, the ``run`` script.
-    No solution code, no hidden tests, no hidden references.
-``OUT/autograder.zip``
-    ``setup.sh`` and ``run_autograder`` at the top (Gradescope's layout) plus the same sources with
-    the hidden tests and references. ``run_autograder`` copies the submission's lab folders over the
-    stubs, grades them and writes ``results/results.json``.
+    geomlib, the stubs of the chosen labs, their public graded tests and public references,
+    notebooks without outputs, the student guide as README.md, pyproject.toml, uv.lock, ``run``.
+    No solution code, no hidden tests, no hidden references, no other lab.
+``OUT/autograder-<lab>.zip``, one per chosen lab
+    Gradescope's layout: ``setup.sh`` and ``run_autograder`` at the top, next to the sources that
+    grade that lab only (its stubs, public and hidden tests and references, geomlib, the lock).
+    Both scripts honour ``GEOMLIB_AUTOGRADER_ROOT`` (default ``/autograder``: ``source/``,
+    ``submission/``, ``results/`` under it), so the zip installs and runs locally too
+    (``docs/autograder.md``).
+
+Everything is written into a temporary folder inside ``OUT`` and moved into place only when the
+whole release succeeded: a failed release leaves ``OUT`` as it was.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import stat
+import tempfile
 import zipfile
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import stubs
 
-__all__ = ["release", "student_files", "leaked_lines"]
+__all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secret_lines", "ReleaseError"]
 
 _SKIP_DIRS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache", ".ruff_cache"}
 _TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version"]
+_TEXT_SUFFIXES = {".py", ".md", ".ipynb", ".txt", ".toml", ".json", ".cfg", ".sh", ".yml", ".yaml", ".rst", ""}
 
-SETUP_SH = """#!/usr/bin/env bash
-# Gradescope runs this once when the autograder image is built (as root, Ubuntu).
+
+class ReleaseError(RuntimeError):
+    """The release cannot be made (stale stubs, missing references, a leak, an unknown lab)."""
+
+
+# ------------------------------------------------------------------------------------ scripts
+
+SETUP_SH = r"""#!/usr/bin/env bash
+# Gradescope runs this once, as root, when it builds the autograder image (Ubuntu).
+# Locally (as root):  GEOMLIB_AUTOGRADER_ROOT=/tmp/ag bash /tmp/ag/source/setup.sh
+# It installs the grader where the sandbox user (GEOMLIB_SANDBOX_USER, default nobody) can run it
+# and makes the hidden cases and references readable by root only. Lab: @LAB@.
 set -euo pipefail
+ROOT="${GEOMLIB_AUTOGRADER_ROOT:-/autograder}"
+SRC="$ROOT/source"
+SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
+cd "$SRC"
 export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq libosmesa6 python3 python3-pip python3-venv curl >/dev/null
-command -v uv >/dev/null || python3 -m pip install --quiet uv 2>/dev/null || python3 -m pip install --quiet --break-system-packages uv
-cd /autograder/source
-uv sync --frozen
-# Hidden references stay readable by root only; student code runs as `nobody` (GEOMLIB_SANDBOX_USER).
-find tests/reference -type d -name hidden -exec chmod -R go-rwx {} +
+
+# System packages, only the missing ones: headless OpenGL for pyrender, a Python, pip.
+need=()
+ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so' || need+=(libosmesa6)
+command -v python3 >/dev/null 2>&1 || need+=(python3 python3-venv python3-pip)
+if ! command -v uv >/dev/null 2>&1 && ! python3 -m pip --version >/dev/null 2>&1; then need+=(python3-pip); fi
+if [ ${#need[@]} -gt 0 ]; then
+  echo "setup.sh: apt-get install ${need[*]}"
+  apt-get update -qq
+  apt-get install -y -qq "${need[@]}" >/dev/null
+fi
+if ! command -v uv >/dev/null 2>&1; then
+  python3 -m pip install --quiet uv 2>/dev/null || python3 -m pip install --quiet --break-system-packages uv
+fi
+
+# A Python the sandbox user can read (not one under /root, which it cannot open): the one named by
+# GEOMLIB_AUTOGRADER_PYTHON, else a system python3.11, else uv installs 3.11 under $ROOT/python.
+PY="${GEOMLIB_AUTOGRADER_PYTHON:-}"
+for cand in /usr/bin/python3.11 /usr/local/bin/python3.11; do
+  if [ -n "$PY" ]; then break; fi
+  if [ -x "$cand" ]; then PY="$cand"; break; fi
+done
+if [ -z "$PY" ]; then
+  export UV_PYTHON_INSTALL_DIR="$ROOT/python"
+  uv python install 3.11
+  chmod -R a+rX "$ROOT/python"
+  PY="$(uv python find 3.11)"
+fi
+echo "setup.sh: Python $PY"
+
+# The locked library and the test runner (no dev tools) in source/.venv, with bytecode compiled now
+# (the sandbox user cannot write it).
+export UV_PROJECT_ENVIRONMENT="$SRC/.venv"
+uv sync --frozen --no-dev --group grading --compile-bytecode --python "$PY" --no-python-downloads --quiet
+chmod a+rx "$ROOT"
+chmod -R a+rX "$SRC"
+# Hidden cases, hidden tests and hidden references: root only.
+find "$SRC/tests" -name '*hidden*' -exec chmod -R go-rwx {} +
+
+# The grader must start, and the sandbox user must be able to run the same Python.
+"$SRC/.venv/bin/python" -c 'import geomlib.grading.grade, pytest, numpy, scipy'
+if [ "$(id -u)" = 0 ] && [ -n "$SANDBOX_USER" ]; then
+  if ! (cd / && runuser -u "$SANDBOX_USER" -- "$SRC/.venv/bin/python" -c 'import numpy, scipy, geomlib.grading.worker'); then
+    echo "setup.sh: the sandbox user '$SANDBOX_USER' cannot run $SRC/.venv/bin/python (check the permissions of $ROOT and of the Python)" >&2
+    exit 1
+  fi
+fi
+echo "setup.sh: ready to grade @LAB@"
 """
 
-RUN_AUTOGRADER = """#!/usr/bin/env bash
-# Gradescope calls this for every submission. It never exits before results.json is written.
+RUN_AUTOGRADER = r"""#!/usr/bin/env bash
+# Gradescope runs this for every submission, as root. It always writes results/results.json.
+# Locally (as root):  GEOMLIB_AUTOGRADER_ROOT=/tmp/ag bash /tmp/ag/source/run_autograder
+# Grades lab @LAB@ of the submission in $ROOT/submission (a folder holding @LAB@/ or labs/@LAB@/),
+# from a private copy (regular files only: symbolic links are not followed), as the sandbox user.
 set -u
+LAB="@LAB@"
 ROOT="${GEOMLIB_AUTOGRADER_ROOT:-/autograder}"
 SRC="$ROOT/source"
 SUB="$ROOT/submission"
-RESULTS="$ROOT/results/results.json"
-mkdir -p "$ROOT/results"
-cd "$SRC" || exit 0
-
-# The submission may be the lab folders themselves or a checkout that contains labs/.
-if [ -d "$SUB/labs" ]; then SUBLABS="$SUB/labs"; else SUBLABS="$SUB"; fi
-for lab in labs/*/; do
-  name=$(basename "$lab")
-  if [ -d "$SUBLABS/$name" ]; then
-    rm -rf "labs/$name"
-    cp -r "$SUBLABS/$name" "labs/$name"
-  fi
-done
-chmod -R a+rX labs
-
+OUT="$ROOT/results"
+RESULTS="$OUT/results.json"
+LOG="$OUT/grader-output.txt"
+PY="${GEOMLIB_PYTHON:-$SRC/.venv/bin/python}"
+export GEOMLIB_ROOT="$SRC"
 export GEOMLIB_SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
 export GEOMLIB_NO_FEEDBACK_PICTURES="${GEOMLIB_NO_FEEDBACK_PICTURES-1}"
-PY="${GEOMLIB_PYTHON:-uv run --frozen python}"
-$PY -m geomlib.cli grade --impl labs --results "$RESULTS" --feedback "$ROOT/results/feedback" > "$ROOT/results/grader-output.txt" 2>&1
+mkdir -p "$OUT"
+rm -f "$RESULTS"
+: > "$LOG"
+
+grader_failed() {
+  # The grader's own failure, never the student's: a results.json that says so (plain bash: the
+  # grader's Python may be what is broken).
+  printf '{"score": 0, "output": "The autograder itself failed (%s). This is not a problem with your submission: please tell the course staff.", "output_format": "text", "visibility": "visible", "stdout_visibility": "hidden", "tests": []}\n' "$1" > "$RESULTS"
+  echo "run_autograder: grader failure: $1" | tee -a "$LOG"
+  exit 0
+}
+
+cd "$SRC" 2>/dev/null || grader_failed "no source folder at $SRC"
+"$PY" -c 'import geomlib.grading.grade' >>"$LOG" 2>&1 || grader_failed "its Python environment does not start; run setup.sh"
+if [ "$(id -u)" = 0 ] && [ -n "$GEOMLIB_SANDBOX_USER" ]; then
+  id "$GEOMLIB_SANDBOX_USER" >/dev/null 2>&1 || grader_failed "unknown sandbox user $GEOMLIB_SANDBOX_USER"
+  (cd / && runuser -u "$GEOMLIB_SANDBOX_USER" -- "$PY" -c 'import numpy, geomlib.grading.worker') >>"$LOG" 2>&1 \
+    || grader_failed "the sandbox user $GEOMLIB_SANDBOX_USER cannot run the grader's Python; run setup.sh"
+fi
+
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/geomlib-submission.XXXXXX")" || grader_failed "cannot create a work folder"
+trap 'rm -rf "$WORK"' EXIT
+chmod 755 "$WORK"
+"$PY" -m geomlib.grading.submission "$SUB" "$LAB" "$WORK/labs" --results "$RESULTS" >>"$LOG" 2>&1
 status=$?
+if [ "$status" = 0 ]; then
+  "$PY" -m geomlib.cli grade --impl "$WORK/labs" --lab "$LAB" --results "$RESULTS" --feedback "$OUT/feedback" >>"$LOG" 2>&1
+  status=$?
+fi
 if [ ! -s "$RESULTS" ]; then
-  # The grader itself failed: report it instead of losing the submission's result.
-  python3 - "$RESULTS" "$ROOT/results/grader-output.txt" "$status" <<'PY'
+  "$PY" - "$RESULTS" "$LOG" "$status" <<'PY' || grader_failed "it ended with status $status"
 import json, sys
 out = open(sys.argv[2], errors="replace").read()[-4000:]
-json.dump({"score": 0, "output": f"The autograder failed (exit {sys.argv[3]}); please tell the course staff.\\n\\n{out}",
-           "tests": []}, open(sys.argv[1], "w"))
+msg = f"The autograder itself failed (exit status {sys.argv[3]}). This is not a problem with your submission: please tell the course staff."
+json.dump({"score": 0, "output": msg, "output_format": "text", "visibility": "visible",
+           "stdout_visibility": "hidden", "tests": []}, open(sys.argv[1], "w"))
+print(out)
 PY
 fi
-cat "$ROOT/results/grader-output.txt"
+cat "$LOG"
 exit 0
 """
+
+_AUTOGRADER_README = """# Autograder for the lab "{lab}"
+
+Generated by `geomlib release`; see the course's docs/autograder.md. Gradescope unzips this into
+/autograder/source, runs `setup.sh` once and `run_autograder` for every submission.
+"""
+
+
+# ------------------------------------------------------------------------------------ files
+
+
+def _labs(root: Path, labs: list[str] | None) -> list[str]:
+    known = [n for n in _impl.lab_names() if (root / "solutions" / n / "__init__.py").is_file()]
+    if not labs:
+        return known
+    unknown = [n for n in labs if n not in known]
+    if unknown:
+        raise ReleaseError(f"unknown lab(s) {', '.join(unknown)}; known: {', '.join(known)}")
+    return list(dict.fromkeys(labs))
 
 
 def _is_hidden(rel: Path) -> bool:
     return any("hidden" in part for part in rel.parts)
 
 
-def student_files(root: Path, *, include_hidden: bool) -> list[tuple[Path, Path]]:
-    """(source, relative destination) pairs of everything a student (or the autograder) gets."""
-    out: list[tuple[Path, Path]] = []
+def _tree(root: Path, folder: str, keep=lambda rel: True) -> list[tuple[Path, Path]]:
+    base = root / folder
+    out = []
+    if not base.is_dir():
+        return out
+    for p in sorted(base.rglob("*")):
+        rel = p.relative_to(root)
+        if p.is_dir() or p.is_symlink() or _SKIP_DIRS & set(rel.parts) or p.name == "READY":
+            continue
+        if keep(rel):
+            out.append((p, rel))
+    return out
 
-    def add_tree(folder: str, keep=lambda rel: True):
-        base = root / folder
-        if not base.is_dir():
-            return
-        for p in sorted(base.rglob("*")):
-            rel = p.relative_to(root)
-            if p.is_dir() or _SKIP_DIRS & set(rel.parts) or p.name == "READY":
-                continue
-            if keep(rel):
-                out.append((p, rel))
 
-    add_tree("geomlib")
-    add_tree("labs")
-    add_tree("notebooks", keep=lambda rel: rel.suffix == ".ipynb" or rel.name == "README.md")
-    add_tree(
-        "docs",
-        keep=lambda rel: rel.name in ("students.md", "cameras.md", "cameras.png") or rel.parts[1:2] == ("figures",),
-    )
-
-    def keep_test(rel: Path) -> bool:
+def _tests(root: Path, labs: list[str], *, include_hidden: bool) -> list[tuple[Path, Path]]:
+    def keep(rel: Path) -> bool:
         parts = rel.parts
-        if parts[1] not in ("graded", "reference", "conftest.py"):
+        if parts[1] == "conftest.py":
+            return True
+        if parts[1] not in ("graded", "reference"):
             return False  # library tests, solution cross-checks and framework tests stay with instructors
+        if parts[1] == "graded" and len(parts) == 3:
+            return True  # tests/graded/__init__.py
+        if len(parts) < 3 or parts[2] not in labs:
+            return False
         return include_hidden or not _is_hidden(rel)
 
-    add_tree("tests", keep=keep_test)
-    for name in _TOP_FILES:
-        if (root / name).is_file():
-            out.append((root / name, Path(name)))
+    return _tree(root, "tests", keep)
+
+
+def student_files(
+    root: Path, labs: list[str] | None = None, *, include_hidden: bool = False
+) -> list[tuple[Path, Path]]:
+    """(source, relative destination) pairs of everything a student gets for ``labs`` (default: all)."""
+    labs = labs or _impl.lab_names()
+    out = _tree(root, "geomlib")
+    out += _tree(root, "labs", lambda rel: rel.parts[1] in labs)
+    out += _tree(
+        root,
+        "notebooks",
+        lambda rel: rel.name == "README.md" or (rel.suffix == ".ipynb" and rel.stem in labs),
+    )
+    out += _tree(
+        root,
+        "docs",
+        lambda rel: (
+            rel.name in ("students.md", "cameras.md", "cameras.png")
+            or (rel.parts[1:2] == ("figures",) and len(rel.parts) > 3 and rel.parts[2] in labs)
+        ),
+    )
+    out += _tests(root, labs, include_hidden=include_hidden)
+    out += [(root / n, Path(n)) for n in _TOP_FILES if (root / n).is_file()]
+    return out
+
+
+def autograder_files(root: Path, lab: str) -> list[tuple[Path, Path]]:
+    """(source, relative destination) pairs of the sources that grade ``lab`` (hidden material included)."""
+    out = _tree(root, "geomlib")
+    out += _tree(root, "labs", lambda rel: rel.parts[1] == lab and rel.suffix == ".py")
+    out += _tests(root, [lab], include_hidden=True)
+    out += [(root / n, Path(n)) for n in ("pyproject.toml", "uv.lock", ".python-version") if (root / n).is_file()]
     return out
 
 
@@ -138,82 +269,162 @@ def _strip_outputs(text: str) -> str:
     return json.dumps(nb, indent=1, ensure_ascii=False) + "\n"
 
 
-def _zip(folder: Path, zip_path: Path) -> None:
-    with zipfile.ZipFile(zip_path, "w", zipfile.ZIP_DEFLATED) as z:
-        for p in sorted(folder.rglob("*")):
-            if p.is_file():
-                z.write(p, str(Path(folder.name) / p.relative_to(folder)))
+def _zip_tree(z: zipfile.ZipFile, folder: Path, prefix: str = "") -> None:
+    for p in sorted(folder.rglob("*")):
+        if p.is_file():
+            rel = p.relative_to(folder).as_posix()
+            info = zipfile.ZipInfo(prefix + rel, date_time=(2000, 1, 1, 0, 0, 0))
+            mode = 0o755 if os.access(p, os.X_OK) else 0o644
+            info.external_attr = (mode | stat.S_IFREG) << 16
+            info.compress_type = zipfile.ZIP_DEFLATED
+            z.writestr(info, p.read_bytes())
 
 
-def leaked_lines(bundle: Path, *, min_len: int = 12) -> list[tuple[str, str]]:
-    """Distinctive lines from inside solution blocks that appear anywhere in ``bundle``.
+def _script(z: zipfile.ZipFile, name: str, text: str) -> None:
+    info = zipfile.ZipInfo(name, date_time=(2000, 1, 1, 0, 0, 0))
+    info.external_attr = (0o755 | stat.S_IFREG) << 16
+    info.compress_type = zipfile.ZIP_DEFLATED
+    z.writestr(info, text)
 
-    A line counts as distinctive when it is at least ``min_len`` characters long and does not also
-    appear outside the solution blocks in ``solutions/`` (given code legitimately shared).
-    """
-    root = _impl.course_root()
-    inside: set[str] = set()
-    outside: set[str] = set()
+
+# ------------------------------------------------------------------------------------ leaks
+
+
+def _baseline_lines(root: Path) -> set[str]:
+    """Stripped lines of the code that ships anyway: the library and the given code of every stub."""
+    lines: set[str] = set()
+    for f in (root / "geomlib").rglob("*.py"):
+        if "__pycache__" not in f.parts:
+            lines |= {ln.strip() for ln in f.read_text().splitlines()}
     for f in (root / "solutions").rglob("*.py"):
-        text = f.read_text()
-        sol = set(stubs.solution_lines(text, str(f)))
-        inside |= sol
-        outside |= {ln.strip() for ln in stubs.make_stub(text, str(f)).splitlines()}
-    secret = {ln for ln in inside - outside if len(ln) >= min_len and not ln.startswith("#")}
+        if "__pycache__" not in f.parts:
+            lines |= {ln.strip() for ln in stubs.make_stub(f.read_text(), str(f)).splitlines()}
+    return lines
+
+
+def secret_lines(root: Path | None = None, labs: list[str] | None = None) -> dict[str, set[str]]:
+    """``{task: lines}``: the lines inside each solution block that appear nowhere in the code that ships anyway.
+
+    The code that ships anyway is the library (``geomlib/``) and the stubs' given code; a line of a
+    solution block found there (``return False``, ``if tol is None:``) gives nothing away. Comments
+    are not code and do not count. Tasks are named ``<lab>/<file>: <task as the BEGIN marker names it>``.
+    """
+    root = Path(root) if root else _impl.course_root()
+    baseline = _baseline_lines(root)
+    out: dict[str, set[str]] = {}
+    for f in sorted((root / "solutions").rglob("*.py")):
+        if "__pycache__" in f.parts or (labs and f.relative_to(root / "solutions").parts[0] not in labs):
+            continue
+        rel = f.relative_to(root / "solutions").as_posix()
+        for task, body in stubs.solution_blocks(f.read_text(), str(f)):
+            secret = {ln for ln in body if not ln.startswith("#") and ln not in baseline}
+            if secret:
+                key = f"{rel}: {task}"
+                out.setdefault(key, set()).update(secret)
+    return out
+
+
+def leaked_lines(bundle: Path, secrets: dict[str, set[str]] | None = None) -> list[tuple[str, str, str]]:
+    """``(file, line, task)`` for every line of a text file under ``bundle`` that is a solution's secret line."""
+    secrets = secret_lines() if secrets is None else secrets
+    owner = {ln: task for task, lines in secrets.items() for ln in lines}
     leaks = []
-    for p in bundle.rglob("*"):
-        if not p.is_file() or p.suffix in (".npz", ".png", ".zip", ".lock"):
+    for p in sorted(Path(bundle).rglob("*")):
+        if not p.is_file() or p.suffix not in _TEXT_SUFFIXES:
             continue
         try:
             text = p.read_text()
         except (UnicodeDecodeError, OSError):
             continue
+        if p.suffix == ".ipynb":  # notebook source is JSON: look at the cells' own lines
+            try:
+                cells = json.loads(text).get("cells", [])
+                text = "\n".join("".join(c.get("source", [])) for c in cells)
+            except (ValueError, AttributeError):
+                pass
         for ln in text.splitlines():
             s = ln.strip()
-            if s in secret:
-                leaks.append((str(p.relative_to(bundle)), s))
+            if s in owner:
+                leaks.append((p.relative_to(bundle).as_posix(), s, owner[s]))
     return leaks
 
 
-def release(out: Path) -> dict[str, Path]:
-    """Write ``out/student/``, ``out/student.zip`` and ``out/autograder.zip``; returns their paths.
+# ------------------------------------------------------------------------------------ release
+
+
+def _check_course(root: Path, labs: list[str]) -> None:
+    problems = stubs.check(labs)
+    if problems:
+        raise ReleaseError(f"labs/ is stale ({problems[0]}); run `geomlib stubs build` first")
+    from geomlib.grading.cases import load_cases, reference_path
+
+    for lab in labs:
+        missing = [c.id for c in load_cases(lab) if not reference_path(lab, c).is_file()]
+        if missing:
+            raise ReleaseError(
+                f"{lab}: {len(missing)} reference output(s) missing (e.g. {missing[0]}); "
+                f"run `geomlib refs build --lab {lab}` first"
+            )
+
+
+def release(out: str | os.PathLike, labs: list[str] | None = None, *, log=print) -> dict[str, Path]:
+    """Write the student bundle and one autograder zip per lab into ``out``; returns their paths.
+
+    Parameters
+    ----------
+    out : path
+        Output folder (created if needed). Earlier outputs of the same names are replaced.
+    labs : list of str, optional
+        Labs to release (default: every lab with a solution).
 
     Raises
     ------
-    RuntimeError
-        When ``labs/`` is stale or a solution line would leak into the student bundle.
+    ReleaseError
+        When a lab is unknown, ``labs/`` is stale, references are missing or a solution line would
+        reach students. ``out`` is then left as it was.
     """
     root = _impl.course_root()
-    problems = stubs.check()
-    if problems:
-        raise RuntimeError("labs/ is stale; run `geomlib stubs build` first:\n  " + "\n  ".join(problems))
+    labs = _labs(root, labs)
+    _check_course(root, labs)
     out = Path(out)
-    student = out / "student"
-    if student.exists():
-        shutil.rmtree(student)
-    _copy(student_files(root, include_hidden=False), student)
-    guide = root / "docs" / "students.md"
-    if guide.is_file():
-        shutil.copy2(guide, student / "README.md")
-    leaks = leaked_lines(student)
-    if leaks:
-        raise RuntimeError(
-            "solution lines would leak into the student bundle:\n  " + "\n  ".join(f"{f}: {s}" for f, s in leaks[:10])
-        )
-    _zip(student, out / "student.zip")
-
-    staging = out / "autograder-source"
-    if staging.exists():
-        shutil.rmtree(staging)
-    _copy(student_files(root, include_hidden=True), staging)
-    zpath = out / "autograder.zip"
-    with zipfile.ZipFile(zpath, "w", zipfile.ZIP_DEFLATED) as z:
-        for name, text in (("setup.sh", SETUP_SH), ("run_autograder", RUN_AUTOGRADER)):
-            info = zipfile.ZipInfo(name)
-            info.external_attr = (0o755 | stat.S_IFREG) << 16
-            z.writestr(info, text)
-        for p in sorted(staging.rglob("*")):
-            if p.is_file():
-                z.write(p, str(p.relative_to(staging)))
-    shutil.rmtree(staging)
-    return {"student": student, "student_zip": out / "student.zip", "autograder_zip": zpath}
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=".release-", dir=out))
+    try:
+        student = tmp / "student"
+        _copy(student_files(root, labs), student)
+        guide = root / "docs" / "students.md"
+        if guide.is_file():
+            shutil.copy2(guide, student / "README.md")
+        leaks = leaked_lines(student)
+        if leaks:
+            f, line, task = leaks[0]
+            raise ReleaseError(
+                f"{len(leaks)} solution line(s) would reach students, e.g. {f}: {line!r} (from {task}); "
+                f"move that code into a solution block's stored reference or the library"
+            )
+        with zipfile.ZipFile(tmp / "student.zip", "w") as z:
+            _zip_tree(z, student, "student/")
+        made = {"student": out / "student", "student_zip": out / "student.zip"}
+        for lab in labs:
+            staging = tmp / f"source-{lab}"
+            _copy(autograder_files(root, lab), staging)
+            (staging / "README.md").write_text(_AUTOGRADER_README.format(lab=lab))
+            name = f"autograder-{lab}.zip"
+            with zipfile.ZipFile(tmp / name, "w") as z:
+                _script(z, "setup.sh", SETUP_SH.replace("@LAB@", lab))
+                _script(z, "run_autograder", RUN_AUTOGRADER.replace("@LAB@", lab))
+                _zip_tree(z, staging)
+            shutil.rmtree(staging)
+            made[f"autograder_{lab}"] = out / name
+        # Everything is ready: move it into place (replacing earlier outputs of the same names).
+        for path in made.values():
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            elif path.exists() or path.is_symlink():
+                path.unlink()
+            (tmp / path.name).rename(path)
+        for path in made.values():
+            log(f"  {path}")
+        return made
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)

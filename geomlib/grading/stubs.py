@@ -24,7 +24,7 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 
-__all__ = ["make_stub", "build", "check", "solution_lines", "StubError"]
+__all__ = ["make_stub", "build", "check", "solution_lines", "solution_blocks", "StubError"]
 
 _BEGIN = re.compile(r"^(?P<indent>\s*)# BEGIN SOLUTION(?::\s*(?P<task>.*?))?\s*$")
 _END = re.compile(r"^\s*# END SOLUTION\s*$")
@@ -108,6 +108,17 @@ def solution_lines(text: str, name: str = "<solution>") -> list[str]:
     blocks, _ = _scan(text, name)
     lines = text.splitlines()
     return [lines[k - 1].strip() for b in blocks for k in range(b.start + 1, b.end) if lines[k - 1].strip()]
+
+
+def solution_blocks(text: str, name: str = "<solution>") -> list[tuple[str, list[str]]]:
+    """``(task, stripped lines)`` of every solution block, in file order (the task as its BEGIN marker names it)."""
+    blocks, _ = _scan(text, name)
+    lines = text.splitlines()
+    out = []
+    for b in blocks:
+        body = [lines[k - 1].strip() for k in range(b.start + 1, b.end) if lines[k - 1].strip()]
+        out.append((b.task or f"line {b.start}", body))
+    return out
 
 
 def _pairs(labs: list[str] | None):

@@ -1,9 +1,13 @@
-"""`geomlib release`: the student bundle leaks nothing and grades its stubs to zero; the autograder zip works."""
+"""`geomlib release` on the sample course: the bundle leaks nothing, the per-lab zip grades, failures are clean.
+
+The real course is released and graded end to end in ``test_release_course.py``.
+"""
 
 from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -14,7 +18,7 @@ import pytest
 
 from geomlib.grading.results import validate_results
 
-from .course import run_geomlib, sandbox_python
+from .course import run_geomlib
 
 
 @pytest.fixture(scope="module")
@@ -39,6 +43,7 @@ def test_student_bundle_has_no_solutions_and_no_hidden_material(release, sample_
     for p in student.rglob("*"):
         if p.is_file() and p.suffix in (".py", ".md", ".ipynb", ".txt", ".toml"):
             assert secret not in p.read_text(), p
+    assert sorted(p.name for p in release.iterdir()) == ["autograder-sample.zip", "student", "student.zip"]
     with zipfile.ZipFile(release / "student.zip") as z:
         assert not any("solutions/" in n or "hidden" in n for n in z.namelist())
 
@@ -68,7 +73,7 @@ def test_student_bundle_grades_its_stubs_to_zero_without_errors(release):
 def _autograder(release: Path, submission_labs: Path | None) -> dict:
     root = Path(tempfile.mkdtemp(prefix="geomlib-autograder-"))
     root.chmod(0o755)
-    with zipfile.ZipFile(release / "autograder.zip") as z:
+    with zipfile.ZipFile(release / "autograder-sample.zip") as z:
         z.extractall(root / "source")
         names = z.namelist()
     assert "setup.sh" in names and "run_autograder" in names
@@ -76,20 +81,20 @@ def _autograder(release: Path, submission_labs: Path | None) -> dict:
     assert not any(n.startswith("solutions/") for n in names)
     (root / "submission").mkdir()
     if submission_labs is not None:
-        import shutil
-
         shutil.copytree(submission_labs, root / "submission" / "labs" / submission_labs.name)
     hidden = root / "source" / "tests" / "reference" / "sample" / "hidden"
     hidden.chmod(0o700)  # as setup.sh does
     run = root / "source" / "run_autograder"
     run.chmod(0o755)
     env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    env.update(GEOMLIB_AUTOGRADER_ROOT=str(root), GEOMLIB_PYTHON=sys.executable, PYTHONPATH=str(root / "source"))
-    python = sandbox_python("nobody")
-    if python is None:  # not root, or no Python `nobody` can read: grade without the user drop
-        env["GEOMLIB_SANDBOX_USER"] = ""
-    elif python[1]:  # the system's Python with this environment's packages (as on Gradescope)
-        env.update(GEOMLIB_PYTHON=python[0], PYTHONPATH=os.pathsep.join([env["PYTHONPATH"], python[1]["PYTHONPATH"]]))
+    # The sandbox user's drop is exercised on the real course (test_release_course.py): this
+    # interpreter may live where `nobody` cannot read it.
+    env.update(
+        GEOMLIB_AUTOGRADER_ROOT=str(root),
+        GEOMLIB_PYTHON=sys.executable,
+        PYTHONPATH=str(root / "source"),
+        GEOMLIB_SANDBOX_USER="",
+    )
     p = subprocess.run(["bash", str(run)], env=env, capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stdout + p.stderr
     return json.loads((root / "results" / "results.json").read_text())
@@ -102,7 +107,86 @@ def test_run_autograder_grades_a_correct_submission_with_hidden_tests(release, s
     assert any(t["visibility"] == "hidden" for t in r["tests"])
 
 
-def test_run_autograder_on_an_empty_submission_scores_zero(release):
+def test_run_autograder_on_an_empty_submission_says_what_to_upload(release):
     r = _autograder(release, None)
     validate_results(r)
-    assert r["score"] == 0 and r["tests"]
+    assert r["score"] == 0 and "no folder sample/ or labs/sample/" in r["output"]
+
+
+# ------------------------------------------------------------------------------ failures, leaks
+
+
+def _course_copy(sample_course) -> Path:
+    base = Path(tempfile.mkdtemp(prefix="geomlib-sample-copy-"))
+    root = base / "course"
+    shutil.copytree(sample_course, root, symlinks=True)
+    return root
+
+
+def _plant(root: Path, lines: list[str]) -> None:
+    """Add ``lines`` to a public test helper that ships to students."""
+    helper = root / "tests" / "graded" / "sample" / "cases.py"
+    helper.write_text(helper.read_text() + "\n\ndef _planted(V, E, tol=None):\n" + "".join(f"    {x}\n" for x in lines))
+
+
+def test_a_planted_leak_stops_the_release_with_one_line_and_leaves_nothing(sample_course):
+    root = _course_copy(sample_course)
+    _plant(root, ["M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])", "return M"])
+    out = root.parent / "dist"
+    out.mkdir()
+    (out / "keep.txt").write_text("an earlier file")
+    p = run_geomlib(root, "release", str(out), check=False)
+    assert p.returncode == 1, p.stdout + p.stderr
+    err = p.stderr.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in p.stderr, p.stderr
+    assert err[0].startswith("geomlib release: error:") and "tests/graded/sample/cases.py" in err[0]
+    assert "M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])" in err[0] and "Task 2 (midpoints)" in err[0]
+    assert sorted(p.name for p in out.iterdir()) == ["keep.txt"]  # nothing half-written, nothing removed
+
+
+def test_generic_lines_of_a_solution_block_are_not_leaks(sample_course):
+    # Lines that the library ships anyway (`return False`, `if tol is None:`) give nothing away,
+    # even inside a solution block: a helper may use them.
+    root = _course_copy(sample_course)
+    ops = root / "solutions" / "sample" / "ops.py"
+    text = ops.read_text().replace(
+        "    c = V.mean(axis=0)\n",
+        "    if tol is None:\n        pass\n    if False:\n        return False\n    c = V.mean(axis=0)\n",
+    )
+    ops.write_text(text)
+    _plant(root, ["if tol is None:", "    return False"])
+    from geomlib.grading import release as rel
+
+    secrets = rel.secret_lines(root)
+    task1 = next(v for k, v in secrets.items() if "Task 1" in k)
+    assert "c = V.mean(axis=0)" in task1 and "if tol is None:" not in task1 and "return False" not in task1
+    out = root.parent / "dist"
+    p = run_geomlib(root, "release", str(out), check=False)
+    assert p.returncode == 0, p.stdout + p.stderr
+
+
+def test_an_unknown_lab_or_stale_stubs_give_one_clear_line(sample_course):
+    root = _course_copy(sample_course)
+    p = run_geomlib(root, "release", str(root.parent / "dist"), "--lab", "nope", check=False)
+    assert p.returncode == 1 and p.stderr.strip() == "geomlib release: error: unknown lab(s) nope; known: sample"
+    stub = root / "labs" / "sample" / "ops.py"
+    stub.write_text(stub.read_text() + "\n# edited by hand\n")
+    p = run_geomlib(root, "release", str(root.parent / "dist"), check=False)
+    assert p.returncode == 1 and "labs/ is stale" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    assert not (root.parent / "dist").exists() or not any((root.parent / "dist").iterdir())
+
+
+def test_run_autograder_copies_the_submission_without_following_links(release, sample_course, tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("TOP SECRET")
+    lab = tmp_path / "sub" / "sample"
+    shutil.copytree(sample_course / "solutions" / "sample", lab)
+    (lab / "notes.txt").symlink_to(secret)
+    (lab / "outside").symlink_to(tmp_path)
+    from geomlib.grading.submission import copy_lab, find_lab
+
+    assert find_lab(tmp_path / "sub", "sample") == lab
+    skipped = copy_lab(lab, tmp_path / "copy")
+    assert sorted(skipped) == ["notes.txt (symbolic link)", "outside (symbolic link)"]
+    assert not (tmp_path / "copy" / "notes.txt").exists() and not (tmp_path / "copy" / "outside").exists()
+    assert (tmp_path / "copy" / "ops.py").read_text() == (lab / "ops.py").read_text()

@@ -86,6 +86,19 @@ def seam_mean_inputs():
     return {"values": values, "group": rank[inv.ravel()]}
 
 
+def linear_offsets():
+    """s = 1/4 + u/2 + v/4 on a uv grid: linear inside every triangle, so its baked map is linear too."""
+    V, F, UV = datasets.uv_grid(8)
+    return {"V": V, "F": F, "UV": UV, "s": 0.25 + 0.5 * UV[:, 0] + 0.25 * UV[:, 1], "size": 32, "bits": 16}
+
+
+# What a test needs from an earlier task (here an offset map, Task 4's output) is stored by
+# `geomlib refs build` from the solution and read back with `stored_input`, never computed here.
+STORED = [
+    Case(id="map-linear-32", function="bake_offset_map", inputs=linear_offsets, outputs=("image", "bias", "scale"),
+         check=map_check(), part="stored input", points=0),
+]  # fmt: skip
+
 CASES = [
     # ---- Task 1: offsets
     Case(

@@ -29,7 +29,7 @@ CASES = [
         outputs=("delta",),
         check=checks.Allclose(atol=tol.EXACT),
         part="offsets",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -40,7 +40,20 @@ CASES = [
         outputs=("delta",),
         check=checks.Allclose(atol=tol.GEOMETRY),
         part="offsets",
-        points=1,
+        points=7,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-normal-offsets-random",
+        function="normal_offsets",
+        inputs=lambda: {
+            "delta": np.random.default_rng(21).normal(size=(500, 3)),
+            "N": np.random.default_rng(22).normal(size=(500, 3)) * 0.5,
+        },
+        outputs=("s",),
+        check=checks.Allclose(atol=tol.EXACT),
+        part="projection on normals",
+        points=3,
         visibility="hidden",
     ),
     Case(
@@ -51,7 +64,7 @@ CASES = [
         outputs=("V",),
         check=checks.Allclose(atol=tol.GEOMETRY),
         part="direct denoising",
-        points=1,
+        points=14,
         visibility="hidden",
     ),
     Case(
@@ -62,7 +75,7 @@ CASES = [
         outputs=("image", "bias", "scale"),
         check=map_check(),
         part="baking the map",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +86,7 @@ CASES = [
         outputs=("image", "bias", "scale"),
         check=map_check(),
         part="baking the map",
-        points=1,
+        points=4,
         visibility="hidden",
     ),
     Case(
@@ -84,7 +97,7 @@ CASES = [
         outputs=("V",),
         check=checks.Allclose(atol=tol.EXACT),
         part="denoising through the map",
-        points=1,
+        points=11,
         visibility="hidden",
     ),
     Case(
@@ -94,7 +107,7 @@ CASES = [
         outputs=("Vw", "Fw", "group"),
         check=weld_check(),
         part="seam fix",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -104,7 +117,7 @@ CASES = [
         outputs=("Vw", "Fw", "group"),
         check=weld_check(),
         part="seam fix",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
 ]

@@ -14,6 +14,7 @@ import numpy as np
 from geomlib import datasets, topology
 from geomlib.geometry import mean_edge_length, vertex_normals
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import Mismatch
 from geomlib.textures import rasterize_uv
@@ -214,11 +215,10 @@ def test_bake_a_linear_function_by_hand(lab):
             name="(bias, scale)",
             hint="bias = min s, scale = max s - min s",
         )
-        levels = 2**bits - 1
         expect_close(
             label,
             image,
-            np.round(h * levels),
+            np.round(h * np.iinfo(dtype).max),  # worked out above: h at the texel centres, in integer levels
             atol=1.0,
             name="image",
             hint="row 0 of the image is the TOP of UV space (v near 1)",
@@ -304,14 +304,15 @@ def test_integer_maps_are_decoded(lab):
 @graded(points=1, part="denoising through the map")
 def test_linear_map_is_read_exactly_inside(lab):
     """a map that is linear in (u, v) is read exactly (up to its quantisation) away from the border"""
-    size = 32
-    c = (np.arange(size) + 0.5) / size
-    image = np.round((0.25 + 0.5 * c[None, :] + 0.25 * c[::-1, None]) * 65535).astype(np.uint16)  # h = 1/4 + u/2 + v/4
+    # The map of s = 1/4 + u/2 + v/4 (uint16, 32 x 32), baked by the solution's bake_offset_map and
+    # stored by `geomlib refs build` (see STORED in cases.py): reading it back must give s again.
+    m = stored_input("denoise", "map-linear-32")
+    image, bias, scale = m["image"], float(m["bias"]), float(m["scale"])
     V, F, UV = datasets.uv_grid(8)
     UV = 0.05 + 0.9 * UV  # stay inside the outermost texel centres
-    X = lab.denoise_with_map(V, F, UV, np.tile(UP, (len(V), 1)), image, -0.1, 0.4, 1.0, weld=False)
-    expected = -(-0.1 + 0.4 * (0.25 + 0.5 * UV[:, 0] + 0.25 * UV[:, 1]))
-    expect_close("denoise_with_map on a linear map", np.asarray(X)[:, 2], expected, atol=0.4 / 65535, name="z")
+    X = lab.denoise_with_map(V, F, UV, np.tile(UP, (len(V), 1)), image, bias, scale, 1.0, weld=False)
+    expected = -(0.25 + 0.5 * UV[:, 0] + 0.25 * UV[:, 1])
+    expect_close("denoise_with_map on a linear map", np.asarray(X)[:, 2], expected, atol=scale / 65535, name="z")
 
 
 @graded(points=1, part="denoising through the map")

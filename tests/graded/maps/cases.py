@@ -81,8 +81,8 @@ def random_map(s: int, seed: int, channels: int | None = None) -> np.ndarray:
 
 
 def unit_vectors(shape, seed: int) -> np.ndarray:
-    n = np.random.default_rng(seed).normal(size=(*shape, 3))
-    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+    g = np.random.default_rng(seed).normal(size=(*shape, 3))
+    return g / np.linalg.norm(g, axis=-1, keepdims=True)
 
 
 def affine_grid(n: int = 4):

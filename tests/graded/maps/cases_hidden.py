@@ -39,7 +39,7 @@ CASES = [
         outputs=TANGENTS,
         check=checks.Allclose(atol=1e-10),
         part="tangent frames",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -52,7 +52,7 @@ CASES = [
         outputs=TANGENTS,
         check=checks.Allclose(atol=1e-10),
         part="tangent frames",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -62,7 +62,7 @@ CASES = [
         outputs=("img",),
         check=MapClose("img", atol=1.0, display="codes"),
         part="encode/decode",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +73,7 @@ CASES = [
         outputs=("n",),
         check=MapClose("n", atol=1e-12, display="normals"),
         part="height to normals",
-        points=1,
+        points=11,
         visibility="hidden",
     ),
     Case(
@@ -83,7 +83,7 @@ CASES = [
         outputs=("image",),
         check=MapClose("image", atol=1e-4),
         part="shading",
-        points=1,
+        points=15,
         visibility="hidden",
     ),
     Case(
@@ -94,7 +94,7 @@ CASES = [
         outputs=("V",),
         check=checks.Allclose(atol=1e-10),
         part="displacement",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -105,7 +105,7 @@ CASES = [
         outputs=("normal_map",),
         check=MapClose("normal_map", atol=1e-5, display="normals"),
         part="baking",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
 ]

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.grading import Case, checks
+from geomlib.grading.cases import stored_input
 
 from .support import (
     CAMERA,
@@ -37,18 +38,58 @@ def _scene(**extra):
     return make
 
 
-def _map_inputs(M, size, seed, n=400, frustum=False):
-    """A depth map of the small scene through M, and random surface points with their map coordinates."""
+# ------------------------------------------------------------------------ stored inputs
+# What a test needs from an earlier task (a depth map, light-space coordinates, receiver-plane
+# gradients, cube-map matrices) is never computed here: `geomlib refs build` runs the solution
+# once on the entries of STORED and the helpers read its outputs back with `stored_input`.
+
+
+def _points(seed, n=400):
+    V, F = small_scene()
+    return surface_points(V, F, n, seed)
+
+
+def stored(id: str) -> dict:
+    return stored_input("shadows", id)
+
+
+def depth_entry(id, M, size, cull="none", visibility="visible"):
+    """A depth map of the small scene through M (Task 2's output), stored for later tasks."""
+    return Case(id=id, function="depth_map", inputs=_scene(M=M, size=size), params={"cull": cull}, outputs=("D",),
+                check=MapClose("D", atol=1e-9), part="stored input", points=0, visibility=visibility)  # fmt: skip
+
+
+def uvz_entry(id, M, seed, n=400, visibility="visible"):
+    """Light-space coordinates of random surface points (Task 3's light_uvz), stored for later tasks."""
+    return Case(id=id, function="light_uvz", inputs=lambda: {"P": _points(seed, n)[0], "M": M}, outputs=("uvz",),
+                check=NanClose("uvz", atol=1e-10), part="stored input", points=0, visibility=visibility)  # fmt: skip
+
+
+def gradient_entry(id, M, size, seed, n=400, visibility="visible"):
+    """Receiver-plane gradients of random surface points (Task 4), stored for the PCF cases."""
+
+    def inputs():
+        P, N = _points(seed, n)
+        return {"P": P, "N": N, "M": M, "size": size}
+
+    return Case(id=id, function="receiver_depth_gradient", inputs=inputs, outputs=("g",),
+                check=checks.Allclose(atol=1e-10), part="stored input", points=0, visibility=visibility)  # fmt: skip
+
+
+def map_entries(key, M, size, seed, visibility="visible"):
+    return [
+        depth_entry(f"depth-{key}", M, size, visibility=visibility),
+        uvz_entry(f"uvz-{key}", M, seed, visibility=visibility),
+    ]
+
+
+def _map_inputs(key, M, seed, n=400, frustum=False):
+    """A stored depth map of the small scene through M, random surface points and their stored map coordinates."""
 
     def make():
-        from geomlib.raster import rasterize
-
-        V, F = small_scene()
-        g = rasterize(V, F, M, size, size, depth_only=True)
-        D = np.where(g.mask, g.depth, 1.0)
-        P, N = surface_points(V, F, n, seed)
-        C = np.c_[P, np.ones(len(P))] @ M.T
-        uvz = (C[:, :3] / C[:, 3:] + 1) / 2
+        P, N = _points(seed, n)
+        D = stored(f"depth-{key}")["D"]
+        uvz = stored(f"uvz-{key}")["uvz"]
         if not frustum:
             keep = np.all((uvz >= 0) & (uvz <= 1), axis=1)
             P, N, uvz = P[keep], N[keep], uvz[keep]
@@ -65,24 +106,58 @@ def _pick(make, *names, **extra):
     return f
 
 
-def _grad(make, size):
-    """Receiver-plane gradients computed here, with numpy, for PCF cases (so PCF does not need Task 4)."""
+def _grad(make, key):
+    """Stored receiver-plane gradients of the map's points (so PCF does not need the student's Task 4)."""
 
     def f():
         d = make()
-        M = d["M"]
-        pi = np.c_[d["N"], -np.einsum("ij,ij->i", d["N"], d["P"])]
-        abcd = pi @ np.linalg.inv(M)
-        g = np.clip(-abcd[:, :2] / abcd[:, 2:3], -20, 20) / size
-        return {"D": d["D"], "uvz": d["uvz"], "gradient": g}
+        uvz_all = stored(f"uvz-{key}")["uvz"]
+        keep = np.all((uvz_all >= 0) & (uvz_all <= 1), axis=1)
+        return {"D": d["D"], "uvz": d["uvz"], "gradient": stored(f"gradient-{key}")["g"][keep]}
 
     return f
 
 
 M_ORTHO = ortho_light(LIGHT_DIR)
 M_SPOT = spot_light()
-MAP_ORTHO = _map_inputs(M_ORTHO, 64, seed=1)
-MAP_SPOT = _map_inputs(M_SPOT, 64, seed=2)
+M_PARTIAL = ortho_light(LIGHT_DIR, bounds=[[-1.5, -1.5, 0], [1.5, 1.5, 1.9]])  # covers part of the floor
+MAP_ORTHO = _map_inputs("ortho-64", M_ORTHO, seed=1)
+MAP_SPOT = _map_inputs("spot-64", M_SPOT, seed=2)
+CUBE_SIZE = 64
+
+
+def cube_entries(size, visibility="visible"):
+    """The six faces' depth maps of a point light at CUBE_POS (Tasks 8 and 2), stored for the cube-map case."""
+    prefix = "hidden-" if visibility == "hidden" else ""
+
+    def face_inputs(i):
+        def make():
+            V, F = small_scene()
+            return {"V": V, "F": F, "M": stored(f"{prefix}cube-matrices")["Ms"][i], "size": size}
+
+        return make
+
+    out = [
+        Case(id=f"{prefix}cube-matrices", function="cube_light_matrices",
+             inputs=lambda: {"position": CUBE_POS, "near": 0.2, "far": 12.0}, outputs=("Ms",),
+             check=checks.Allclose(atol=1e-10), part="stored input", points=0, visibility=visibility)
+    ]  # fmt: skip
+    out += [
+        Case(id=f"{prefix}cube-depth-{size}-{i}", function="depth_map", inputs=face_inputs(i), params={"cull": "front"},
+             outputs=("D",), check=MapClose("D", atol=1e-9), part="stored input", points=0, visibility=visibility)
+        for i in range(6)
+    ]  # fmt: skip
+    return out
+
+
+STORED = [
+    *map_entries("ortho-64", M_ORTHO, 64, seed=1),
+    *map_entries("spot-64", M_SPOT, 64, seed=2),
+    gradient_entry("gradient-spot-64", M_SPOT, 64, seed=2),
+    uvz_entry("uvz-partial-32", M_PARTIAL, seed=5),
+    depth_entry("depth-partial-64", M_PARTIAL, 64),
+    *cube_entries(CUBE_SIZE),
+]
 
 CASES = [
     # ---------------------------------------------------------------- Task 1: light matrix
@@ -150,7 +225,7 @@ CASES = [
     Case(
         id="uvz-ortho",
         function="light_uvz",
-        inputs=_pick(_map_inputs(M_ORTHO, 64, seed=3, frustum=True), "P", "M"),
+        inputs=lambda: {"P": _points(3)[0], "M": M_ORTHO},
         outputs=("uvz",),
         check=checks.Allclose(atol=1e-10),
         part="comparison",
@@ -260,11 +335,7 @@ CASES = [
     Case(
         id="outside-ortho",
         function="outside_frustum",
-        inputs=lambda: {
-            "uvz": _map_inputs(
-                ortho_light(LIGHT_DIR, bounds=[[-1.5, -1.5, 0], [1.5, 1.5, 1.9]]), 32, 5, frustum=True
-            )()["uvz"]
-        },
+        inputs=lambda: {"uvz": stored("uvz-partial-32")["uvz"]},
         outputs=("outside",),
         check=checks.Equal("outside"),
         part="frustum handling",
@@ -286,7 +357,7 @@ CASES = [
     Case(
         id="pcf5-spot-gradient",
         function="pcf_visibility",
-        inputs=lambda: {**_grad(MAP_SPOT, 64)(), "bias": 0.002},
+        inputs=lambda: {**_grad(MAP_SPOT, "spot-64")(), "bias": 0.002},
         params={"pcf": 5},
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
@@ -354,22 +425,8 @@ CASES = [
 ]
 
 
-def _cube_matrices(pos, near, far):
-    from geomlib.camera import look_at, perspective
-
-    dirs = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
-    ups = np.array([[0.0, -1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [0, -1, 0], [0, -1, 0]])
-    return [perspective(90.0, 1.0, near, far) @ look_at(pos, pos + d, u) for d, u in zip(dirs, ups)]
-
-
-def _point_inputs(size, seed, n=400, near=0.2, far=12.0):
-    """Six depth maps made here with geomlib's rasterizer (not with the lab's cube-map functions)."""
-    from geomlib.raster import rasterize
-
-    V, F = small_scene()
-    maps = []
-    for M in _cube_matrices(CUBE_POS, near, far):
-        g = rasterize(V, F, M, size, size, cull="front", depth_only=True)
-        maps.append(np.where(g.mask, g.depth, 1.0))
-    P, N = surface_points(V, F, n, seed)
-    return {"P": P, "N": N, "maps": np.stack(maps), "position": CUBE_POS, "near": near, "far": far}
+def _point_inputs(size, seed, n=400, near=0.2, far=12.0, prefix=""):
+    """Six stored depth maps of a point light (the solution's cube-map matrices and depth pass) and surface points."""
+    maps = np.stack([stored(f"{prefix}cube-depth-{size}-{i}")["D"] for i in range(6)])
+    P, N = _points(seed, n)
+    return {"P": P, "N": N, "maps": maps, "position": CUBE_POS, "near": near, "far": far}

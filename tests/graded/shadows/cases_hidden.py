@@ -6,14 +6,33 @@ import numpy as np
 
 from geomlib.grading import Case, checks
 
-from .cases import _grad, _map_inputs, _pick, _point_inputs, _scene
+from .cases import (
+    _grad,
+    _map_inputs,
+    _pick,
+    _point_inputs,
+    _scene,
+    cube_entries,
+    gradient_entry,
+    map_entries,
+    stored,
+    uvz_entry,
+)
 from .support import CAMERA, MapClose, SameRows, ortho_light, small_scene, spot_light
 
 DIR2 = np.array([-0.6, 0.2, -0.7])
 M2 = ortho_light(DIR2)
 S2 = spot_light(position=(3.0, 2.0, 4.0), target=(0.5, 0.0, 0.3), fov=55.0, near=1.0, far=10.0)
-MAP2 = _map_inputs(M2, 80, seed=11)
-MAP_S2 = _map_inputs(S2, 72, seed=12)
+H = "hidden"
+MAP2 = _map_inputs("hidden-m2-80", M2, seed=11)
+MAP_S2 = _map_inputs("hidden-s2-72", S2, seed=12)
+STORED = [
+    *map_entries("hidden-m2-80", M2, 80, seed=11, visibility=H),
+    *map_entries("hidden-s2-72", S2, 72, seed=12, visibility=H),
+    gradient_entry("gradient-hidden-m2-80", M2, 80, seed=11, visibility=H),
+    uvz_entry("uvz-hidden-s2-13", S2, seed=13, visibility=H),
+    *cube_entries(48, visibility=H),
+]
 
 CASES = [
     Case(
@@ -26,7 +45,7 @@ CASES = [
         outputs=("M",),
         check=checks.Allclose(atol=1e-10),
         part="light matrix",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -42,7 +61,7 @@ CASES = [
         outputs=("M",),
         check=checks.Allclose(atol=1e-10),
         part="light matrix",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
     Case(
@@ -53,7 +72,7 @@ CASES = [
         outputs=("D",),
         check=MapClose("D", atol=1e-9),
         part="depth pass",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -63,7 +82,7 @@ CASES = [
         outputs=("lit",),
         check=checks.Allclose(atol=1e-12),
         part="comparison",
-        points=1,
+        points=12,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +92,7 @@ CASES = [
         outputs=("g",),
         check=checks.Allclose(atol=1e-10),
         part="bias",
-        points=1,
+        points=11,
         visibility="hidden",
     ),
     Case(
@@ -84,39 +103,39 @@ CASES = [
         outputs=("F",),
         check=SameRows("F"),
         part="culling",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
         id="hidden-outside-spot",
         function="outside_frustum",
-        inputs=lambda: {"uvz": np.nan_to_num(_map_inputs(S2, 32, 13, frustum=True)()["uvz"], nan=2.0)},
+        inputs=lambda: {"uvz": np.nan_to_num(stored("uvz-hidden-s2-13")["uvz"], nan=2.0)},
         outputs=("outside",),
         check=checks.Equal("outside"),
         part="frustum handling",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
     Case(
         id="hidden-pcf3-gradient",
         function="pcf_visibility",
-        inputs=lambda: {**_grad(MAP2, 80)(), "bias": 0.001},
+        inputs=lambda: {**_grad(MAP2, "hidden-m2-80")(), "bias": 0.001},
         params={"pcf": 3},
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
         part="PCF",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
         id="hidden-point-light",
         function="point_shadow_visibility",
-        inputs=lambda: _point_inputs(48, seed=14),
+        inputs=lambda: _point_inputs(48, seed=14, prefix="hidden-"),
         params={"bias": 0.004, "slope_bias": 0.0},
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
         part="cube map",
-        points=1,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -131,7 +150,7 @@ CASES = [
         outputs=("image",),
         check=checks.ImageMatch(),
         part="all together",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
 ]

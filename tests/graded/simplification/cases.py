@@ -14,6 +14,7 @@ import numpy as np
 from geomlib import datasets, topology
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
+from geomlib.grading.cases import stored_input
 
 from .support import noisy_icosphere, random_quadrics, simplification_check
 
@@ -54,21 +55,20 @@ def edge_pairs(make, push: float = 0.0):
     return inputs
 
 
-def edge_quadrics(make):
-    """Summed quadrics ``Q_i + Q_j`` of every edge, from area-weighted plane quadrics computed here."""
+def quadrics_entry(id: str, make, visibility: str = "visible") -> Case:
+    """Area-weighted vertex quadrics (Task 1's output), stored by `geomlib refs build` for the placement cases."""
+    return Case(id=id, function="vertex_quadrics", inputs=lambda: {k: make()[k] for k in ("V", "F")},
+                params={"weighting": "area"}, outputs=("Q",), check=checks.Allclose(atol=tol.EXACT),
+                part="stored input", points=0, visibility=visibility)  # fmt: skip
+
+
+def edge_quadrics(make, id: str):
+    """Summed quadrics ``Q_i + Q_j`` of every edge, from the stored vertex quadrics ``id`` (see STORED)."""
 
     def inputs():
         d = make()
         V, F = d["V"], d["F"]
-        v0, v1, v2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-        c = np.cross(v1 - v0, v2 - v0)
-        area = 0.5 * np.linalg.norm(c, axis=1)
-        n = c / (2 * area[:, None])
-        p = np.c_[n, -np.einsum("ij,ij->i", n, v0)]
-        K = area[:, None, None] * p[:, :, None] * p[:, None, :]
-        Q = np.zeros((len(V), 4, 4))
-        for corner in range(3):
-            np.add.at(Q, F[:, corner], K)
+        Q = stored_input("simplification", id)["Q"]
         E = topology.unique_edges(F)
         return {"Q": Q[E[:, 0]] + Q[E[:, 1]], "v1": V[E[:, 0]], "v2": V[E[:, 1]]}
 
@@ -98,6 +98,10 @@ QUAD_HINT = "K_f = area * p pᵀ with p = (n, -n·v0) and n the unit normal; Q_v
 PLACE_HINT = "solve A x = -b with A = Q[:3, :3], b = Q[:3, 3]; the cost is xᵀ A x + 2 bᵀ x + c"
 LINK_HINT = "common neighbours must be exactly the vertices opposite the edge (count the virtual boundary vertex)"
 CONTRACT_HINT = "kill the faces that use both vertices, rename j to i in the others, V[i] = position, Q[i] += Q[j]"
+
+# What a case needs from an earlier task is stored by `geomlib refs build` from the solution and
+# read back with `stored_input`, never computed here.
+STORED = [quadrics_entry("quadrics-noisy-ico2", ico_noisy(2)), quadrics_entry("quadrics-sharp-box", sharp_box)]
 
 CASES = [
     # ---------------------------------------------------------------- Task 1: quadrics
@@ -148,7 +152,7 @@ CASES = [
     Case(
         id="placement-noisy-ico2-edges",
         function="optimal_contraction",
-        inputs=edge_quadrics(ico_noisy(2)),
+        inputs=edge_quadrics(ico_noisy(2), "quadrics-noisy-ico2"),
         outputs=("position", "cost"),
         check=checks.All(checks.Allclose("position", atol=tol.GEOMETRY), checks.Allclose("cost", atol=tol.EXACT)),
         part="placement",
@@ -158,7 +162,7 @@ CASES = [
     Case(
         id="placement-sharp-box-edges",
         function="optimal_contraction",
-        inputs=edge_quadrics(sharp_box),
+        inputs=edge_quadrics(sharp_box, "quadrics-sharp-box"),
         outputs=("position", "cost"),
         check=checks.All(checks.Allclose("position", atol=tol.GEOMETRY), checks.Allclose("cost", atol=tol.EXACT)),
         part="placement",

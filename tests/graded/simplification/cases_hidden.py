@@ -6,7 +6,7 @@ from geomlib import datasets
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
-from .cases import edge_pairs, edge_quadrics, ico_noisy, simplify
+from .cases import edge_pairs, edge_quadrics, ico_noisy, quadrics_entry, simplify
 from .support import random_quadrics, simplification_check
 
 
@@ -34,6 +34,8 @@ def ant_chain():
     return {**d, "Q": random_quadrics(len(d["V"]), seed=9), "pairs": pairs, "positions": d["V"][[0, 10, 100]] * 1.01}
 
 
+STORED = [quadrics_entry("quadrics-torus-fine", torus_fine, visibility="hidden")]
+
 CASES = [
     Case(
         id="hidden-face-quadrics-ant",
@@ -42,7 +44,7 @@ CASES = [
         outputs=("K",),
         check=checks.Allclose(atol=tol.EXACT),
         part="quadrics",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -53,17 +55,17 @@ CASES = [
         outputs=("Q",),
         check=checks.Allclose(atol=tol.EXACT),
         part="quadrics",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
         id="hidden-placement-torus-edges",
         function="optimal_contraction",
-        inputs=edge_quadrics(torus_fine),
+        inputs=edge_quadrics(torus_fine, "quadrics-torus-fine"),
         outputs=("position", "cost"),
         check=checks.All(checks.Allclose("position", atol=tol.GEOMETRY), checks.Allclose("cost", atol=tol.EXACT)),
         part="placement",
-        points=1,
+        points=12,
         visibility="hidden",
     ),
     Case(
@@ -73,7 +75,7 @@ CASES = [
         outputs=("link_ok", "flips"),
         check=checks.Equal(),
         part="contraction",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -85,7 +87,7 @@ CASES = [
             checks.Equal(("F", "removed")), checks.Allclose("V", atol=tol.EXACT), checks.Allclose("Q", atol=tol.EXACT)
         ),
         part="contraction",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -95,7 +97,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(ant, 180), 180, flips=False),  # thin legs: see validity_problem
         part="greedy loop",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -105,7 +107,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(rock, 100), 100),
         part="greedy loop",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -115,7 +117,7 @@ CASES = [
         outputs=("V", "F"),
         check=simplification_check(simplify(ico_noisy(3, 0.02, 11), 64), 64),
         part="greedy loop",
-        points=1,
+        points=5,
         visibility="hidden",
     ),
 ]

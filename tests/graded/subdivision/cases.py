@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from geomlib import datasets
 from geomlib.grading import Case, checks
+from geomlib.grading.cases import stored_input
 
-from .support import airplane, centroids, faces_check, matrix_check, quad_grid
+from .support import airplane, faces_check, matrix_check, quad_grid
 
 # --------------------------------------------------------------------------------------------
 # inputs (functions: built when the case runs, identical every time)
@@ -54,10 +55,18 @@ def cage():
     return {"V": V, "faces": faces}
 
 
-def with_face_points(make):
+def face_points_entry(name: str, make) -> Case:
+    """The face points of a mesh (Task 6's output), stored by `geomlib refs build` for the edge/vertex-point cases."""
+    return Case(id=f"face-points-{name}", function="cc_face_points", inputs=make, outputs=("FP",),
+                check=checks.Allclose(), part="stored input", points=0)  # fmt: skip
+
+
+def with_face_points(make, name: str):
+    """The mesh and its stored face points (the solution's, see STORED: these cases do not need Task 6)."""
+
     def inputs():
         d = make()
-        d["face_points"] = centroids(d["V"], d["faces"])
+        d["face_points"] = stored_input("subdivision", f"face-points-{name}")["FP"]
         return d
 
     return inputs
@@ -89,6 +98,15 @@ FACES_HINT = (
 BOUNDARY_HINT = "boundary edge -> midpoint; boundary vertex -> 3/4 itself + 1/8 each of its two boundary neighbours"
 LEVELS_HINT = "apply one step `levels` times, feeding each result into the next step"
 CC_HINT = "face point = centroid; edge point = (a + b + two face points) / 4; vertex point = (Q + 2R + (k - 3) P) / k"
+
+# What a case needs from an earlier task is stored by `geomlib refs build` from the solution and
+# read back with `stored_input`, never computed here.
+STORED = [
+    face_points_entry("open-grid", open_quads),
+    face_points_entry("quad-torus", bumpy_quad_torus),
+    face_points_entry("cube", bumpy_cube),
+    face_points_entry("cage", cage),
+]
 
 CASES = [
     # ---------------------------------------------------------------- Task 1: odd vertices
@@ -214,7 +232,7 @@ CASES = [
     Case(
         id="cc-edges-open-grid",
         function="cc_edge_points",
-        inputs=with_face_points(open_quads),
+        inputs=with_face_points(open_quads, "open-grid"),
         outputs=("EP",),
         check=checks.Allclose(),
         part="boundary rules",
@@ -224,7 +242,7 @@ CASES = [
     Case(
         id="cc-vertices-open-grid",
         function="cc_vertex_points",
-        inputs=with_face_points(open_quads),
+        inputs=with_face_points(open_quads, "open-grid"),
         outputs=("VP",),
         check=checks.Allclose(),
         part="boundary rules",
@@ -290,7 +308,7 @@ CASES = [
     Case(
         id="cc-edges-quad-torus",
         function="cc_edge_points",
-        inputs=with_face_points(bumpy_quad_torus),
+        inputs=with_face_points(bumpy_quad_torus, "quad-torus"),
         outputs=("EP",),
         check=checks.Allclose(),
         part="catmull-clark points",
@@ -300,7 +318,7 @@ CASES = [
     Case(
         id="cc-vertices-quad-torus",
         function="cc_vertex_points",
-        inputs=with_face_points(bumpy_quad_torus),
+        inputs=with_face_points(bumpy_quad_torus, "quad-torus"),
         outputs=("VP",),
         check=checks.Allclose(),
         part="catmull-clark points",
@@ -310,7 +328,7 @@ CASES = [
     Case(
         id="cc-vertices-cube",
         function="cc_vertex_points",
-        inputs=with_face_points(bumpy_cube),
+        inputs=with_face_points(bumpy_cube, "cube"),
         outputs=("VP",),
         check=checks.Allclose(),
         part="catmull-clark points",
@@ -342,7 +360,7 @@ CASES = [
     Case(
         id="cc-vertices-cage",
         function="cc_vertex_points",
-        inputs=with_face_points(cage),
+        inputs=with_face_points(cage, "cage"),
         outputs=("VP",),
         check=checks.Allclose(),
         part="non-quad input",

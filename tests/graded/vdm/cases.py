@@ -1,7 +1,10 @@
-"""Graded cases of the lab "vdm": inputs built from geomlib and libigl only (never from the solution).
+"""Graded cases of the lab "vdm": inputs built from geomlib, never by solution code in this file.
 
-Every task is graded on its own: a task's inputs never come from another task's output (uv
-coordinates come from the meshes' own grids or from ``igl.harmonic``; grids from closed-form warps).
+Every task is graded on its own: a task's inputs never come from the student's output of another
+task. Where a task needs an earlier task's result (the open box's square parameterization, a
+mesh's sharp edges and corners) it is the solution's, stored by ``geomlib refs build`` (``STORED``)
+and read back with ``stored_input``; other uv coordinates come from the meshes' own grids, grids
+from closed-form warps.
 
 Tolerances: parameterizations 1e-8 (one sparse solve); sampling, naive VDMs, importances and
 fields 1e-10 (arithmetic); the transport grid 1e-6 (a few hundred FFTs and Legendre transforms,
@@ -13,11 +16,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import igl
 import numpy as np
 
-from geomlib import datasets, topology
+from geomlib import datasets
 from geomlib.grading import Case, checks
+from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context, as_output_array, format_vec
 
 # ------------------------------------------------------------------------------------- checks
@@ -95,34 +98,16 @@ def open_box(n: int = 4, size=(1.0, 1.0, 0.5)) -> tuple[np.ndarray, np.ndarray]:
     return V[used] + s / 2, remap[F]
 
 
-def square_boundary(V: np.ndarray, loop: np.ndarray) -> np.ndarray:
-    """The loop on the unit square by arc length, corners at the 4 vertices of largest turn (for inputs only)."""
-    P = V[loop]
-    e_out = np.roll(P, -1, axis=0) - P
-    e_in = P - np.roll(P, 1, axis=0)
-    turn = np.einsum("ij,ij->i", e_in, e_out) / (np.linalg.norm(e_in, axis=1) * np.linalg.norm(e_out, axis=1))
-    corners = np.sort(np.argsort(turn, kind="stable")[:4])
-    seg = np.linalg.norm(e_out, axis=1)
-    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
-    uv = np.zeros((len(loop), 2))
-    for k in range(4):
-        a, b = corners[k], corners[(k + 1) % 4]
-        idx = np.arange(a, b if b > a else b + len(loop)) % len(loop)
-        s = np.concatenate([[0.0], np.cumsum(seg[idx])])
-        t = s[:-1] / s[-1]
-        uv[idx] = square[k] + t[:, None] * (square[(k + 1) % 4] - square[k])
-    return uv
-
-
-def harmonic_uv(V: np.ndarray, F: np.ndarray) -> np.ndarray:
-    """A fixed-boundary harmonic parameterization by libigl (for inputs only)."""
-    loop = topology.boundary_loops(F)[0]
-    return igl.harmonic(V, F, loop, square_boundary(V, loop), 1)
+def uv_entry(n: int) -> Case:
+    """The open box's harmonic square parameterization (Task 1's output), stored for the later tasks' inputs."""
+    return Case(id=f"uv-box-{n}", function="parameterize_square", inputs=lambda: dict(zip(("V", "F"), open_box(n), strict=True)),
+                params={"method": "harmonic"}, outputs=("UV",), check=checks.Allclose(atol=1e-8), part="stored input",
+                points=0)  # fmt: skip
 
 
 def box_with_uv(n: int = 8) -> dict:
     V, F = open_box(n)
-    return {"V": V, "F": F, "UV": harmonic_uv(V, F)}
+    return {"V": V, "F": F, "UV": stored_input("vdm", f"uv-box-{n}")["UV"]}
 
 
 def rock_with_uv(n: int = 16, seed: int = 0) -> dict:
@@ -161,7 +146,7 @@ def warped(res: int, amount: float = 0.04) -> np.ndarray:
 
 
 def pixel_centres(n: int) -> tuple[np.ndarray, np.ndarray]:
-    c = (np.arange(n) + 0.5) / n
+    c = np.arange(0.5, n) / n  # pixel centres
     v, u = np.meshgrid(c, c, indexing="ij")
     return u, v
 
@@ -184,6 +169,8 @@ def random_splats(k: int, seed: int) -> dict:
 def sharp_inputs(mesh: str) -> dict:
     if mesh == "box":
         d = box_with_uv(8)
+    elif mesh == "box4":
+        d = box_with_uv(4)
     elif mesh == "rock":
         d = rock_with_uv(16)
     else:
@@ -191,19 +178,17 @@ def sharp_inputs(mesh: str) -> dict:
     return d
 
 
-def align_inputs(mesh: str | dict, grid: np.ndarray, angle: float = 30.0) -> dict:
-    """Mesh, uv, grid and the mesh's sharp edges and corners (computed here with geomlib's dihedral angles)."""
-    d = sharp_inputs(mesh) if isinstance(mesh, str) else mesh
-    E, theta = _dihedral(d["V"], d["F"])
-    edges = E[theta > np.deg2rad(angle)]
-    corners = np.flatnonzero(np.bincount(edges.ravel(), minlength=len(d["V"])) > 2)
-    return {**d, "grid_uv": grid, "edges": edges, "corners": corners}
+def features_entry(mesh: str, visibility: str = "visible") -> Case:
+    """A mesh's sharp edges and corners (Task 7a's output), stored by `geomlib refs build` for the alignment cases."""
+    return Case(id=f"features-{mesh}", function="sharp_features", inputs=lambda: {k: v for k, v in sharp_inputs(mesh).items() if k != "UV"},
+                params={"angle": 30.0}, outputs=("edges", "corners"), check=checks.Equal(), part="stored input",
+                points=0, visibility=visibility)  # fmt: skip
 
 
-def _dihedral(V, F):
-    from geomlib.geometry import dihedral_angles
-
-    return dihedral_angles(V, F)
+def align_inputs(mesh: str, grid: np.ndarray) -> dict:
+    """Mesh, uv, grid and the mesh's sharp edges and corners (the solution's, stored: see STORED)."""
+    features = stored_input("vdm", f"features-{mesh}")
+    return {**sharp_inputs(mesh), "grid_uv": grid, "edges": features["edges"], "corners": features["corners"]}
 
 
 def half_step_inputs(n: int = 16) -> dict:
@@ -219,6 +204,10 @@ def half_step_inputs(n: int = 16) -> dict:
 # ------------------------------------------------------------------------------------- cases
 
 UV_HINT = "map each side of the boundary by arc length, then solve L u = 0 for the interior with the boundary fixed"
+
+# What a case needs from an earlier task (a parameterization, sharp features) is stored by
+# `geomlib refs build` from the solution and read back with `stored_input`, never computed here.
+STORED = [uv_entry(4), uv_entry(6), uv_entry(8), features_entry("box"), features_entry("rock")]
 
 CASES = [
     # ----------------------------------------------------------------------- Task 1

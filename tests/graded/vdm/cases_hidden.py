@@ -9,7 +9,7 @@ from .cases import (
     TexelClose,
     align_inputs,
     blob_field,
-    box_with_uv,
+    features_entry,
     height_field_with_uv,
     line_field,
     open_box,
@@ -25,6 +25,8 @@ def _mesh(d: dict) -> dict:
     return {"V": d["V"], "F": d["F"]}
 
 
+STORED = [features_entry("box4", visibility="hidden")]
+
 CASES = [
     Case(
         id="hidden-param-harmonic-rock",
@@ -33,7 +35,7 @@ CASES = [
         outputs=("UV",),
         check=checks.Allclose(atol=1e-8),
         part="parameterization",
-        points=2,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -44,7 +46,7 @@ CASES = [
         outputs=("UV",),
         check=checks.Allclose(atol=1e-8),
         part="parameterization",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -54,7 +56,7 @@ CASES = [
         outputs=("P",),
         check=checks.Allclose(atol=1e-10),
         part="sampling",
-        points=2,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -65,7 +67,7 @@ CASES = [
         outputs=("D",),
         check=TexelClose("D", atol=1e-10),
         part="naive VDM",
-        points=2,
+        points=9,
         visibility="hidden",
     ),
     Case(
@@ -75,7 +77,7 @@ CASES = [
         outputs=("I",),
         check=checks.Allclose(atol=1e-12),
         part="importance",
-        points=1,
+        points=6,
         visibility="hidden",
     ),
     Case(
@@ -86,7 +88,7 @@ CASES = [
         outputs=("field",),
         check=TexelClose("field", atol=1e-12),
         part="field",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -97,7 +99,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-6),
         part="transport grid",
-        points=2,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -108,7 +110,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-6),
         part="transport grid",
-        points=1,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -119,7 +121,7 @@ CASES = [
         outputs=("edges", "corners"),
         check=checks.All(SameRows("edges"), SameRows("corners")),
         part="alignment",
-        points=1,
+        points=8,
         visibility="hidden",
     ),
     Case(
@@ -129,7 +131,7 @@ CASES = [
         outputs=("grid_uv",),
         check=TexelClose("grid_uv", atol=1e-9),
         part="alignment",
-        points=2,
+        points=7,
         visibility="hidden",
     ),
     Case(
@@ -139,18 +141,18 @@ CASES = [
         outputs=("diagonals",),
         check=checks.Equal(),
         part="diagonals",
-        points=2,
+        points=5,
         visibility="hidden",
     ),
     Case(
         id="hidden-diagonals-box-uniform-9",
         function="choose_diagonals",
-        inputs=lambda: {k: v for k, v in align_inputs(box_with_uv(4), uniform(9)).items() if k != "corners"},
+        inputs=lambda: {k: v for k, v in align_inputs("box4", uniform(9)).items() if k != "corners"},
         params={"default": False},
         outputs=("diagonals",),
         check=checks.Equal(),
         part="diagonals",
-        points=1,
+        points=4,
         visibility="hidden",
     ),
 ]

@@ -315,7 +315,7 @@ def test_field_takes_the_max_and_rejects_bad_input(lab):
 def test_half_step_at_the_optimum(lab):
     """when the delivered density already equals the target, nothing moves and the residual is 0"""
     n = 8
-    c = (np.arange(n) + 0.5) / n
+    c = np.arange(0.5, n) / n  # pixel centres
     v, u = np.meshgrid(c, c, indexing="ij")
     phi = 0.5 * (u**2 + v**2)  # the identity potential is its own Legendre transform on the grid
     out = lab.bfm_half_step(phi, np.ones((n, n)), np.ones((n, n)), 1.0)

@@ -1,0 +1,135 @@
+"""`geomlib grade-all`: many submissions of one lab, Gradescope's export layout, a CSV, isolation."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading import batch
+from geomlib.grading.results import validate_results
+
+from .course import run_geomlib
+
+# The sandbox user's drop is exercised on the real course, with a Python `nobody` can read
+# (test_release_course.py); this interpreter may live under /root.
+NO_SANDBOX = {"GEOMLIB_SANDBOX_USER": ""}
+
+METADATA = """\
+submission_101:
+  :submitters:
+  - :name: Ada Lovelace
+    :sid: '1001'
+    :email: ada@example.edu
+  :created_at: 2026-11-20 10:00:00.000000000 -08:00
+  :score: 0.0
+submission_102:
+  :submitters:
+  - :name: Pair One
+    :sid: '1002'
+    :email: one@example.edu
+  - :name: Pair Two
+    :sid: '1003'
+    :email: two@example.edu
+submission_103:
+  :submitters:
+  - :name: Empty Upload
+    :sid: '1004'
+"""
+
+
+def _export(sample_course, tmp_path) -> Path:
+    exp = tmp_path / "export"
+    exp.mkdir()
+    (exp / "submission_metadata.yml").write_text(METADATA)
+    shutil.copytree(sample_course / "solutions" / "sample", exp / "submission_101" / "labs" / "sample")
+    shutil.copytree(sample_course / "labs" / "sample", exp / "submission_102" / "sample")
+    (exp / "submission_103").mkdir()
+    (exp / "submission_103" / "notes.txt").write_text("forgot the code")
+    return exp
+
+
+def test_metadata_parser_reads_every_submitter(tmp_path):
+    (tmp_path / "submission_metadata.yml").write_text(METADATA)
+    subs = {s.id: s for s in batch.discover(tmp_path)}
+    assert sorted(subs) == ["submission_101", "submission_102", "submission_103"]
+    assert subs["submission_102"].names == ["Pair One", "Pair Two"]
+    assert subs["submission_102"].sids == ["1002", "1003"] and subs["submission_101"].emails == ["ada@example.edu"]
+
+
+def test_grade_all_on_a_gradescope_export(sample_course, tmp_path):
+    exp = _export(sample_course, tmp_path)
+    out = tmp_path / "out"
+    p = run_geomlib(
+        sample_course, "grade-all", str(exp), "--lab", "sample", "--out", str(out), "--jobs", "2", env=NO_SANDBOX
+    )
+    assert "[3/3]" in p.stdout and "scores.csv" in p.stdout
+    rows = list(csv.DictReader((out / "scores.csv").open()))
+    by = {r["submission"]: r for r in rows}
+    full = float(by["(max)"]["score"])
+    assert full > 0 and float(by["submission_101"]["score"]) == full
+    assert by["submission_101"]["name"] == "Ada Lovelace" and by["submission_102"]["sid"] == "1002; 1003"
+    assert float(by["submission_102"]["score"]) == 0 and by["submission_102"]["status"] == "ok"
+    assert by["submission_103"]["status"] == "no lab"
+    parts = [c for c in rows[0] if c not in ("submission", "name", "sid", "email", "score", "max", "status")]
+    assert parts and sum(float(by["submission_101"][c]) for c in parts) == full
+    for sid in ("submission_101", "submission_102", "submission_103"):
+        validate_results(json.loads((out / sid / "results.json").read_text()))
+
+
+def test_a_crash_costs_only_its_own_submission(sample_course, tmp_path, monkeypatch):
+    exp = _export(sample_course, tmp_path)
+    real = batch._grade_one
+
+    def flaky(sub, lab, out, timeout):
+        if sub.id == "submission_102":
+            raise MemoryError("the grader ran out of memory")
+        return real(sub, lab, out, timeout)
+
+    monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
+    monkeypatch.setenv("GEOMLIB_SANDBOX_USER", "")
+    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
+    monkeypatch.setattr(batch, "_grade_one", flaky)
+    summary = batch.grade_all(exp, "sample", tmp_path / "out", jobs=2, log=lambda *a: None)
+    assert sorted(summary["failed"]) == ["submission_102", "submission_103"]
+    rows = {r["submission"]: r for r in csv.DictReader(summary["csv"].open())}
+    assert rows["submission_102"]["status"] == "error" and float(rows["submission_101"]["score"]) > 0
+
+
+def test_a_folder_per_student_and_a_timeout(sample_course, tmp_path):
+    subs = tmp_path / "subs"
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "alice" / "sample")
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "bob" / "labs" / "sample")
+    out = tmp_path / "out"
+    p = run_geomlib(
+        sample_course,
+        "grade-all",
+        str(subs),
+        "--lab",
+        "sample",
+        "--out",
+        str(out),
+        "--timeout",
+        "0.01",
+        check=False,
+        env=NO_SANDBOX,
+    )
+    rows = {r["submission"]: r for r in csv.DictReader((out / "scores.csv").open())}
+    assert rows["alice"]["status"].startswith("timed out") and rows["bob"]["status"].startswith("timed out")
+    assert p.returncode == 1  # nothing could be graded
+    validate_results(json.loads((out / "alice" / "results.json").read_text()))
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the sandbox user is used as root only")
+def test_a_sandbox_user_that_cannot_run_the_grader_stops_grade_all_with_one_line(sample_course, tmp_path):
+    subs = tmp_path / "subs"
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "alice" / "sample")
+    p = run_geomlib(sample_course, "grade-all", str(subs), "--lab", "sample", "--out", str(tmp_path / "out"),
+                    check=False, env={"GEOMLIB_SANDBOX_USER": "no-such-user-xyz"})  # fmt: skip
+    assert p.returncode == 1 and "Traceback" not in p.stderr
+    assert p.stderr.startswith("geomlib grade-all: error: the sandbox user 'no-such-user-xyz' cannot run")
+    assert not (tmp_path / "out" / "alice").exists()

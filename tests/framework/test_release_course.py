@@ -1,0 +1,341 @@
+"""The real course, released and graded the way Gradescope does it (issue 13, items 1-3 and 5).
+
+One lab (subdivision: the quickest to grade) is released with ``geomlib release``; its autograder
+zip is unzipped into a temporary ``GEOMLIB_AUTOGRADER_ROOT``; ``setup.sh`` installs it (the real
+``uv sync --frozen``, offline from the uv cache; apt is skipped when the packages are present);
+``run_autograder`` then grades four submissions — the solutions, the stubs, a hostile one and one
+that looks the public stored outputs up — as root with the drop to ``nobody``, as on Gradescope.
+Every results.json is validated against the Gradescope schema.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading.results import validate_results
+
+pytestmark = pytest.mark.slow
+
+ROOT = Path(__file__).resolve().parents[2]
+LAB = "subdivision"
+IS_ROOT = os.geteuid() == 0
+
+
+def _env(**extra) -> dict:
+    env = {k: v for k, v in os.environ.items() if k not in ("GEOMLIB_ROOT", "VIRTUAL_ENV", "UV_PROJECT_ENVIRONMENT")}
+    env.update(extra)
+    return env
+
+
+@pytest.fixture(scope="module")
+def base():
+    d = Path(tempfile.mkdtemp(prefix="geomlib-course-release-"))
+    d.chmod(0o755)  # the sandbox user must be able to reach the autograder root below it
+    yield d
+    # The installed environment holds thousands of files: remove it without making the suite wait.
+    subprocess.Popen(
+        ["rm", "-rf", str(d)], start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+
+
+@pytest.fixture(scope="module")
+def released(base) -> Path:
+    out = base / "dist"
+    p = subprocess.run(
+        [sys.executable, "-m", "geomlib.cli", "release", str(out), "--lab", LAB],
+        cwd=ROOT,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert p.returncode == 0, p.stdout + p.stderr
+    return out
+
+
+@pytest.fixture(scope="module")
+def autograder(base, released) -> Path:
+    if shutil.which("uv") is None:
+        pytest.skip("uv is not installed")
+    root = base / "autograder"
+    (root / "source").mkdir(parents=True)
+    root.chmod(0o755)
+    with zipfile.ZipFile(released / f"autograder-{LAB}.zip") as z:
+        z.extractall(root / "source")
+    env = _env(GEOMLIB_AUTOGRADER_ROOT=str(root), UV_OFFLINE="1")
+    if not IS_ROOT:
+        env["GEOMLIB_SANDBOX_USER"] = ""
+    p = subprocess.run(
+        ["bash", str(root / "source" / "setup.sh")], env=env, capture_output=True, text=True, timeout=600
+    )
+    assert p.returncode == 0, f"setup.sh failed:\n{p.stdout[-3000:]}\n{p.stderr[-3000:]}"
+    assert "ready to grade" in p.stdout
+    return root
+
+
+def _run(root: Path, fill, **extra_env) -> tuple[dict, str]:
+    """Put a submission in place with ``fill(submission_dir)``, run run_autograder, return (results, log)."""
+    for name in ("submission", "results"):
+        shutil.rmtree(root / name, ignore_errors=True)
+    (root / "submission").mkdir()
+    fill(root / "submission")
+    subprocess.run(["chmod", "-R", "a+rX", str(root / "submission")], check=True)
+    env = _env(GEOMLIB_AUTOGRADER_ROOT=str(root), **extra_env)
+    if not IS_ROOT:
+        env["GEOMLIB_SANDBOX_USER"] = ""
+    p = subprocess.run(
+        ["bash", str(root / "source" / "run_autograder")], env=env, capture_output=True, text=True, timeout=900
+    )
+    assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+    results = json.loads((root / "results" / "results.json").read_text())
+    validate_results(results)
+    return results, p.stdout
+
+
+@pytest.fixture(scope="module")
+def points():
+    from geomlib.grading.points import points_by_part
+
+    return points_by_part([LAB])[LAB]
+
+
+# ---------------------------------------------------------------------------------- the zip
+
+
+def test_autograder_zip_grades_only_its_lab(released):
+    with zipfile.ZipFile(released / f"autograder-{LAB}.zip") as z:
+        names = z.namelist()
+    assert {"setup.sh", "run_autograder", "README.md", "pyproject.toml", "uv.lock"} <= set(names)
+    labs = {n.split("/")[1] for n in names if n.startswith("labs/")}
+    graded = {n.split("/")[2] for n in names if n.startswith("tests/graded/") and n.count("/") > 2}
+    refs = {n.split("/")[2] for n in names if n.startswith("tests/reference/")}
+    assert labs == graded == refs == {LAB}
+    assert f"tests/graded/{LAB}/cases_hidden.py" in names
+    assert any(n.startswith(f"tests/reference/{LAB}/hidden/") for n in names)
+    assert not any(n.startswith(("solutions/", "notebooks/", "tests/framework", "tests/unit")) for n in names)
+
+
+def test_hidden_material_is_readable_by_root_only(autograder):
+    src = autograder / "source"
+    hidden = [src / f"tests/graded/{LAB}/cases_hidden.py", src / f"tests/graded/{LAB}/test_{LAB}_hidden.py"]
+    hidden += sorted((src / f"tests/reference/{LAB}/hidden").glob("*"))
+    for p in hidden:
+        assert p.stat().st_mode & 0o077 == 0, p
+    if IS_ROOT:
+        for p in hidden[:3]:
+            r = subprocess.run(["runuser", "-u", "nobody", "--", "cat", str(p)], capture_output=True)
+            assert r.returncode != 0 and not r.stdout, p
+
+
+# ---------------------------------------------------------------------------------- submissions
+
+
+def test_solutions_score_every_point(autograder, points):
+    r, _ = _run(autograder, lambda sub: shutil.copytree(ROOT / "solutions" / LAB, sub / "labs" / LAB))
+    total = sum(p + h for p, h in points.values())
+    assert r["score"] == total == sum(t["max_score"] for t in r["tests"])
+    assert all(t["status"] == "passed" for t in r["tests"]), [t["name"] for t in r["tests"] if t["status"] != "passed"]
+    assert any(t["visibility"] == "hidden" for t in r["tests"])
+
+
+def test_stubs_score_zero(autograder):
+    # Submitted as the bare lab folder (no labs/ around it): both layouts are accepted.
+    r, _ = _run(autograder, lambda sub: shutil.copytree(ROOT / "labs" / LAB, sub / LAB))
+    assert r["score"] == 0
+    pointed = [t for t in r["tests"] if t["max_score"] > 0]
+    assert pointed and all("not implemented yet" in t["output"] for t in pointed)
+
+
+HOSTILE = """
+
+import os as _os
+import pathlib as _pathlib
+
+_SRC = _pathlib.Path(_os.environ.get("GEOMLIB_ROOT", "/autograder/source"))
+
+
+def _attack():
+    got = []
+    for rel in ("tests/graded/{lab}/cases_hidden.py", "tests/reference/{lab}/hidden/manifest.json",
+                "tests/graded/{lab}/test_{lab}_hidden.py", "hidden_cases.py"):
+        for base in (_SRC, _pathlib.Path(__file__).parent):
+            try:
+                got.append("read " + str((base / rel).read_bytes()[:20]))
+            except OSError:
+                pass
+    for rel in ("pwned.txt", "geomlib/pwned.py", "tests/reference/{lab}/pwned.npz", "../results/results.json"):
+        try:
+            (_SRC / rel).write_text("pwned")
+            got.append("wrote " + rel)
+        except OSError:
+            pass
+    return got
+
+
+def loop_odd_matrix(V, F):
+    raise RuntimeError("attack: " + repr(_attack()))
+
+
+def loop_subdivide(V, F, levels=1, weights="loop"):
+    raise RuntimeError("attack: " + repr(_attack()))
+"""
+
+
+def test_hostile_submission_gains_nothing(autograder):
+    src = autograder / "source"
+
+    def fill(sub):
+        lab = sub / "labs" / LAB
+        shutil.copytree(ROOT / "labs" / LAB, lab)
+        with open(lab / "loop.py", "a") as f:
+            f.write(HOSTILE.replace("{lab}", LAB))
+        # Links into the course: copied as links (or followed) they would expose hidden material.
+        (lab / "hidden_cases.py").symlink_to(src / f"tests/graded/{LAB}/cases_hidden.py")
+        (lab / "course").symlink_to(src)
+
+    before = {p: p.stat().st_mtime for p in src.rglob("*") if p.is_file() and ".venv" not in p.parts}
+    r, log = _run(autograder, fill)
+    assert r["score"] == 0
+    assert "not copied: course (symbolic link)" in log and "not copied: hidden_cases.py (symbolic link)" in log
+    attacks = [t["output"] for t in r["tests"] if "attack:" in t["output"]]
+    assert attacks, "the hostile functions did not run"
+    if IS_ROOT:  # as nobody: nothing hidden read, nothing written
+        assert not any("read " in a or "wrote " in a for a in attacks), attacks
+    after = {p: p.stat().st_mtime for p in src.rglob("*") if p.is_file() and ".venv" not in p.parts}
+    assert after == before, "the submission changed the autograder's source"
+
+
+LOOKUP = """
+
+
+def _lookup(_name, _kwargs):
+    import json
+    import pathlib
+
+    import numpy as np
+
+    from geomlib.grading.cases import inputs_digest
+
+    here = pathlib.Path(__file__).parent / "_answers"
+    index = json.loads((here / "index.json").read_text())
+    key = _name + "-" + inputs_digest(dict(_kwargs), {{}})
+    if key not in index:
+        raise NotImplementedError("lookup: this input is not among the public stored outputs")
+    with np.load(here / (key + ".npz")) as z:
+        out = [z[name] for name in index[key]]
+    return out[0] if len(out) == 1 else tuple(out)
+"""
+
+
+def _lookup_submission(student: Path, sub: Path) -> None:
+    """The stubs, with every task function replaced by a look-up of the public stored outputs.
+
+    Built only from what students get (the student bundle's cases and references): for each public
+    case, the digest of its arguments maps to its stored outputs.
+    """
+    code = (
+        "import sys, json, shutil, pathlib\n"
+        "from geomlib.grading.cases import load_cases, inputs_digest, reference_path\n"
+        f"out = pathlib.Path(sys.argv[1]); out.mkdir(parents=True); index = {{}}\n"
+        f"for c in load_cases({LAB!r}, hidden=False):\n"
+        "    key = c.function + '-' + inputs_digest({**c.inputs(), **c.params}, {})\n"
+        f"    shutil.copy(reference_path({LAB!r}, c), out / (key + '.npz'))\n"
+        "    index[key] = list(c.outputs)\n"
+        "(out / 'index.json').write_text(json.dumps(index))\n"
+    )
+    lab = sub / "labs" / LAB
+    shutil.copytree(student / "labs" / LAB, lab)
+    env = _env(GEOMLIB_ROOT=str(student), PYTHONPATH=str(student))
+    subprocess.run([sys.executable, "-c", code, str(lab / "_answers")], env=env, check=True, timeout=300)
+    for f in lab.glob("*.py"):
+        names = [n.name for n in ast.parse(f.read_text()).body if isinstance(n, ast.FunctionDef)]
+        names = [n for n in names if not n.startswith("_")]
+        if not names or f.name == "__init__.py":
+            continue
+        extra = LOOKUP.format()
+        for n in names:
+            extra += f"\n\ndef {n}(*args, **kwargs):\n    if args:\n"
+            extra += '        raise NotImplementedError("lookup: positional arguments")\n'
+            extra += f"    return _lookup({n!r}, kwargs)\n"
+        f.write_text(f.read_text() + extra)
+
+
+def _public_reference_points() -> float:
+    """Points of the public reference cases (in a subprocess: this session may hold another course's `graded`)."""
+    code = (
+        f"from geomlib.grading.cases import load_cases; print(sum(c.points for c in load_cases({LAB!r}, hidden=False)))"
+    )
+    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True, check=True)
+    return float(p.stdout.strip())
+
+
+def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
+    r, _ = _run(autograder, lambda sub: _lookup_submission(released / "student", sub))
+    public_refs = _public_reference_points()
+    total = sum(p + h for p, h in points.values())
+    # The look-up really works: it earns every public reference case, and nothing else.
+    missed = [
+        t["name"] + ": " + t["output"][:200]
+        for t in r["tests"]
+        if t["status"] == "failed" and "lookup:" not in t["output"]
+    ]
+    assert r["score"] == public_refs, (r["score"], public_refs, missed)
+    assert r["score"] < total / 2
+    per_part: dict[str, float] = {}
+    for t in r["tests"]:
+        per_part[t["tags"][1]] = per_part.get(t["tags"][1], 0) + t["score"]
+    for part, got in per_part.items():
+        pub, hid = points[part]
+        assert got < (pub + hid) / 2 or pub + hid == 0, (part, got, pub, hid)
+    print(f"\nlookup submission: {r['score']:g} / {total:g}")
+
+
+def test_a_failure_of_the_grader_is_reported_as_the_graders(autograder):
+    r, _ = _run(
+        autograder,
+        lambda sub: shutil.copytree(ROOT / "solutions" / LAB, sub / LAB),
+        GEOMLIB_PYTHON=str(autograder / "no-such-python"),
+    )
+    assert r["score"] == 0 and r["tests"] == []
+    assert "autograder itself failed" in r["output"] and "not a problem with your submission" in r["output"]
+
+
+def test_a_submission_without_the_lab_is_told_what_to_upload(autograder):
+    r, _ = _run(autograder, lambda sub: (sub / "notes.txt").write_text("hello"))
+    assert r["score"] == 0 and f"no folder {LAB}/ or labs/{LAB}/" in r["output"]
+    assert "notes.txt" in r["output"]
+
+
+def test_grade_all_on_the_real_course_as_nobody(autograder, base, points):
+    """Batch regrading with the autograder's environment (readable by the sandbox user), as root with the drop."""
+    subs = base / "subs"
+    shutil.copytree(ROOT / "solutions" / LAB, subs / "alice" / "labs" / LAB)
+    shutil.copytree(ROOT / "labs" / LAB, subs / "bob" / LAB)
+    (subs / "carol").mkdir()
+    subprocess.run(["chmod", "-R", "a+rX", str(subs)], check=True)
+    out = base / "regrade"
+    env = _env(GEOMLIB_ROOT=str(autograder / "source"))
+    if not IS_ROOT:
+        env["GEOMLIB_SANDBOX_USER"] = ""
+    py = autograder / "source" / ".venv" / "bin" / "python"
+    cmd = [str(py), "-m", "geomlib.cli", "grade-all", str(subs), "--lab", LAB, "--out", str(out), "--jobs", "2"]
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stdout + p.stderr
+    import csv
+
+    rows = {r["submission"]: r for r in csv.DictReader((out / "scores.csv").open())}
+    total = sum(p + h for p, h in points.values())
+    assert float(rows["alice"]["score"]) == float(rows["(max)"]["score"]) == total and rows["alice"]["status"] == "ok"
+    assert rows["bob"]["score"] == "0" and rows["carol"]["status"] == "no lab"
+    for who in ("alice", "bob", "carol"):
+        validate_results(json.loads((out / who / "results.json").read_text()))
