@@ -128,7 +128,7 @@ CASES = [
     _cc(
         "probe-cc-edges-cube",
         "cc_edge_points",
-        with_face_points(bumpy_cube),
+        with_face_points(bumpy_cube, "cube"),
         ("EP",),
         checks.Allclose(),
         "edge point = (a + b + FP[f0] + FP[f1]) / 4",
@@ -144,7 +144,7 @@ CASES = [
     _cc(
         "probe-cc-edges-cage",
         "cc_edge_points",
-        with_face_points(cage),
+        with_face_points(cage, "cage"),
         ("EP",),
         checks.Allclose(),
         "edge point = (a + b + FP[f0] + FP[f1]) / 4",
