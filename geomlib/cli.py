@@ -31,7 +31,7 @@ examples:
 
 
 def _cmd_figures(a) -> int:
-    from geomlib import figures
+    from geomlib.grading import figures
 
     out = Path(a.out)
     figs = figures.build_all(out, labs=a.lab, quick=a.quick, progress=True)

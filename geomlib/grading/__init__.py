@@ -1,4 +1,7 @@
-"""The grading framework: graded cases, sandboxed student code, references, stubs, scores, release.
+"""The course tooling: graded cases, sandboxed student code, references, stubs, scores, release, figures.
+
+The library (every other module of :mod:`geomlib`) never imports this package, and importing it
+needs no pytest (``tests/unit/test_layering.py``).
 
 What a graded test module imports::
 
@@ -7,20 +10,39 @@ What a graded test module imports::
 See ``docs/adding-a-lab.md`` (instructors) and ``docs/autograder.md`` (running the autograder).
 """
 
-from geomlib.grading import checks, tolerances
-from geomlib.grading.cases import Case, expect_close, expect_raises, graded, load_cases, reference_tests, run_case
-from geomlib.grading.errors import (
-    BadReturn,
-    BudgetSpent,
-    GraderError,
-    GradingFailure,
-    Mismatch,
-    NotImplementedYet,
-    StudentCrash,
-    StudentError,
-    StudentTimeout,
-)
-from geomlib.grading.impl import course_root, lab_names, load_lab, resolve_impl
+import importlib
+
+#: Public names, by the submodule that defines them. Imported on first use, so that importing the
+#: grader (a notebook's ``check``, ``geomlib grade``) needs neither pytest nor the plugin until a
+#: graded test module is collected.
+_EXPORTS = {
+    "cases": ("Case", "expect_close", "expect_raises", "graded", "load_cases", "reference_tests", "run_case"),
+    "errors": (
+        "BadReturn",
+        "BudgetSpent",
+        "GraderError",
+        "GradingFailure",
+        "Mismatch",
+        "NotImplementedYet",
+        "StudentCrash",
+        "StudentError",
+        "StudentTimeout",
+    ),
+    "impl": ("course_root", "lab_names", "load_lab", "resolve_impl"),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
+_SUBMODULES = ("checks", "tolerances")
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f"geomlib.grading.{_WHERE[name]}"), name)
+    elif name in _SUBMODULES:
+        value = importlib.import_module(f"geomlib.grading.{name}")
+    else:
+        raise AttributeError(f"module 'geomlib.grading' has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
 def check(lab: str, task: int | None = None, part: str | None = None, **kwargs):

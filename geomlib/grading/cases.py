@@ -15,7 +15,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import tolerances as tol
@@ -119,6 +118,8 @@ def graded(
     """Mark a test as graded: its points, its part and its Gradescope visibility."""
     if visibility not in VISIBILITIES:
         raise ValueError(f"visibility must be one of {VISIBILITIES}")
+    import pytest  # graded tests run under pytest; importing this module does not need it
+
     return pytest.mark.graded(points=points, part=part, visibility=visibility, timeout=timeout, memory_mb=memory_mb)
 
 
@@ -230,6 +231,8 @@ def reference_tests(cases: list[Case]):
     ids = [c.id for c in cases]
     if len(set(ids)) != len(ids):
         raise ValueError(f"duplicate case ids: {sorted({i for i in ids if ids.count(i) > 1})}")
+    import pytest
+
     params = [pytest.param(c, id=c.id, marks=graded(c.points, c.part, c.visibility, timeout=c.timeout)) for c in cases]
 
     @pytest.mark.parametrize("case", params)

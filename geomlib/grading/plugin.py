@@ -13,7 +13,6 @@ Loaded by ``tests/conftest.py``. A graded test lives in ``tests/graded/<lab>/`` 
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -21,29 +20,8 @@ import pytest
 from geomlib.grading import impl as _impl
 from geomlib.grading import sandbox, tolerances
 from geomlib.grading.errors import GraderError, GradingFailure, NotImplementedYet
+from geomlib.grading.results import Record
 from geomlib.grading.sandbox import LabProxy
-
-
-@dataclass
-class Record:
-    """The outcome of one graded test."""
-
-    nodeid: str
-    lab: str
-    part: str
-    name: str
-    points: float
-    visibility: str
-    passed: bool
-    message: str
-    duration: float
-    not_implemented: bool = False
-    error: bool = False
-
-    @property
-    def score(self) -> float:
-        return self.points if self.passed else 0.0
-
 
 #: Records of the most recent run in this process (read by ``geomlib grade``).
 RECORDS: list[Record] = []

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import json
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
-from geomlib.grading.plugin import Record
 from geomlib.grading.sandbox import clean_text
 
 __all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results", "markdown_text", "plain_text"]
@@ -66,6 +66,27 @@ _MD_SPECIAL = str.maketrans({c: "\\" + c for c in "\\`*_[]<>#|~"})
 #: Longest test output / top-level output kept in results.json (characters).
 TEST_OUTPUT_CHARS = 6000
 TOP_OUTPUT_CHARS = 20000
+
+
+@dataclass
+class Record:
+    """The outcome of one graded test."""
+
+    nodeid: str
+    lab: str
+    part: str
+    name: str
+    points: float
+    visibility: str
+    passed: bool
+    message: str
+    duration: float
+    not_implemented: bool = False
+    error: bool = False
+
+    @property
+    def score(self) -> float:
+        return self.points if self.passed else 0.0
 
 
 def markdown_text(text: str, limit: int = TEST_OUTPUT_CHARS) -> str:
