@@ -142,6 +142,7 @@ def pytest_runtest_makereport(item, call):
             message=sandbox.clean_text(message),
             duration=getattr(rep, "duration", 0.0),
             not_implemented=isinstance(exc, NotImplementedYet),
+            picture=getattr(exc, "feedback", None) if isinstance(exc, GradingFailure) else None,
             error=exc is not None
             and (isinstance(exc, GraderError) or not isinstance(exc, GradingFailure | AssertionError)),
         )

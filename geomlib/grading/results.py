@@ -5,12 +5,14 @@ The fields follow Gradescope's autograder specification: top-level ``score``, ``
 ``number``, ``score``, ``max_score``, ``status`` (``passed``/``failed``), ``output`` and
 ``visibility`` (plus ``name_format``/``output_format``). Messages are Markdown (``output_format: md``);
 the top-level ``output`` holds a per-part table of the *visible* tests only, so hidden and
-after-due-date tests follow their own visibility. Feedback pictures are not embedded: they are files
-for local runs (``geomlib grade``), and Gradescope's image would only show a path.
+after-due-date tests follow their own visibility. A failed test with a feedback picture is written
+as HTML (``output_format: html``) with the picture inlined as a base64 data URI, because Gradescope
+serves no files from the results folder (:func:`embedded_picture`).
 """
 
 from __future__ import annotations
 
+import html
 import json
 import re
 from dataclasses import dataclass
@@ -83,6 +85,7 @@ class Record:
     duration: float
     not_implemented: bool = False
     error: bool = False
+    picture: str | None = None  # a feedback picture (path), when the failed check drew one
 
     @property
     def score(self) -> float:
@@ -127,6 +130,48 @@ def visible_summary(records: list[Record]) -> str:
     return "\n".join(lines)
 
 
+#: Largest feedback picture embedded in results.json (PNG bytes, after shrinking to PICTURE_WIDTH).
+PICTURE_BYTES = 400_000
+PICTURE_WIDTH = 900
+
+
+def embedded_picture(path: str | Path) -> str | None:
+    """A feedback picture as an ``<img>`` with a base64 data URI, or None if it is missing or too large.
+
+    Gradescope shows a test's output as HTML when ``output_format`` is ``html`` and does not serve
+    files from ``/autograder/results``: an image reaches the student only inlined in the output
+    (Gradescope's autograder_samples discussion #108). Pictures are shrunk to PICTURE_WIDTH pixels
+    and capped at PICTURE_BYTES so a results.json stays small.
+    """
+    import base64
+    import io
+
+    try:
+        from PIL import Image
+
+        with Image.open(path) as im:
+            im = im.convert("RGB")
+            if im.width > PICTURE_WIDTH:
+                im = im.resize((PICTURE_WIDTH, max(1, round(im.height * PICTURE_WIDTH / im.width))), Image.LANCZOS)
+            buf = io.BytesIO()
+            im.save(buf, format="PNG", optimize=True)
+    except Exception:  # a picture is a help, never a requirement
+        return None
+    data = buf.getvalue()
+    if len(data) > PICTURE_BYTES:
+        return None
+    return f'<img alt="feedback picture" style="max-width: 100%" src="data:image/png;base64,{base64.b64encode(data).decode()}">'
+
+
+def _test_output(r: Record) -> dict:
+    """A test's ``output`` and ``output_format``: Markdown, or HTML with its feedback picture inlined."""
+    img = embedded_picture(r.picture) if (r.picture and not r.passed) else None
+    if img is None:
+        return {"output": markdown_text(r.message), "output_format": "md"}
+    text = html.escape(clean_text(r.message, TEST_OUTPUT_CHARS)).replace("\n", "<br>")
+    return {"output": f"<p>{text}</p>\n{img}", "output_format": "html"}
+
+
 def build_results(records: list[Record], execution_time: float, output: str = "") -> dict:
     """The ``results.json`` dict for graded records (test numbers are ``<lab>.<part>.<k>``).
 
@@ -148,8 +193,7 @@ def build_results(records: list[Record], execution_time: float, output: str = ""
                 "score": round(r.score, 6),
                 "max_score": round(r.points, 6),
                 "status": "passed" if r.passed else "failed",
-                "output": markdown_text(r.message),
-                "output_format": "md",
+                **_test_output(r),
                 "visibility": r.visibility,
                 "tags": [clean_text(r.lab, 100), clean_text(r.part, 100)],
             }

@@ -39,3 +39,46 @@ def test_image_mismatch_writes_a_difference_map(tmp_path):
         checks.ImageMatch()({"image": expected}, {"image": got}, ctx)
     assert "6.25% of pixels differ" in str(e.value) and "row 8, column 8" in str(e.value)
     assert (tmp_path / "maps" / "quad.png").is_file()
+
+
+def test_results_json_inlines_a_failed_tests_feedback_picture(tmp_path):
+    """Gradescope serves no files from results/: the picture travels inside the test's HTML output."""
+    import base64
+
+    from PIL import Image
+
+    from geomlib.grading.results import PICTURE_WIDTH, Record, build_results, validate_results
+
+    pic = tmp_path / "wrong.png"
+    Image.fromarray(np.full((300, 2000, 3), 200, np.uint8)).save(pic)
+
+    def record(passed, picture, message='loop_subdivide on "cube": vertex 3 is off by 0.5 <script>'):
+        return Record(
+            nodeid="t", lab="subdivision", part="levels", name="cube", points=1.0, visibility="visible",
+            passed=passed, message=message, duration=0.1, picture=picture,
+        )  # fmt: skip
+
+    data = build_results([record(False, str(pic)), record(False, None), record(True, str(pic), "")], 1.0)
+    validate_results(data)
+    with_picture, without, passed = data["tests"]
+    assert with_picture["output_format"] == "html"
+    assert "&lt;script&gt;" in with_picture["output"] and "<script>" not in with_picture["output"]
+    b64 = with_picture["output"].split("base64,")[1].split('"')[0]
+    from io import BytesIO
+
+    shown = Image.open(BytesIO(base64.b64decode(b64)))
+    assert shown.width == PICTURE_WIDTH  # shrunk to fit, aspect kept
+    assert abs(shown.height - round(300 * PICTURE_WIDTH / 2000)) <= 1
+    assert without["output_format"] == "md" and "data:image" not in without["output"]
+    assert passed["output_format"] == "md" and "data:image" not in passed["output"]
+
+
+def test_a_missing_or_huge_picture_is_not_embedded(tmp_path):
+    from PIL import Image
+
+    from geomlib.grading import results
+
+    assert results.embedded_picture(tmp_path / "nope.png") is None
+    noise = np.random.default_rng(0).integers(0, 256, (900, 900, 3), dtype=np.uint8)  # incompressible
+    Image.fromarray(noise).save(tmp_path / "noise.png")
+    assert results.embedded_picture(tmp_path / "noise.png") is None
