@@ -43,7 +43,7 @@ import igl  # noqa: E402
 
 from geomlib import camera, datasets  # noqa: E402
 from geomlib.geometry import bbox_diagonal  # noqa: E402
-from geomlib.io import read_mesh  # noqa: E402
+from geomlib.mesh_io import read_mesh  # noqa: E402
 from solutions.sdf import (  # noqa: E402
     compress_bricks,
     gradient_central,
