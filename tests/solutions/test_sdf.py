@@ -78,7 +78,7 @@ def test_pseudonormal_distance_matches_igl(name):
 
 @pytest.mark.skipif(not FANDISK.is_file(), reason="real meshes in ../shared are not available")
 def test_pseudonormal_distance_matches_igl_on_the_fandisk():
-    from geomlib import io
+    from geomlib import mesh_io as io
 
     V, F = io.read_mesh(FANDISK)[:2]
     P = _points(V, 4000, 2, margin=0.05 * bbox_diagonal(V))
