@@ -1,5 +1,8 @@
 """Procedural test meshes: deterministic, built in code (no downloads).
 
+A catalogue (about 750 lines): one short builder per mesh, which would only be scattered by
+splitting; each builder stands alone.
+
 Triangle meshes are ``(V, F)`` with ``V`` float64 ``(n, 3)`` and ``F`` int64 ``(m, 3)``; quad
 meshes ``(V, Q)`` with ``Q`` int64 ``(m, 4)``; mixed polygon meshes ``(V, faces)`` with a list of
 index lists. Closed meshes are outward oriented (counter-clockwise seen from outside), open ones

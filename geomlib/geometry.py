@@ -1,5 +1,8 @@
 """Per-element geometry and spatial queries on triangle meshes.
 
+About 700 lines, over half of them the watertight ray caster and its BVH walk, kept next to the
+closest-point and distance queries that share their validation and bounding boxes.
+
 Measures (normals, areas, dihedral angles, edge lengths), spatial queries (closest points,
 ray casting, surface sampling) and the mesh-to-mesh distances every lab's grading reuses.
 

@@ -1,5 +1,9 @@
 """Figure helpers: image panels with captions, colour maps and bars, line plots, deterministic PNGs.
 
+Longer than most modules (about 800 lines) on purpose: it is the one place every figure of every
+lab is composed, and its parts (panels, text, colour maps and bars, line plots, placeholder
+figures for unfinished tasks) share the same uint8 canvas conventions and font handling.
+
 Everything returns plain ``(h, w, 3)`` uint8 arrays, so renders (:mod:`geomlib.render`), plots
 and colour bars compose freely with :func:`panels` and are written with :func:`save_png`.
 Text uses the DejaVu Sans font bundled with matplotlib, drawn by Pillow; line plots use

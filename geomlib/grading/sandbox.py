@@ -1,5 +1,9 @@
 """Run student code in sandboxed worker processes with a time, memory and total-time limit.
 
+The grader side of one protocol (about 630 lines): starting the zygote, sending calls, reading
+replies under time and size limits, and turning every failure into a message; the worker side is
+:mod:`geomlib.grading.worker`, the confinement :mod:`geomlib.grading.landlock`.
+
 The grader starts a *zygote* (:mod:`geomlib.grading.zygote`): a fresh interpreter with NumPy, SciPy,
 libigl and geomlib imported, which never sees a case, a reference or the grader's open files. For
 each call the grader sends it the function's name and its inputs (pickled: grader → sandbox only);

@@ -1,4 +1,9 @@
-"""PLY, ASCII and binary: reader (faces and tristrips, vertex attributes) and writer."""
+"""PLY, ASCII and binary: reader (faces and tristrips, vertex attributes) and writer.
+
+One format, one module (about 630 lines): the header grammar, the ASCII and binary record walks and
+the writer share the element and property descriptions; no well-kept library reads PLY polygons
+with line-numbered errors (see :mod:`geomlib.mesh_io`).
+"""
 
 from __future__ import annotations
 
