@@ -28,7 +28,7 @@ def test_hidden_cases_carry_most_of_every_part(table, lab):
 @pytest.mark.parametrize("lab", LABS)
 def test_handout_grading_table_matches_the_tests(table, lab):
     text = (ROOT / "labs" / lab / "README.md").read_text()
-    rows = dict(re.findall(r"^\| ([^|]+?) \| ([0-9]+(?: \+ [0-9]+)?(?: = [0-9]+)?) \|", text, flags=re.M))
+    rows = dict(re.findall(r"^\| ([^|]+?) \| ([0-9.]+(?: \+ [0-9.]+)?(?: = [0-9.]+)?) \|", text, flags=re.M))
     for part, (pub, hid) in table[lab].items():
         expected = "0" if pub + hid == 0 else f"{pub:g} + {hid:g}"
         assert rows.get(part) == expected, f"labs/{lab}/README.md: row {part!r} should say {expected}"

@@ -218,56 +218,108 @@ def test_hostile_submission_gains_nothing(autograder):
 LOOKUP = """
 
 
-def _lookup(_name, _kwargs):
+def _key(name, values):
+    import numpy as np
+
+    shapes = []
+    for v in values:
+        if hasattr(v, "__len__") and not isinstance(v, str | dict):
+            try:
+                shapes.append(list(np.shape(v)))
+            except ValueError:
+                shapes.append(["ragged", len(v)])
+    return name + repr(shapes)
+
+
+def _lookup(_name, _args):
     import json
     import pathlib
 
     import numpy as np
 
-    from geomlib.grading.cases import inputs_digest
-
     here = pathlib.Path(__file__).parent / "_answers"
     index = json.loads((here / "index.json").read_text())
-    key = _name + "-" + inputs_digest(dict(_kwargs), {{}})
+    key = _key(_name, _args)
     if key not in index:
         raise NotImplementedError("lookup: this input is not among the public stored outputs")
-    with np.load(here / (key + ".npz")) as z:
-        out = [z[name] for name in index[key]]
+    with np.load(here / (index[key][0] + ".npz")) as z:
+        out = [z[name] for name in index[key][1]]
     return out[0] if len(out) == 1 else tuple(out)
 """
 
+#: Builds the look-up table from what students get (the bundle's public cases and references): a
+#: case is found again by its function and the shapes of its arguments (all a task body can see once
+#: the course's given validation has run); keys shared by cases with different outputs are dropped.
+BUILD_LOOKUP = """
+def _key(name, values):
+    import numpy as np
 
-def _lookup_submission(student: Path, sub: Path) -> None:
-    """The stubs, with every task function replaced by a look-up of the public stored outputs.
+    shapes = []
+    for v in values:
+        if hasattr(v, "__len__") and not isinstance(v, str | dict):
+            try:
+                shapes.append(list(np.shape(v)))
+            except ValueError:
+                shapes.append(["ragged", len(v)])
+    return name + repr(shapes)
 
-    Built only from what students get (the student bundle's cases and references): for each public
-    case, the digest of its arguments maps to its stored outputs.
+import inspect, json, pathlib, shutil, sys
+import numpy as np
+from geomlib.grading.cases import load_cases, reference_path
+from geomlib.grading.impl import load_lab
+out = pathlib.Path(sys.argv[1]); out.mkdir(parents=True)
+lab = load_lab(sys.argv[2], "labs")
+index, points, clash = {}, {}, set()
+for c in load_cases(sys.argv[2], hidden=False):
+    kwargs = {**c.inputs(), **c.params}
+    bound = inspect.signature(getattr(lab, c.function)).bind(**kwargs)
+    bound.apply_defaults()
+    key = _key(c.function, list(bound.arguments.values()))
+    if key in index:
+        clash.add(key)
+    shutil.copy(reference_path(sys.argv[2], c), out / (c.id + ".npz"))
+    index[key] = [c.id, list(c.outputs)]
+    points[key] = c.points
+for key in clash:
+    del index[key], points[key]
+(out / "index.json").write_text(json.dumps(index))
+print(sum(points.values()))
+"""
+
+
+def _lookup_submission(student: Path, sub: Path) -> float:
+    """The stubs, each task's ``raise NotImplementedError`` replaced by a look-up of the public stored outputs.
+
+    The task's signature and the course's given lines before it stay (the grader uses the course's
+    anyway); returns the points of the public cases the look-up can find again.
     """
-    code = (
-        "import sys, json, shutil, pathlib\n"
-        "from geomlib.grading.cases import load_cases, inputs_digest, reference_path\n"
-        f"out = pathlib.Path(sys.argv[1]); out.mkdir(parents=True); index = {{}}\n"
-        f"for c in load_cases({LAB!r}, hidden=False):\n"
-        "    key = c.function + '-' + inputs_digest({**c.inputs(), **c.params}, {})\n"
-        f"    shutil.copy(reference_path({LAB!r}, c), out / (key + '.npz'))\n"
-        "    index[key] = list(c.outputs)\n"
-        "(out / 'index.json').write_text(json.dumps(index))\n"
-    )
     lab = sub / "labs" / LAB
     shutil.copytree(student / "labs" / LAB, lab)
     env = _env(GEOMLIB_ROOT=str(student), PYTHONPATH=str(student))
-    subprocess.run([sys.executable, "-c", code, str(lab / "_answers")], env=env, check=True, timeout=300)
+    p = subprocess.run(
+        [sys.executable, "-c", BUILD_LOOKUP, str(lab / "_answers"), LAB],
+        env=env, check=True, timeout=300, capture_output=True, text=True, cwd=student,
+    )  # fmt: skip
+    findable = float(p.stdout.strip().splitlines()[-1])
     for f in lab.glob("*.py"):
-        names = [n.name for n in ast.parse(f.read_text()).body if isinstance(n, ast.FunctionDef)]
-        names = [n for n in names if not n.startswith("_")]
-        if not names or f.name == "__init__.py":
+        text = f.read_text()
+        lines = text.splitlines()
+        tree = ast.parse(text)
+        tasks = []
+        for node in tree.body:
+            if not isinstance(node, ast.FunctionDef):
+                continue
+            for st in node.body:
+                if isinstance(st, ast.Raise) and "NotImplementedError" in ast.unparse(st):
+                    params = [a.arg for a in node.args.posonlyargs + node.args.args + node.args.kwonlyargs]
+                    tasks.append((st.lineno, st.end_lineno, st.col_offset, node.name, params))
+        if not tasks:
             continue
-        extra = LOOKUP.format()
-        for n in names:
-            extra += f"\n\ndef {n}(*args, **kwargs):\n    if args:\n"
-            extra += '        raise NotImplementedError("lookup: positional arguments")\n'
-            extra += f"    return _lookup({n!r}, kwargs)\n"
-        f.write_text(f.read_text() + extra)
+        for first, last, col, name, params in sorted(tasks, reverse=True):
+            call = " " * col + f"return _lookup({name!r}, [{', '.join(params)}])"
+            lines[first - 1 : last] = [call]
+        f.write_text("\n".join(lines) + "\n" + LOOKUP)
+    return findable
 
 
 def _public_reference_points() -> float:
@@ -280,16 +332,20 @@ def _public_reference_points() -> float:
 
 
 def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
-    r, _ = _run(autograder, lambda sub: _lookup_submission(released / "student", sub))
+    findable = {}
+    r, _ = _run(autograder, lambda sub: findable.setdefault("points", _lookup_submission(released / "student", sub)))
     public_refs = _public_reference_points()
+    assert 0 < findable["points"] <= public_refs
     total = sum(p + h for p, h in points.values())
-    # The look-up really works: it earns every public reference case, and nothing else.
     missed = [
         t["name"] + ": " + t["output"][:200]
         for t in r["tests"]
         if t["status"] == "failed" and "lookup:" not in t["output"]
     ]
-    assert r["score"] == public_refs, (r["score"], public_refs, missed)
+    not_found = [t["name"] for t in r["tests"] if t["status"] == "failed" and "lookup:" in t["output"]]
+    # The look-up really works (it earns most of what it can find again; a few keys are met again by
+    # inputs that a given helper reshapes), and it never earns more than the public reference cases.
+    assert 0.8 * findable["points"] <= r["score"] <= public_refs, (r["score"], findable["points"], missed, not_found)
     assert r["score"] < total / 2
     per_part: dict[str, float] = {}
     for t in r["tests"]:
