@@ -67,6 +67,7 @@ def bump_normal(height, uv, *, strength: float) -> np.ndarray:
     -------
     (..., 3) float64 unit vectors, ``z > 0``.
     """
+    check_height(height, "bump_normal")  # validated here too, so bad input is named by this function
     # BEGIN SOLUTION: Task 1 (bump normal): n = normalize(-du, -dv, 1) from bump_offset
     D = bump_offset(height, uv, strength=strength)
     n = np.concatenate([-D, np.ones_like(D[..., :1])], axis=-1)
