@@ -107,6 +107,9 @@ def relief_uv(
         return d - (1.0 - height_at(H, u0[k] + d * du[k], v0[k] + d * dv[k]))
 
     P = u0.size
+    hit = np.zeros(P, dtype=np.int64)  # the hit layer i of each pixel
+    f_hit = np.zeros(P)  # f(d_i) there (>= 0)
+    f_above = np.zeros(P)  # f(d_(i-1)), the layer above (< 0)
     raise NotImplementedError('Task 3 (march): d_i = i / n for i = 0..n, stop at the first f(d_i) = d_i - (1 - h(uv(d_i))) >= 0')
     b = hit / n
     a = np.maximum(hit - 1, 0) / n

@@ -191,3 +191,31 @@ def test_shadow_of_a_wall_by_hand():
 def test_silhouette_mask():
     uv = np.array([[0.5, 0.5], [-0.01, 0.5], [0.5, 1.2], [1.0, 0.0]])
     assert R.inside_texture(uv).tolist() == [True, False, False, True]
+
+
+@pytest.mark.parametrize("name", ["bumps", "bricks"])
+def test_glsl_shaders_agree_with_numpy(name):
+    """The same math in float32 on llvmpipe: 0.05 texel on 99.9% of the pixels, layer indices and shadows too."""
+    H = MAPS[name]
+    uv = uv_grid(96)
+    light = np.array([-0.5, 0.3, 0.6])
+    for deg in (30, 75):
+        V = direction(deg)
+        a, b = R.parallax_uv(H, uv, V, scale=SCALE), R.glsl_parallax_uv(H, uv, V, scale=SCALE)
+        assert np.percentile(R.uv_error_texels(a, b, S), 99.9) < 0.05
+        for refine in R.REFINEMENTS:
+            n_uv, n_depth, n_steps = R.relief_uv(H, uv, V, scale=SCALE, refine=refine)
+            g_uv, g_depth, g_steps = R.glsl_relief_uv(H, uv, V, scale=SCALE, refine=refine)
+            assert np.percentile(R.uv_error_texels(n_uv, g_uv, S), 99.9) < 0.05, (deg, refine)
+            assert np.mean(n_steps == g_steps) >= 0.999 and np.percentile(np.abs(n_depth - g_depth), 99.9) < 1e-4
+        vis_n = R.relief_shadow(H, n_uv, n_depth, light, scale=SCALE)
+        vis_g = R.glsl_relief_shadow(H, n_uv, n_depth, light, scale=SCALE)
+        assert np.mean(vis_n == vis_g) >= 0.999 and 0 < vis_n.mean() < 1
+
+
+def test_glsl_stub_shader_carries_an_error_directive_naming_its_task():
+    """The generated stub shader has an #error line naming the task (glsl.py turns it into NotImplementedError)."""
+    from geomlib.grading.stubs import make_stub
+
+    stub = make_stub(R.shader_path("parallax").read_text(), "parallax.frag")
+    assert "#error Task 2" in stub
