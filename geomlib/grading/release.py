@@ -154,7 +154,7 @@ def leaked_lines(bundle: Path, *, min_len: int = 12) -> list[tuple[str, str]]:
     root = _impl.course_root()
     inside: set[str] = set()
     outside: set[str] = set()
-    for f in (root / "solutions").rglob("*.py"):
+    for f in (p for p in (root / "solutions").rglob("*") if p.suffix in stubs.STUB_SUFFIXES):  # shaders too
         text = f.read_text()
         sol = set(stubs.solution_lines(text, str(f)))
         inside |= sol

@@ -92,17 +92,18 @@ def height_at(H: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     (this lookup runs dozens of times per pixel in the ray march).
     """
     s = H.shape[0]
-    x = u * s - 0.5
-    y = (1.0 - v) * s - 0.5
-    x0, y0 = np.floor(x), np.floor(y)
+    # Clamping the continuous coordinate to [0, s - 1] first gives the same values (at a clamped
+    # border both taps are the border texel, or the weight of the second is 0) with one clip per
+    # axis; the map padded by one edge row and column makes x0 + 1 and y0 + 1 always valid.
+    x = np.clip(u * s - 0.5, 0.0, s - 1.0)
+    y = np.clip((1.0 - v) * s - 0.5, 0.0, s - 1.0)
+    x0 = x.astype(np.intp)  # floor, x >= 0
+    y0 = y.astype(np.intp)
     fx, fy = x - x0, y - y0
-    xa = np.clip(x0, 0, s - 1).astype(np.intp)
-    xb = np.clip(x0 + 1, 0, s - 1).astype(np.intp)
-    ya = np.clip(y0, 0, s - 1).astype(np.intp) * s
-    yb = np.clip(y0 + 1, 0, s - 1).astype(np.intp) * s
-    flat = H.ravel()
-    t00, t01 = flat.take(ya + xa), flat.take(ya + xb)
-    t10, t11 = flat.take(yb + xa), flat.take(yb + xb)
+    flat = np.pad(H, ((0, 1), (0, 1)), mode="edge").ravel()
+    i = y0 * (s + 1) + x0
+    t00, t01 = flat.take(i), flat.take(i + 1)
+    t10, t11 = flat.take(i + (s + 1)), flat.take(i + (s + 2))
     top = t00 + (t01 - t00) * fx
     bot = t10 + (t11 - t10) * fx
     return top + (bot - top) * fy

@@ -42,7 +42,7 @@ def relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32) -
 
     Notes
     -----
-    Loops over the ``layers`` steps (each a vectorised lookup for every pixel).
+    Loops over the ``layers`` steps (each a vectorised lookup for every pixel not yet in shadow).
     """
     where = "relief_shadow"
     H = check_height(height, where)

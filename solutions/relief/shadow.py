@@ -42,7 +42,7 @@ def relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32) -
 
     Notes
     -----
-    Loops over the ``layers`` steps (each a vectorised lookup for every pixel).
+    Loops over the ``layers`` steps (each a vectorised lookup for every pixel not yet in shadow).
     """
     where = "relief_shadow"
     H = check_height(height, where)
@@ -57,12 +57,15 @@ def relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32) -
     scale = check_scale(scale, where)
     n = check_layers(layers, "layers", where)
     # BEGIN SOLUTION: Task 4 (shadow): d_k = depth (1 - k/layers), uv_k = uv + (depth - d_k) light_xy / light_z; shadow if any d_k > scale (1 - h(uv_k))
-    slope = L[..., :2] / L[..., 2:3]
-    lit = np.ones(shape, dtype=bool)
-    for k in range(1, n):
-        d_k = D * (1.0 - k / n)
-        rise = (D - d_k)[..., None]
-        p = uv + rise * slope
-        lit &= ~(d_k > scale * (1.0 - height_at(H, p[..., 0], p[..., 1])))
-    return lit.astype(np.float64)
+    slope = (L[..., :2] / L[..., 2:3]).reshape(-1, 2)
+    d0, p0 = D.ravel(), uv.reshape(-1, 2)
+    lit = np.ones(d0.size, dtype=bool)
+    alive = np.flatnonzero(d0 > 0)  # a point at the polygon has nothing above it
+    for k in range(1, n):  # k = n is at the polygon, above every relief point
+        d_k = d0[alive] * (1.0 - k / n)
+        p = p0[alive] + (d0[alive] - d_k)[:, None] * slope[alive]
+        under = d_k > scale * (1.0 - height_at(H, p[:, 0], p[:, 1]))
+        lit[alive[under]] = False
+        alive = alive[~under]  # once in shadow, always in shadow
+    return lit.astype(np.float64).reshape(shape)
     # END SOLUTION

@@ -219,3 +219,13 @@ def test_glsl_stub_shader_carries_an_error_directive_naming_its_task():
 
     stub = make_stub(R.shader_path("parallax").read_text(), "parallax.frag")
     assert "#error Task 2" in stub
+
+
+def test_height_at_is_geomlibs_bilinear_clamp_lookup():
+    from geomlib.textures import sample_bilinear
+    from solutions.relief.inputs import height_at
+
+    H = np.random.default_rng(0).random((16, 16))
+    uv = np.random.default_rng(1).uniform(-0.3, 1.3, (500, 2))
+    uv[:4] = [[0, 0], [1, 1], [0.5 / 16, 1 - 0.5 / 16], [1 - 0.5 / 16, 0.5]]
+    assert np.allclose(height_at(H, uv[:, 0], uv[:, 1]), sample_bilinear(H, uv, "clamp"), atol=1e-15, rtol=0)
