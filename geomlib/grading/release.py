@@ -32,7 +32,7 @@ __all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secr
 
 _SKIP_DIRS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache", ".ruff_cache"}
 _TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version"]
-_TEXT_SUFFIXES = {".py", ".md", ".ipynb", ".txt", ".toml", ".json", ".cfg", ".sh", ".yml", ".yaml", ".rst", ""}
+_TEXT_SUFFIXES = {".py", ".frag", ".vert", ".glsl", ".md", ".ipynb", ".txt", ".toml", ".json", ".cfg", ".sh", ".yml", ".yaml", ".rst", ""}
 
 
 class ReleaseError(RuntimeError):
@@ -296,8 +296,8 @@ def _baseline_lines(root: Path) -> set[str]:
     for f in (root / "geomlib").rglob("*.py"):
         if "__pycache__" not in f.parts:
             lines |= {ln.strip() for ln in f.read_text().splitlines()}
-    for f in (root / "solutions").rglob("*.py"):
-        if "__pycache__" not in f.parts:
+    for f in (root / "solutions").rglob("*"):
+        if f.suffix in stubs.STUB_SUFFIXES and "__pycache__" not in f.parts:  # shaders too
             lines |= {ln.strip() for ln in stubs.make_stub(f.read_text(), str(f)).splitlines()}
     return lines
 
@@ -312,12 +312,12 @@ def secret_lines(root: Path | None = None, labs: list[str] | None = None) -> dic
     root = Path(root) if root else _impl.course_root()
     baseline = _baseline_lines(root)
     out: dict[str, set[str]] = {}
-    for f in sorted((root / "solutions").rglob("*.py")):
+    for f in sorted(p for p in (root / "solutions").rglob("*") if p.suffix in stubs.STUB_SUFFIXES):
         if "__pycache__" in f.parts or (labs and f.relative_to(root / "solutions").parts[0] not in labs):
             continue
         rel = f.relative_to(root / "solutions").as_posix()
         for task, body in stubs.solution_blocks(f.read_text(), str(f)):
-            secret = {ln for ln in body if not ln.startswith("#") and ln not in baseline}
+            secret = {ln for ln in body if not ln.startswith(("#", "//")) and ln not in baseline}
             if secret:
                 key = f"{rel}: {task}"
                 out.setdefault(key, set()).update(secret)

@@ -14,6 +14,9 @@ Optional prompt lines, commented out in the solution, are uncommented in the stu
     # END PROMPT
 
 Everything else (imports, docstrings, validation, given helpers) is copied unchanged.
+
+GLSL shaders (``.frag``, ``.vert``, ``.glsl``) use the same markers as ``//`` comments; a stub
+block becomes ``#error Task ...``, so the stub shader does not compile and names its task.
 """
 
 from __future__ import annotations
@@ -30,6 +33,21 @@ _BEGIN = re.compile(r"^(?P<indent>\s*)# BEGIN SOLUTION(?::\s*(?P<task>.*?))?\s*$
 _END = re.compile(r"^\s*# END SOLUTION\s*$")
 _PBEGIN = re.compile(r"^\s*# BEGIN PROMPT\s*$")
 _PEND = re.compile(r"^\s*# END PROMPT\s*$")
+#: Shader files stubbed like the Python ones, with ``//`` markers.
+GLSL_SUFFIXES = (".frag", ".vert", ".glsl")
+STUB_SUFFIXES = (".py", *GLSL_SUFFIXES)
+
+
+def _glsl(name: str) -> bool:
+    return str(name).endswith(GLSL_SUFFIXES)
+
+
+def _comments(text: str, name: str) -> str:
+    """GLSL text with its ``//`` marker lines spelled as ``#`` ones (same line count)."""
+    if not _glsl(name):
+        return text
+    marker = re.compile(r"^(\s*)// ?((?:BEGIN|END) (?:SOLUTION|PROMPT)\b.*)$")
+    return "\n".join(marker.sub(r"\1# \2", line) for line in text.split("\n"))
 
 
 class StubError(ValueError):
@@ -45,7 +63,7 @@ class _Block:
 
 
 def _scan(text: str, name: str) -> tuple[list[_Block], list[tuple[int, int]]]:
-    lines = text.splitlines()
+    lines = _comments(text, name).splitlines()
     blocks, prompts = [], []
     open_block = open_prompt = None
     for i, line in enumerate(lines, start=1):
@@ -79,7 +97,7 @@ def _scan(text: str, name: str) -> tuple[list[_Block], list[tuple[int, int]]]:
 def make_stub(text: str, name: str = "<solution>") -> str:
     """The stub version of one solution file's text."""
     blocks, prompts = _scan(text, name)
-    lines = text.splitlines()
+    lines = _comments(text, name).splitlines()
     out: list[str] = []
     starts = {b.start: b for b in blocks}
     in_prompt = {i for s, e in prompts for i in range(s, e + 1)}
@@ -88,7 +106,10 @@ def make_stub(text: str, name: str = "<solution>") -> str:
         if i in starts:
             b = starts[i]
             task = b.task or "this part of the lab"
-            out.append(f"{b.indent}raise NotImplementedError({task!r})")
+            if _glsl(name):
+                out.append(f"{b.indent}#error {task}")
+            else:
+                out.append(f"{b.indent}raise NotImplementedError({task!r})")
             i = b.end + 1
             continue
         line = lines[i - 1]
@@ -96,7 +117,7 @@ def make_stub(text: str, name: str = "<solution>") -> str:
             if _PBEGIN.match(line) or _PEND.match(line):
                 i += 1
                 continue
-            out.append(re.sub(r"^(\s*)# ?", r"\1", line, count=1))
+            out.append(re.sub(r"^(\s*)// ?" if _glsl(name) else r"^(\s*)# ?", r"\1", line, count=1))
         else:
             out.append(line)
         i += 1
@@ -129,7 +150,7 @@ def _pairs(labs: list[str] | None):
         src = sol_root / lab
         if not src.is_dir():
             raise StubError(f"no solution folder {src}")
-        for f in sorted(src.rglob("*.py")):
+        for f in sorted(f for f in src.rglob("*") if f.suffix in STUB_SUFFIXES):
             if "__pycache__" in f.parts:
                 continue
             yield lab, f, lab_root / lab / f.relative_to(src)
@@ -152,8 +173,8 @@ def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
         written.append(dst)
         expected.setdefault(lab, set()).add(dst)
     for lab, files in expected.items():
-        for f in (_impl.course_root() / "labs" / lab).rglob("*.py"):
-            if f not in files and "__pycache__" not in f.parts:
+        for f in (_impl.course_root() / "labs" / lab).rglob("*"):
+            if f.suffix in STUB_SUFFIXES and f not in files and "__pycache__" not in f.parts:
                 f.unlink()
                 log(f"  removed {f.relative_to(_impl.course_root())} (no solution counterpart)")
     return written
@@ -171,7 +192,7 @@ def check(labs: list[str] | None = None) -> list[str]:
         elif dst.read_text() != make_stub(src.read_text(), str(src)):
             problems.append(f"{rel} differs from the stub generated from {src.relative_to(_impl.course_root())}")
     for lab, files in seen.items():
-        for f in (_impl.course_root() / "labs" / lab).rglob("*.py"):
-            if f not in files and "__pycache__" not in f.parts:
+        for f in (_impl.course_root() / "labs" / lab).rglob("*"):
+            if f.suffix in STUB_SUFFIXES and f not in files and "__pycache__" not in f.parts:
                 problems.append(f"{f.relative_to(_impl.course_root())} has no solution counterpart")
     return problems

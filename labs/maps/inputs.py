@@ -11,13 +11,15 @@ Conventions of the whole lab (see ``geomlib.textures`` for the UV/image conventi
 * Tangents follow glTF / pyrender: an ``(n, 4)`` array ``[T, w]`` with ``B = w (N x T)``.
 
 ``check_uv`` (:func:`geomlib.validate.check_uv`), ``as_unit_vectors`` and ``normalize_rows``
-(:mod:`geomlib.vectors`) come from geomlib, shared with the other labs.
+(:mod:`geomlib.vectors`), ``as_height_map`` and ``fallback_perpendicular``
+(:mod:`geomlib.tangent_space`) come from geomlib, shared with the other labs.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from geomlib.tangent_space import as_height_map, fallback_perpendicular
 from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float, check_uv
 from geomlib.vectors import as_unit_vectors, normalize_rows
 
@@ -34,51 +36,11 @@ __all__ = [
 ]
 
 
-def fallback_perpendicular(N: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to each unit row of ``N`` (deterministic).
-
-    Uses the coordinate axis least aligned with ``N``: ``e - (N . e) N``, normalised.
-    """
-    axis = np.argmin(np.abs(N), axis=-1)
-    E = np.zeros_like(N)
-    np.put_along_axis(E, axis[..., None], 1.0, axis=-1)
-    T = E - np.sum(N * E, axis=-1, keepdims=True) * N
-    return normalize_rows(T, fallback=(1.0, 0.0, 0.0))
-
-
 def _square(img: np.ndarray, name: str, where: str) -> None:
     if img.shape[0] != img.shape[1]:
         raise MeshError(
             f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; maps in this lab are square (s x s texels)"
         )
-
-
-def as_height_map(H, where: str, name: str = "height", *, unit_range: bool = False) -> np.ndarray:
-    """A square single-channel height map as float64 ``(s, s)``.
-
-    uint8 and uint16 images are scaled to ``[0, 1]`` (black = 0); float maps are used as they are
-    and, with ``unit_range``, must lie in ``[0, 1]``.
-    """
-    img = as_image(H, name, where=where)
-    if img.ndim == 3:
-        raise MeshError(
-            f"{where}: {name} has {img.shape[2]} channels (shape {img.shape}); expected a single-channel (grey) "
-            f"height map (s, s)"
-        )
-    _square(img, name, where)
-    if img.dtype == np.uint8:
-        return img.astype(np.float64) / 255.0
-    if img.dtype == np.uint16:
-        return img.astype(np.float64) / 65535.0
-    if img.dtype.kind not in "iuf":
-        raise MeshError(f"{where}: {name} has dtype {img.dtype}, expected floats, uint8 or uint16")
-    out = as_array(img, name, dtype=np.float64, where=where)
-    if unit_range and (out.min() < 0 or out.max() > 1):
-        raise MeshError(
-            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; a displacement map holds values in [0, 1] "
-            f"(use bias and scale to map them to offsets)"
-        )
-    return out
 
 
 def as_encoded_map(img, where: str, name: str = "img") -> np.ndarray:

@@ -6,6 +6,7 @@ import numpy as np
 
 from geomlib.geometry import vertex_normals
 from geomlib.raster import GBuffer, rasterize
+from geomlib.tangent_space import surface_frames
 from geomlib.textures import WRAP_MODES, sample_bilinear
 from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float, check_mesh
 
@@ -15,10 +16,8 @@ from .inputs import (
     as_unit_vectors,
     check_lights,
     check_uv,
-    fallback_perpendicular,
     normalize_rows,
 )
-from .tangents import cross_rows
 
 __all__ = ["shade", "rasterize_mesh", "surface_frames"]
 
@@ -58,36 +57,6 @@ def rasterize_mesh(V, F, M, width: int, height: int, *, UV=None, N=None, tangent
     if tangents is not None:
         attrs["tangent"] = as_tangents(tangents, len(V), where)
     return rasterize(V, F, M, width, height, attributes=attrs, cull=cull)
-
-
-def surface_frames(normal: np.ndarray, tangent: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Given: orthonormal frames from interpolated per-vertex normals and ``[T, w]`` tangents.
-
-    The convention shared by :func:`shade` and :func:`bake_normal_map` (baker and shader must
-    agree, or baked detail comes out tilted)::
-
-        N' = normalize(normal)
-        T' = normalize(T - (N' . T) N')           (T = tangent[..., :3])
-        B' = sign(w) (N' x T')                    (sign(0) = +1)
-
-    Parameters
-    ----------
-    normal : (..., 3) float
-    tangent : (..., 4) float
-
-    Returns
-    -------
-    T, B, N : (..., 3) float64 each, orthonormal, never NaN.
-    """
-    Nn = normalize_rows(normal, fallback=(0.0, 0.0, 1.0))
-    T = tangent[..., :3] - np.einsum("...i,...i->...", tangent[..., :3], Nn)[..., None] * Nn
-    length = np.sqrt(np.einsum("...i,...i->...", T, T))
-    bad = length <= 1e-12
-    T /= np.where(bad, 1.0, length)[..., None]
-    if bad.any():  # tangent parallel to the normal (or zero): any perpendicular direction will do
-        T[bad] = fallback_perpendicular(Nn[bad])
-    w = np.where(tangent[..., 3:4] < 0, -1.0, 1.0).astype(T.dtype)
-    return T, w * cross_rows(Nn, T), Nn
 
 
 def _check_gbuffer(g, need: tuple[str, ...], where: str) -> None:

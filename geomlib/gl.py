@@ -1,0 +1,468 @@
+"""A small headless OpenGL harness: run a fragment shader and read back float buffers.
+
+Real-time labs (relief, ...) let students write GLSL. This module compiles their fragment shader,
+binds float textures and uniforms, draws a full-screen quad (or a mesh with per-vertex
+attributes) into float32 render targets, and returns the pixels as NumPy arrays, so a test can
+compare them with the NumPy reference.
+
+The context lives on the same headless platform as :mod:`geomlib.render` (pyrender):
+:func:`geomlib.render.backend` chooses ``PYOPENGL_PLATFORM`` (OSMesa here, Mesa EGL otherwise),
+and the context is created by pyrender's platform class for that choice. Never mix EGL and OSMesa
+in one process (PyOpenGL binds its platform once, at import). Every call makes this module's
+context current first, so it coexists with pyrender's own contexts.
+
+Conventions, those of every texture in geomlib: image row 0 is ``v = 1`` (the top); the
+full-screen quad passes ``uv`` in [0, 1]² with ``v`` up, and pixel ``(r, c)`` of a ``(h, w)``
+output has its centre at ``uv = ((c + 0.5) / w, 1 - (r + 0.5) / h)``. Textures are uploaded with
+``GL_NEAREST`` filtering and ``GL_CLAMP_TO_EDGE`` unless asked otherwise; shaders that need exact
+bilinear filtering should interpolate ``texelFetch`` results themselves (GPU filtering weights
+have only a few bits of precision on some drivers).
+
+A compile error raises :class:`ShaderError` with the driver's message, with line numbers of the
+source as given (the harness inserts ``#line`` after anything it prepends).
+
+Examples
+--------
+>>> import numpy as np
+>>> from geomlib import gl
+>>> src = "#version 330 core\\nin vec2 uv; out vec4 color;\\nvoid main() { color = vec4(uv, 0, 1); }"
+>>> img = gl.render_quad(src, (4, 2))  # doctest: +SKIP
+>>> img.shape, img.dtype  # doctest: +SKIP
+((2, 4, 4), dtype('float32'))
+"""
+
+from __future__ import annotations
+
+import atexit
+import ctypes
+import re
+from collections.abc import Mapping
+
+import numpy as np
+
+from geomlib.errors import MeshError
+
+__all__ = ["ShaderError", "QUAD_VERTEX_SHADER", "render_quad", "render_mesh", "renderer_info", "close"]
+
+#: Vertex shader of :func:`render_quad`: a full-screen quad passing ``uv`` in [0, 1]² (v up).
+QUAD_VERTEX_SHADER = """#version 330 core
+layout(location = 0) in vec2 position;
+out vec2 uv;
+void main() {
+    uv = 0.5 * position + 0.5;
+    gl_Position = vec4(position, 0.0, 1.0);
+}
+"""
+
+_FIX = (
+    "install OSMesa (`sudo apt-get install libosmesa6` on Debian/Ubuntu), or a Mesa EGL driver "
+    "(`sudo apt-get install libegl1 libgl1-mesa-dri`) and set PYOPENGL_PLATFORM=egl before starting Python"
+)
+
+
+class ShaderError(RuntimeError):
+    """A shader did not compile or link. ``log`` is the driver's message; ``lines`` the line numbers it names."""
+
+    def __init__(self, message: str, log: str = "", lines: tuple[int, ...] = ()):
+        super().__init__(message)
+        self.log = log
+        self.lines = lines
+
+
+# --------------------------------------------------------------------------------------------
+# Context
+# --------------------------------------------------------------------------------------------
+
+_STATE: dict = {}
+
+
+def _gl():
+    """The OpenGL module, with this module's context current (created on first use)."""
+    platform = _STATE.get("platform")
+    if platform is None:
+        from geomlib.render import backend, import_pyrender
+
+        try:
+            chosen = backend()
+            import_pyrender()  # the platform choice and pyrender's NumPy shim, in one place
+            if chosen == "osmesa":
+                from pyrender.platforms.osmesa import OSMesaPlatform as Platform
+            elif chosen == "egl":
+                from pyrender.platforms.egl import EGLPlatform as Platform
+            else:
+                raise RuntimeError(f"PYOPENGL_PLATFORM={chosen!r} is not a headless platform (osmesa or egl)")
+            platform = Platform(1, 1)  # we draw into our own framebuffer objects
+            platform.init_context()
+            platform.make_current()
+        except Exception as e:
+            raise RuntimeError(
+                f"geomlib.gl: could not create a headless OpenGL context ({type(e).__name__}: {e}). Fix: {_FIX}"
+            ) from e
+        _STATE["platform"] = platform
+    else:
+        platform.make_current()
+    from OpenGL import GL
+
+    return GL
+
+
+def renderer_info() -> dict:
+    """``{"platform", "vendor", "renderer", "version", "glsl"}`` of the harness's context."""
+    import os
+
+    GL = _gl()
+    return {
+        "platform": os.environ.get("PYOPENGL_PLATFORM", ""),
+        "vendor": GL.glGetString(GL.GL_VENDOR).decode(),
+        "renderer": GL.glGetString(GL.GL_RENDERER).decode(),
+        "version": GL.glGetString(GL.GL_VERSION).decode(),
+        "glsl": GL.glGetString(GL.GL_SHADING_LANGUAGE_VERSION).decode(),
+    }
+
+
+def close() -> None:
+    """Free the harness's OpenGL context (called automatically at exit)."""
+    platform = _STATE.pop("platform", None)
+    if platform is not None:
+        try:
+            platform.delete_context()
+        except Exception:  # the context may already be gone at interpreter shutdown
+            pass
+
+
+atexit.register(close)
+
+
+# --------------------------------------------------------------------------------------------
+# Shaders
+# --------------------------------------------------------------------------------------------
+
+_LINE_RE = re.compile(r"^\s*\d+:(\d+)\(\d+\)|^ERROR:\s*\d+:(\d+)|^\s*\d+\((\d+)\)", re.M)
+
+
+def _prepare(source: str, version: str) -> str:
+    """Add ``#version`` when missing, keeping the driver's line numbers those of ``source``."""
+    if re.match(r"\s*#version", source):
+        return source
+    return f"#version {version}\n#line 1\n{source}"
+
+
+def _compile(GL, kind, source: str, name: str) -> int:
+    shader = GL.glCreateShader(kind)
+    GL.glShaderSource(shader, source)
+    GL.glCompileShader(shader)
+    if not GL.glGetShaderiv(shader, GL.GL_COMPILE_STATUS):
+        log = GL.glGetShaderInfoLog(shader)
+        log = log.decode(errors="replace") if isinstance(log, bytes) else str(log)
+        GL.glDeleteShader(shader)
+        lines = tuple(int(next(g for g in m.groups() if g)) for m in _LINE_RE.finditer(log))
+        src_lines = source.splitlines()
+        if src_lines and src_lines[0].startswith("#version") and len(src_lines) > 1 and src_lines[1] == "#line 1":
+            src_lines = src_lines[2:]
+        shown = "".join(
+            f"\n  line {n}: {src_lines[n - 1].strip()}" for n in dict.fromkeys(lines) if 0 < n <= len(src_lines)
+        )
+        raise ShaderError(f"{name} did not compile:\n{log.strip()}{shown}", log=log, lines=lines)
+    return shader
+
+
+def _program(GL, vertex: str, fragment: str, name: str, version: str) -> int:
+    key = (vertex, fragment, version)
+    cache = _STATE.setdefault("programs", {})
+    if key in cache:
+        return cache[key]
+    vs = _compile(GL, GL.GL_VERTEX_SHADER, _prepare(vertex, version), f"{name} (vertex shader)")
+    fs = _compile(GL, GL.GL_FRAGMENT_SHADER, _prepare(fragment, version), name)
+    prog = GL.glCreateProgram()
+    GL.glAttachShader(prog, vs)
+    GL.glAttachShader(prog, fs)
+    GL.glLinkProgram(prog)
+    GL.glDeleteShader(vs)
+    GL.glDeleteShader(fs)
+    if not GL.glGetProgramiv(prog, GL.GL_LINK_STATUS):
+        log = GL.glGetProgramInfoLog(prog)
+        log = log.decode(errors="replace") if isinstance(log, bytes) else str(log)
+        GL.glDeleteProgram(prog)
+        raise ShaderError(f"{name} did not link:\n{log.strip()}", log=log)
+    if len(cache) > 32:  # a grader compiles a few shaders per student; keep memory bounded
+        GL.glDeleteProgram(cache.pop(next(iter(cache))))
+    cache[key] = prog
+    return prog
+
+
+def _set_uniform(GL, prog: int, name: str, value) -> None:
+    loc = GL.glGetUniformLocation(prog, name)
+    if loc < 0:  # unused uniforms are optimised away by the compiler; not an error
+        return
+    if isinstance(value, bool | int | np.integer):
+        GL.glUniform1i(loc, int(value))
+        return
+    a = np.asarray(value)
+    if a.dtype.kind in "iub":
+        a = a.astype(np.int32).ravel()
+        {1: GL.glUniform1i, 2: GL.glUniform2i, 3: GL.glUniform3i, 4: GL.glUniform4i}[a.size](loc, *a.tolist())
+        return
+    a = a.astype(np.float32)
+    if a.shape in ((3, 3), (4, 4)):
+        fn = GL.glUniformMatrix3fv if a.shape == (3, 3) else GL.glUniformMatrix4fv
+        fn(loc, 1, GL.GL_TRUE, np.ascontiguousarray(a))
+        return
+    a = a.ravel()
+    fns = {1: GL.glUniform1f, 2: GL.glUniform2f, 3: GL.glUniform3f, 4: GL.glUniform4f}
+    if a.size not in fns:
+        raise MeshError(f"geomlib.gl: uniform {name!r} has {a.size} values; expected 1 to 4, or a 3x3/4x4 matrix")
+    fns[a.size](loc, *[float(x) for x in a])
+
+
+_FORMATS = {
+    1: ("GL_R32F", "GL_RED"),
+    2: ("GL_RG32F", "GL_RG"),
+    3: ("GL_RGB32F", "GL_RGB"),
+    4: ("GL_RGBA32F", "GL_RGBA"),
+}
+
+
+def _bind_textures(GL, prog: int, textures: Mapping, filter: str, wrap: str) -> list[int]:
+    names = []
+    for unit, (name, image) in enumerate(textures.items()):
+        a = np.asarray(image, dtype=np.float32)
+        if a.ndim == 2:
+            a = a[:, :, None]
+        if a.ndim != 3 or a.shape[2] not in _FORMATS or min(a.shape[:2]) < 1:
+            raise MeshError(
+                f"geomlib.gl: texture {name!r} has shape {np.shape(image)}; expected (h, w) or (h, w, c) with c in 1..4"
+            )
+        internal, fmt = (getattr(GL, n) for n in _FORMATS[a.shape[2]])
+        tex = GL.glGenTextures(1)
+        names.append(tex)
+        GL.glActiveTexture(GL.GL_TEXTURE0 + unit)
+        GL.glBindTexture(GL.GL_TEXTURE_2D, tex)
+        GL.glPixelStorei(GL.GL_UNPACK_ALIGNMENT, 1)
+        # GL's first row is t = 0 (the bottom); geomlib's row 0 is v = 1 (the top).
+        data = np.ascontiguousarray(a[::-1])
+        GL.glTexImage2D(GL.GL_TEXTURE_2D, 0, internal, a.shape[1], a.shape[0], 0, fmt, GL.GL_FLOAT, data)
+        f = GL.GL_LINEAR if filter == "linear" else GL.GL_NEAREST
+        w = GL.GL_REPEAT if wrap == "repeat" else GL.GL_CLAMP_TO_EDGE
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MIN_FILTER, f)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_MAG_FILTER, f)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_S, w)
+        GL.glTexParameteri(GL.GL_TEXTURE_2D, GL.GL_TEXTURE_WRAP_T, w)
+        loc = GL.glGetUniformLocation(prog, name)
+        if loc >= 0:
+            GL.glUniform1i(loc, unit)
+    return names
+
+
+def _size(size) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in size)
+    except (TypeError, ValueError):
+        raise MeshError(f"geomlib.gl: size must be (width, height), got {size!r}") from None
+    if not (1 <= w <= 8192 and 1 <= h <= 8192):
+        raise MeshError(f"geomlib.gl: size must be between 1 and 8192 pixels on each side, got {(w, h)}")
+    return w, h
+
+
+def _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw) -> list[np.ndarray]:
+    w, h = size
+    if filter not in ("nearest", "linear") or wrap not in ("clamp", "repeat"):
+        raise MeshError(
+            f"geomlib.gl: filter must be 'nearest' or 'linear' and wrap 'clamp' or 'repeat', got {filter!r}, {wrap!r}"
+        )
+    fbo = GL.glGenFramebuffers(1)
+    GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, fbo)
+    colour = [GL.glGenRenderbuffers(1) for _ in range(outputs)]
+    for i, rb in enumerate(colour):
+        GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, rb)
+        GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_RGBA32F, w, h)
+        GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_COLOR_ATTACHMENT0 + i, GL.GL_RENDERBUFFER, rb)
+    depth = GL.glGenRenderbuffers(1)
+    GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, depth)
+    GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, GL.GL_DEPTH_COMPONENT24, w, h)
+    GL.glFramebufferRenderbuffer(GL.GL_FRAMEBUFFER, GL.GL_DEPTH_ATTACHMENT, GL.GL_RENDERBUFFER, depth)
+    texs: list[int] = []
+    try:
+        status = GL.glCheckFramebufferStatus(GL.GL_FRAMEBUFFER)
+        if status != GL.GL_FRAMEBUFFER_COMPLETE:
+            raise RuntimeError(
+                f"geomlib.gl: float framebuffer incomplete (status {status:#x}); the driver lacks RGBA32F targets"
+            )
+        GL.glDrawBuffers(outputs, [GL.GL_COLOR_ATTACHMENT0 + i for i in range(outputs)])
+        GL.glViewport(0, 0, w, h)
+        GL.glClearColor(0.0, 0.0, 0.0, 0.0)
+        GL.glClear(GL.GL_COLOR_BUFFER_BIT | GL.GL_DEPTH_BUFFER_BIT)
+        GL.glUseProgram(prog)
+        texs = _bind_textures(GL, prog, textures or {}, filter, wrap)
+        for name, value in (uniforms or {}).items():
+            _set_uniform(GL, prog, name, value)
+        draw()
+        GL.glFinish()
+        out = []
+        GL.glPixelStorei(GL.GL_PACK_ALIGNMENT, 1)
+        for i in range(outputs):
+            GL.glReadBuffer(GL.GL_COLOR_ATTACHMENT0 + i)
+            buf = np.empty((h, w, 4), dtype=np.float32)
+            GL.glReadPixels(0, 0, w, h, GL.GL_RGBA, GL.GL_FLOAT, buf)
+            out.append(buf[::-1].copy())  # GL's first row is the bottom
+        return out
+    finally:
+        GL.glUseProgram(0)
+        if texs:
+            GL.glDeleteTextures(texs)
+        GL.glBindFramebuffer(GL.GL_FRAMEBUFFER, 0)
+        GL.glDeleteRenderbuffers(len(colour) + 1, [*colour, depth])
+        GL.glDeleteFramebuffers(1, [fbo])
+
+
+def _vertex_array(GL, prog, arrays: Mapping[str, np.ndarray]):
+    vao = GL.glGenVertexArrays(1)
+    GL.glBindVertexArray(vao)
+    buffers = []
+    for name, a in arrays.items():
+        loc = GL.glGetAttribLocation(prog, name)
+        if loc < 0:
+            continue
+        a = np.ascontiguousarray(a, dtype=np.float32)
+        vbo = GL.glGenBuffers(1)
+        buffers.append(vbo)
+        GL.glBindBuffer(GL.GL_ARRAY_BUFFER, vbo)
+        GL.glBufferData(GL.GL_ARRAY_BUFFER, a.nbytes, a, GL.GL_STATIC_DRAW)
+        GL.glEnableVertexAttribArray(loc)
+        GL.glVertexAttribPointer(loc, a.shape[1], GL.GL_FLOAT, GL.GL_FALSE, 0, ctypes.c_void_p(0))
+    return vao, buffers
+
+
+def render_quad(
+    fragment: str,
+    size,
+    *,
+    textures: Mapping[str, np.ndarray] | None = None,
+    uniforms: Mapping[str, object] | None = None,
+    outputs: int = 1,
+    filter: str = "nearest",
+    wrap: str = "clamp",
+    version: str = "330 core",
+    name: str = "fragment shader",
+) -> np.ndarray | list[np.ndarray]:
+    """Run ``fragment`` once per pixel of a ``size = (width, height)`` float32 image.
+
+    Parameters
+    ----------
+    fragment : str
+        GLSL fragment shader. It receives ``in vec2 uv`` (pixel centre in [0, 1]², v up) and writes
+        ``out vec4`` colour(s) (``layout(location = i)`` for ``outputs > 1``). A missing
+        ``#version`` line gets ``#version {version}``; line numbers in errors stay those of ``fragment``.
+    size : (width, height)
+    textures : dict name -> (h, w) or (h, w, c) array, optional
+        Bound to the ``sampler2D`` uniforms of those names as 32-bit float textures, row 0 at v = 1.
+    uniforms : dict name -> value, optional
+        Python ints (and bools) set ``int`` uniforms; floats and 2- to 4-vectors ``float``/``vecN``;
+        3x3 and 4x4 arrays ``mat3``/``mat4`` (row-major NumPy order). Names the shader does not use
+        are ignored (the compiler removes them).
+    outputs : int
+        Number of colour outputs read back.
+    filter : {"nearest", "linear"}, wrap : {"clamp", "repeat"}
+        Texture sampling state for ``texture()`` (``texelFetch`` ignores both).
+    name : str
+        Names the shader in error messages (e.g. the student's file name).
+
+    Returns
+    -------
+    (height, width, 4) float32, or a list of ``outputs`` of them
+        Row 0 is the top of the image (v = 1).
+
+    Raises
+    ------
+    ShaderError
+        The shader does not compile or link (the driver's message, with line numbers of ``fragment``).
+    RuntimeError
+        No headless OpenGL context can be created (the message names the fix).
+    """
+    size = _size(size)
+    GL = _gl()
+    prog = _program(GL, QUAD_VERTEX_SHADER, fragment, name, version)
+    quad = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
+    vao, buffers = _vertex_array(GL, prog, {"position": quad})
+
+    def draw():
+        GL.glBindVertexArray(vao)
+        GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
+
+    try:
+        out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
+    finally:
+        GL.glBindVertexArray(0)
+        GL.glDeleteBuffers(len(buffers), buffers)
+        GL.glDeleteVertexArrays(1, [vao])
+    return out[0] if outputs == 1 else out
+
+
+def render_mesh(
+    vertex: str,
+    fragment: str,
+    F,
+    attributes: Mapping[str, np.ndarray],
+    size,
+    *,
+    textures: Mapping[str, np.ndarray] | None = None,
+    uniforms: Mapping[str, object] | None = None,
+    outputs: int = 1,
+    filter: str = "nearest",
+    wrap: str = "clamp",
+    version: str = "330 core",
+    name: str = "fragment shader",
+) -> np.ndarray | list[np.ndarray]:
+    """Draw the triangles ``F`` with per-vertex ``attributes`` through ``vertex`` and ``fragment`` (depth-tested).
+
+    Parameters
+    ----------
+    vertex, fragment : str
+        GLSL shaders; the vertex shader writes ``gl_Position`` (clip space) from its ``in`` attributes.
+    F : (m, 3) int
+        Triangles indexing the rows of the attributes.
+    attributes : dict name -> (n, k) float array, k in 1..4
+        Bound to the vertex shader's ``in`` variables of those names (unused ones are skipped).
+    size, textures, uniforms, outputs, filter, wrap, version, name
+        As in :func:`render_quad`.
+
+    Returns
+    -------
+    (height, width, 4) float32, or a list of them; pixels not covered keep the value 0.
+    """
+    size = _size(size)
+    F = np.asarray(F)
+    if F.ndim != 2 or F.shape[1] != 3 or F.dtype.kind not in "iu":
+        raise MeshError(
+            f"geomlib.gl.render_mesh: F must be an (m, 3) integer array, got shape {F.shape}, dtype {F.dtype}"
+        )
+    n = None
+    for key, a in attributes.items():
+        a = np.asarray(a)
+        if a.ndim != 2 or not 1 <= a.shape[1] <= 4 or (n is not None and len(a) != n):
+            raise MeshError(
+                f"geomlib.gl.render_mesh: attribute {key!r} has shape {a.shape}; expected (n, 1..4), same n for all"
+            )
+        n = len(a)
+    if n is None or F.size and (F.min() < 0 or F.max() >= n):
+        raise MeshError("geomlib.gl.render_mesh: F indexes vertices that have no attributes")
+    GL = _gl()
+    prog = _program(GL, vertex, fragment, name, version)
+    vao, buffers = _vertex_array(GL, prog, attributes)
+    idx = np.ascontiguousarray(F, dtype=np.uint32)
+    ebo = GL.glGenBuffers(1)
+    GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, ebo)
+    GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, idx.nbytes, idx, GL.GL_STATIC_DRAW)
+
+    def draw():
+        GL.glEnable(GL.GL_DEPTH_TEST)
+        GL.glBindVertexArray(vao)
+        GL.glDrawElements(GL.GL_TRIANGLES, idx.size, GL.GL_UNSIGNED_INT, ctypes.c_void_p(0))
+        GL.glDisable(GL.GL_DEPTH_TEST)
+
+    try:
+        out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
+    finally:
+        GL.glBindVertexArray(0)
+        GL.glDeleteBuffers(len(buffers) + 1, [*buffers, ebo])
+        GL.glDeleteVertexArrays(1, [vao])
+    return out[0] if outputs == 1 else out

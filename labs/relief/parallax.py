@@ -1,0 +1,51 @@
+"""Task 2: parallax mapping — one shift of uv along the view direction, with or without offset limiting."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.validate import check_float
+
+from .inputs import check_directions, check_height, check_scale, check_uv_points, height_at
+
+__all__ = ["parallax_uv"]
+
+
+def parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, offset_limit: bool = False) -> np.ndarray:
+    """Texture coordinates seen through the relief, approximated by one shift (Kaneko et al. 2001).
+
+    The view ray enters the polygon at ``uv`` and goes down, away from the eye; at depth ``d`` it
+    is at ``uv - d * view_xy / view_z``. Parallax mapping takes the depth of the surface AT ``uv``
+    as if it held along the whole ray. With the height scaled and biased,
+    ``hsb = scale * h(uv) + bias`` (``bias = -scale`` by default: the relief lies below the polygon,
+    ``-hsb`` is the depth ``scale * (1 - h)``)::
+
+        uv' = uv + hsb * view_xy / view_z          (parallax mapping)
+        uv' = uv + hsb * view_xy                   (offset limiting, Welsh 2004)
+
+    Offset limiting does not make the result more accurate: it caps the shift at ``|hsb|``, so
+    at grazing angles (``view_z -> 0``) the texture no longer swims far away.
+
+    Parameters
+    ----------
+    height : (s, s) float in [0, 1], uint8 or uint16
+    uv : (..., 2) float
+    view : (3,) or (..., 3) float
+        Tangent-space direction towards the eye (normalised here), ``z > 0``.
+    scale : float >= 0
+        Depth of the relief (UV units) where ``h = 0``.
+    bias : float, optional
+        Default ``-scale``.
+    offset_limit : bool
+
+    Returns
+    -------
+    (..., 2) float64
+    """
+    where = "parallax_uv"
+    H = check_height(height, where)
+    uv = check_uv_points(uv, where)
+    V = check_directions(view, uv.shape[:-1], where)
+    scale = check_scale(scale, where)
+    bias = -scale if bias is None else check_float(bias, "bias", where=where)
+    raise NotImplementedError("Task 2 (parallax): hsb = scale h(uv) + bias; uv' = uv + hsb view_xy / view_z (offset limiting: uv + hsb view_xy)")

@@ -1,0 +1,123 @@
+"""Given: run the lab's GLSL shaders (``shaders/*.frag``, tasks 2-4) headless, with the NumPy functions' signatures.
+
+``glsl_parallax_uv``, ``glsl_relief_uv`` and ``glsl_relief_shadow`` take the same arguments as
+:func:`parallax_uv`, :func:`relief_uv` and :func:`relief_shadow` (on a grid of pixels: ``uv`` is
+``(h, w, 2)``) and return the same values, computed by ``shaders/parallax.frag``,
+``shaders/relief.frag`` and ``shaders/shadow.frag`` in single precision on the GPU (llvmpipe,
+through :mod:`geomlib.gl`). The graders compare them with the NumPy reference outputs.
+
+Every pixel is one fragment; its inputs (``uv``, ``view``, ``depth``, ``light``) arrive as float
+textures read with ``texelFetch`` at the fragment's own pixel, so the shader sees the same values
+as the NumPy code (rounded to float32).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geomlib import gl
+from geomlib.validate import MeshError, as_array, check_choice, check_float
+
+from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points
+from .relief import REFINEMENTS
+
+__all__ = ["SHADERS", "shader_path", "glsl_parallax_uv", "glsl_relief_uv", "glsl_relief_shadow"]
+
+#: The shader files of the lab, in task order.
+SHADERS = ("parallax", "relief", "shadow")
+
+
+def shader_path(name: str) -> Path:
+    """``shaders/<name>.frag`` next to this file."""
+    return Path(__file__).resolve().parent / "shaders" / f"{name}.frag"
+
+
+def _run(name: str, size: tuple[int, int], textures: dict, uniforms: dict) -> np.ndarray:
+    path = shader_path(name)
+    source = path.read_text()
+    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
+    if todo:
+        raise NotImplementedError(f"shaders/{name}.frag: {todo[0]}")
+    return gl.render_quad(source, size, textures=textures, uniforms=uniforms, name=f"shaders/{name}.frag")
+
+
+def _grid(uv, where: str) -> np.ndarray:
+    uv = check_uv_points(uv, where)
+    if uv.ndim != 3:
+        raise MeshError(f"{where}: uv has shape {uv.shape}; the GLSL route renders images, expected (h, w, 2)")
+    return uv
+
+
+def glsl_parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, offset_limit: bool = False):
+    """:func:`parallax_uv` computed by ``shaders/parallax.frag``; ``uv`` is ``(h, w, 2)``."""
+    where = "glsl_parallax_uv"
+    H = check_height(height, where)
+    uv = _grid(uv, where)
+    V = check_directions(view, uv.shape[:-1], where)
+    scale = check_scale(scale, where)
+    bias = -scale if bias is None else check_float(bias, "bias", where=where)
+    out = _run(
+        "parallax",
+        (uv.shape[1], uv.shape[0]),
+        {"height": H, "uv_in": uv, "view_in": V},
+        {"scale": scale, "bias": bias, "offset_limit": int(bool(offset_limit))},
+    )
+    return out[..., :2].astype(np.float64)
+
+
+def glsl_relief_uv(
+    height,
+    uv,
+    view,
+    *,
+    scale: float,
+    min_layers: int = 8,
+    max_layers: int = 32,
+    refine: str = "secant",
+    refine_steps: int = 5,
+):
+    """:func:`relief_uv` computed by ``shaders/relief.frag``; ``uv`` is ``(h, w, 2)``."""
+    where = "glsl_relief_uv"
+    H = check_height(height, where)
+    uv = _grid(uv, where)
+    V = check_directions(view, uv.shape[:-1], where)
+    scale = check_scale(scale, where)
+    lo = check_layers(min_layers, "min_layers", where)
+    hi = check_layers(max_layers, "max_layers", where)
+    if hi < lo:
+        raise MeshError(f"{where}: max_layers ({hi}) must be >= min_layers ({lo})")
+    check_choice(refine, "refine", REFINEMENTS, where=where)
+    steps = check_layers(refine_steps, "refine_steps", where, minimum=0)
+    out = _run(
+        "relief",
+        (uv.shape[1], uv.shape[0]),
+        {"height": H, "uv_in": uv, "view_in": V},
+        {
+            "scale": scale,
+            "min_layers": lo,
+            "max_layers": hi,
+            "refine": REFINEMENTS.index(refine),
+            "refine_steps": steps,
+        },
+    )
+    return out[..., :2].astype(np.float64), out[..., 2].astype(np.float64), np.rint(out[..., 3]).astype(np.int64)
+
+
+def glsl_relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32):
+    """:func:`relief_shadow` computed by ``shaders/shadow.frag``; ``uv`` is ``(h, w, 2)``."""
+    where = "glsl_relief_shadow"
+    H = check_height(height, where)
+    uv = _grid(uv, where)
+    D = as_array(depth, "depth", dtype=np.float64, where=where)
+    if D.shape != uv.shape[:-1]:
+        raise MeshError(f"{where}: depth has shape {D.shape}; expected {uv.shape[:-1]}, one depth per uv")
+    L = check_directions(light, uv.shape[:-1], where, name="light")
+    out = _run(
+        "shadow",
+        (uv.shape[1], uv.shape[0]),
+        {"height": H, "uv_in": uv, "depth_in": D, "light_in": L},
+        {"scale": check_scale(scale, where), "layers": check_layers(layers, "layers", where)},
+    )
+    return out[..., 0].astype(np.float64)

@@ -1,0 +1,71 @@
+"""Task 4: self-shadowing — march from the hit point towards the light through the height field."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib.validate import MeshError, as_array
+
+from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points, height_at
+
+__all__ = ["relief_shadow"]
+
+
+def relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32) -> np.ndarray:
+    """Visibility of the light from the relief point at ``uv``, ``depth`` (1 lit, 0 in shadow).
+
+    The shadow ray leaves the hit point (``uv``, ``depth`` below the polygon) towards the light
+    and rises to the polygon in ``layers`` equal steps; at step ``k = 1 .. layers``::
+
+        d_k  = depth (1 - k / layers)                       (its depth)
+        uv_k = uv + (depth - d_k) light_xy / light_z        (where it is)
+
+    The point is in shadow when some ray point lies below the relief, ``d_k > scale (1 - h(uv_k))``
+    (a hard shadow; at ``k = layers`` the ray is at the polygon, above every relief point).
+
+    Parameters
+    ----------
+    height : (s, s) float in [0, 1], uint8 or uint16
+    uv : (..., 2) float
+        Hit points, e.g. from :func:`relief_uv`.
+    depth : (...) float >= 0
+        Their depth below the polygon (UV units), e.g. from :func:`relief_uv`.
+    light : (3,) or (..., 3) float
+        Tangent-space direction towards the light (normalised here), ``z > 0``.
+    scale : float >= 0
+        The relief's depth scale (the one the hits were found with).
+    layers : int >= 1
+
+    Returns
+    -------
+    (...) float64 in {0, 1}
+
+    Notes
+    -----
+    Loops over the ``layers`` steps (each a vectorised lookup for every pixel not yet in shadow).
+    """
+    where = "relief_shadow"
+    H = check_height(height, where)
+    uv = check_uv_points(uv, where)
+    shape = uv.shape[:-1]
+    D = as_array(depth, "depth", dtype=np.float64, where=where)
+    if D.shape != shape:
+        raise MeshError(f"{where}: depth has shape {D.shape}; expected {shape}, one depth per uv")
+    if (D < 0).any():
+        raise MeshError(f"{where}: depth has negative values (min {D.min():.6g}); depths below the polygon are >= 0")
+    L = check_directions(light, shape, where, name="light")
+    scale = check_scale(scale, where)
+    n = check_layers(layers, "layers", where)
+    # BEGIN SOLUTION: Task 4 (shadow): d_k = depth (1 - k/layers), uv_k = uv + (depth - d_k) light_xy / light_z; shadow if any d_k > scale (1 - h(uv_k))
+    slope = (L[..., :2] / L[..., 2:3]).reshape(-1, 2)
+    d0, p0 = D.ravel(), uv.reshape(-1, 2)
+    lit = np.ones(d0.size, dtype=bool)
+    alive = np.flatnonzero(d0 > 0)  # a point at the polygon has nothing above it
+    for k in range(1, n):  # k = n is at the polygon, above every relief point
+        d_k = d0[alive] * (1.0 - k / n)
+        p = p0[alive] + (d0[alive] - d_k)[:, None] * slope[alive]
+        under = d_k > scale * (1.0 - height_at(H, p[:, 0], p[:, 1]))
+        lit[alive[under]] = False
+        alive = alive[~under]  # once in shadow, always in shadow
+    return lit.astype(np.float64).reshape(shape)
+    # END SOLUTION
