@@ -11,13 +11,15 @@ dense grid displaced by the height field, rasterized the same way.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
+from geomlib.plot import Figure, colorbar, figures_or_placeholders, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
+from geomlib.viewer import write_html
 
 from .bump import bump_normal
 from .heights import bricks, bumps
@@ -27,7 +29,10 @@ from .shadow import relief_shadow
 from .silhouette import inside_texture
 from .truth import exact_uv, uv_error_texels
 
-__all__ = ["make_figures", "quad_gbuffer", "shade"]
+__all__ = ["make_figures", "make_view", "quad_gbuffer", "shade"]
+
+#: Tasks whose panels the figure being drawn had to leave out (its caption then names the first).
+_MISSING: list[str] = []
 
 LAB = "relief"
 SCALE = 0.08
@@ -75,6 +80,8 @@ def _try(fn, size):
     try:
         return fn(), None
     except NotImplementedError as e:
+        task = re.search(r"Task (\d+[a-z]?)", str(e))
+        _MISSING.append(task.group(1) if task else "?")
         return None, f" (not implemented yet: {str(e).split(':')[0]})"
 
 
@@ -217,7 +224,9 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Figure:
                         if m == "parallax"
                         else relief_uv(H, uv, V, scale=SCALE, refine=m)[0]
                     )
-                except NotImplementedError:
+                except NotImplementedError as e:
+                    task = re.search(r"Task (\d+[a-z]?)", str(e))
+                    _MISSING.append(task.group(1) if task else "?")
                     continue
                 e = np.percentile(uv_error_texels(got, truth, 256), 99)
                 curves.setdefault(f"{m} ({kind})", []).append(max(e, 1e-6))
@@ -250,7 +259,9 @@ def _fig_steps(out: Path, quick: bool) -> Figure:
     mask, uv, view, _, _ = quad_gbuffer(size)
     try:
         _, _, steps = relief_uv(H, uv, view, scale=SCALE, refine="none")
-    except NotImplementedError:
+    except NotImplementedError as e:
+        task = re.search(r"Task (\d+[a-z]?)", str(e))
+        _MISSING.append(task.group(1) if task else "?")
         img = panels([_missing(size)], ["relief_uv: not implemented yet"])
     else:
         from .relief import layer_count
@@ -276,22 +287,78 @@ def _fig_steps(out: Path, quick: bool) -> Figure:
     )
 
 
-def make_figures(out_dir: Path, lab: str | None = None, quick: bool = False) -> list[Figure]:
+def _named_missing(build, out: Path, quick: bool) -> list[Figure]:
+    """Draw one figure builder; where panels had to be left out, each caption starts with the missing task."""
+    _MISSING.clear()
+    figs = build(out, quick)
+    figs = figs if isinstance(figs, list) else [figs]
+    if _MISSING:
+        figs = [
+            Figure(f.path, f"Task {_MISSING[0]} not implemented yet; the other panels show: {f.caption}", f.lab)
+            for f in figs
+        ]
+    return figs
+
+
+def make_figures(out_dir: Path, lab=None, quick: bool = False) -> list[Figure]:
     """Render the lab's figures into ``out_dir`` and return them with captions.
 
     Parameters
     ----------
     out_dir : Path
         Folder for the PNG files (created).
-    lab : str, optional
-        Ignored (the figures command passes it for some labs).
+    lab : module, optional
+        Ignored (the figures use the functions of the package this file is in).
     quick : bool
         Smaller images (for the notebook and tests).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    figs = _fig_methods(out, quick)
-    figs.append(_fig_errors(out, quick))
-    figs.append(_fig_error_vs_angle(out, quick))
-    figs.append(_fig_steps(out, quick))
+    figs: list[Figure] = []
+    names = {_fig_methods: "methods_bumps", _fig_errors: "uv_error", _fig_error_vs_angle: "error_vs_angle"}
+    for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps):
+
+        def draw(o, q, b=build):
+            return _named_missing(b, o, q)
+
+        draw.figure_name = names.get(build, "steps")  # the placeholder's file when the figure cannot be drawn
+        figs += figures_or_placeholders((draw,), out, LAB, quick)
     return figs
+
+
+def fig_view(out: Path, quick: bool) -> Figure:
+    H = bricks(64 if quick else 128)
+    s = H.shape[0]
+    Vg, F = datasets.grid_patch(s - 1)
+    V = Vg.copy()
+    V[:, :2] = Vg[:, :2] * (s - 1) / s + 0.5 / s
+    r = np.clip(((1 - V[:, 1]) * s).astype(int), 0, s - 1)
+    c = np.clip((V[:, 0] * s).astype(int), 0, s - 1)
+    V[:, 2] = -SCALE * (1 - H[r, c])  # the relief lies below the polygon
+    n = bump_normal(H, V[:, :2], strength=SCALE)
+    tilt = np.degrees(np.arccos(np.clip(n[:, 2] / np.linalg.norm(n, axis=1), -1, 1)))
+    path = write_html(
+        out / "relief_3d.html", V, F, tilt, title="Bricks as real geometry", up="z",
+        cmap="viridis", scalar_name="bump-normal tilt (degrees)",
+    )  # fmt: skip
+    return Figure(
+        path,
+        "Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured by "
+        "how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
+        "this relief on one flat quad; seen edge-on, that quad's silhouette stays a straight line.",
+        LAB,
+    )
+
+
+fig_view.figure_name = "relief_3d"
+
+
+def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+    """Write the lab's interactive 3D view, ``relief_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+
+    Same arguments as :func:`make_figures`; before Task 1 is implemented, the returned figure is a
+    "Task 1 not implemented yet" picture instead.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders((fig_view,), out, LAB, quick)[0]
