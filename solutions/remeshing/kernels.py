@@ -297,8 +297,10 @@ def flip_check(V, F, T, VH, val, feat, h, hes, nb1):
         return CONSTRAINED
     a, b = org(F, h), dst(F, h)
     c, d = org(F, pv(h)), org(F, pv(t))
-    if c == d or val[a] <= 3 or val[b] <= 3:
+    if c == d:
         return VALENCE
+    if val[a] <= (2 if _on_boundary(F, T, VH, a, hes) else 3) or val[b] <= (2 if _on_boundary(F, T, VH, b, hes) else 3):
+        return VALENCE  # each end keeps at least 3 edges inside, 2 on the boundary
     k = neighbours(F, T, VH, c, hes, nb1)
     if k < 0:
         return VALENCE
