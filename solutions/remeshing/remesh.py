@@ -109,8 +109,9 @@ def make_state(V, F, feature_edges=None, *, preserve_boundary: bool = True, wher
     """Build the kernels' state of a checked manifold triangle mesh.
 
     ``feature_edges`` (k, 2) vertex pairs are kept as feature lines; with ``preserve_boundary``
-    the boundary edges are too. A vertex on two feature edges slides along them (class 1); on one
-    or more than two it is a corner (class 2) and stays put.
+    the boundary edges are too. A vertex on two feature edges slides along them (class 1) unless
+    the line turns there by more than 45°; there, and on one or more than two feature edges, it is
+    a corner (class 2) and stays put.
     """
     H = topology.halfedge_mesh(F, len(V), manifold=True, checked=True, where=where)
     T = H.twin
@@ -122,6 +123,15 @@ def make_state(V, F, feature_edges=None, *, preserve_boundary: bool = True, wher
     first = feat & ((T < 0) | (np.arange(len(T)) < T))  # each feature edge once
     count = np.bincount(np.r_[a[first], b[first]], minlength=len(V))
     cls = np.where(count == 0, 0, np.where(count == 2, 1, 2))
+    # a line that turns by more than 45 degrees at a vertex (a square's corner) has a corner there:
+    # |d1 + d2|^2 = 2 + 2 cos(angle between the two edge directions) > 2 - sqrt(2)
+    ea, eb = a[first], b[first]
+    d = V[eb] - V[ea]
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    s = np.zeros((len(V), 3))
+    np.add.at(s, ea, d)
+    np.add.at(s, eb, -d)
+    cls[(cls == 1) & ((s**2).sum(axis=1) > 2 - np.sqrt(2))] = 2
     return RemeshState(V, F, T, cls, feat)
 
 
