@@ -64,7 +64,18 @@ def lab_names(impl: str | os.PathLike | None = "solutions") -> list[str]:
     """Labs that have graded tests, in course order if known (folders under ``tests/graded``)."""
     graded = tests_dir() / "graded"
     names = sorted(p.name for p in graded.iterdir() if p.is_dir() and not p.name.startswith(("_", ".")))
-    order = ["sample", "subdivision", "simplification", "maps", "denoise", "shadows", "vdm", "sdf", "relief"]
+    order = [
+        "sample",
+        "subdivision",
+        "simplification",
+        "remeshing",
+        "maps",
+        "denoise",
+        "shadows",
+        "vdm",
+        "sdf",
+        "relief",
+    ]
     return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
 
 

@@ -32,7 +32,23 @@ __all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secr
 
 _SKIP_DIRS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache", ".ruff_cache"}
 _TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version"]
-_TEXT_SUFFIXES = {".py", ".frag", ".vert", ".glsl", ".md", ".ipynb", ".txt", ".toml", ".json", ".cfg", ".sh", ".yml", ".yaml", ".rst", ""}
+_TEXT_SUFFIXES = {
+    ".py",
+    ".frag",
+    ".vert",
+    ".glsl",
+    ".md",
+    ".ipynb",
+    ".txt",
+    ".toml",
+    ".json",
+    ".cfg",
+    ".sh",
+    ".yml",
+    ".yaml",
+    ".rst",
+    "",
+}
 
 
 class ReleaseError(RuntimeError):

@@ -1,0 +1,183 @@
+"""Benchmark: lab "remeshing" (isotropic remeshing) against gpytoolbox's ``remesh_botsch``, in one run.
+
+Run: ``uv run python bench/remeshing.py [--quick] [--iterations N]``
+
+gpytoolbox is a benchmark-only tool, not a dependency of the course: it is looked up in a
+throwaway virtual environment (``--gpy-python``, default ``/tmp/gpyvenv/bin/python``; make it with
+``uv venv /tmp/gpyvenv && VIRTUAL_ENV=/tmp/gpyvenv uv pip install gpytoolbox``) and run there in a
+subprocess on the same input, timed inside that process. Without it the comparison is skipped
+with a message.
+
+Per mesh it prints, for ours and gpytoolbox: time (best of 2), faces, minimum angle, share of
+angles below 30°, edge-length std / mean, valence-6 share of interior vertices, Hausdorff distance
+to the input relative to the bbox diagonal (``geomlib.geometry.mesh_distance``), and the time
+ratio. It also reports the kernels' first-call cost: compile (fresh numba cache, in a subprocess)
+and cache load.
+
+Meshes: ``../shared/data/meshes`` when present (bunny_hr to h = 0.03 as in issue 18, an
+irregular 8k-face igl.qslim output of it to h = 0.015, fandisk with features, camelhead with its
+boundary), else the built-in bumpy sphere and height field.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import igl
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from geomlib import datasets, topology  # noqa: E402
+from geomlib.geometry import mesh_distance  # noqa: E402
+from solutions.remeshing import isotropic_remesh  # noqa: E402
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
+
+GPY_SCRIPT = r"""
+import sys, time, json, numpy as np
+from gpytoolbox import remesh_botsch
+d = np.load(sys.argv[1])
+V, F, h, its = d["V"], d["F"].astype(np.int32), float(d["h"]), int(d["its"])
+fe = d["feature_edges"].reshape(-1, 2).astype(np.int32)
+best = np.inf
+for _ in range(2):
+    t = time.perf_counter()
+    U, G = remesh_botsch(V, F, i=its, h=h, feature_edges=fe if len(fe) else None, project=True)
+    best = min(best, time.perf_counter() - t)
+np.savez(sys.argv[2], V=U, F=G, t=best)
+"""
+
+
+def quality(V0, F0, V, F) -> dict:
+    H = topology.halfedge_mesh(F, len(V), manifold=True)
+    e = np.linalg.norm(V[H.E[:, 0]] - V[H.E[:, 1]], axis=1)
+    ang = []
+    for k in range(3):
+        a, b = V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]
+        c = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        ang.append(np.degrees(np.arccos(np.clip(c, -1, 1))))
+    ang = np.concatenate(ang)
+    inner = ~H.boundary_vertex
+    return {
+        "faces": len(F),
+        "min_angle": float(ang.min()),
+        "below_30": float(np.mean(ang < 30)),
+        "edge_cv": float(e.std() / e.mean()),
+        "valence6": float(np.mean(H.valence[inner] == 6)),
+        "hausdorff": mesh_distance(V0, F0, V, F, n_samples=50_000)["hausdorff"],
+    }
+
+
+def meshes(quick: bool) -> list:
+    out = []
+    if SHARED.exists() and not quick:
+        V, F = igl.read_triangle_mesh(str(SHARED / "bunny_hr.obj"))
+        F = F.astype(np.int64)
+        out.append(("bunny_hr", V, F, None, None))
+        U, G, *_ = igl.qslim(V, F.astype(np.int32), 8000)
+        out.append(("bunny qslim 8k", U, G.astype(np.int64), None, None))
+        for name, fa in (("fandisk.obj", 45.0), ("camelhead.off", None)):
+            if (SHARED / name).exists():
+                V2, F2 = igl.read_triangle_mesh(str(SHARED / name))
+                out.append((name.split(".")[0], V2, F2.astype(np.int64), None, fa))
+    else:
+        V, F = datasets.icosphere(4)
+        out.append(("bumpy sphere", datasets.add_noise(V, 0.01, seed=0, direction="normal", F=F), F, None, None))
+        out.append(("height field", *datasets.height_field(48), None, None))
+    return out
+
+
+def target(name, V, F):
+    from geomlib.geometry import mean_edge_length
+
+    if name == "bunny_hr":
+        return 0.03  # issue 18: about 2x its mean edge (0.0149)
+    if name == "bunny qslim 8k":
+        return 0.015
+    return 1.0 * mean_edge_length(V, F)
+
+
+def run_gpy(py, V, F, h, its, feature_angle):
+    with tempfile.TemporaryDirectory() as tmp:
+        feat = np.zeros((0, 2), np.int64)
+        if feature_angle is not None:  # the same sharp edges for both
+            from solutions.remeshing import sharp_edges
+
+            feat = sharp_edges(V, F, feature_angle)
+        np.savez(f"{tmp}/in.npz", V=V, F=F, h=h, its=its, feature_edges=feat)
+        r = subprocess.run([py, "-c", GPY_SCRIPT, f"{tmp}/in.npz", f"{tmp}/out.npz"], capture_output=True, text=True)
+        if r.returncode:
+            return None, r.stderr.strip().splitlines()[-1] if r.stderr else "failed"
+        d = np.load(f"{tmp}/out.npz")
+        return (d["V"], d["F"].astype(np.int64), float(d["t"])), None
+
+
+def first_call_costs() -> dict:
+    code = (
+        "import time; t = time.perf_counter(); from geomlib import datasets; "
+        "from solutions.remeshing import isotropic_remesh as r; V, F = datasets.icosphere(1); "
+        "r(V, F, 0.5, iterations=1); print(time.perf_counter() - t)"
+    )
+    out = {}
+    with tempfile.TemporaryDirectory() as cache:
+        for label in ("compile (empty numba cache)", "cache load"):
+            env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+            r = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True)
+            out[label] = float(r.stdout.strip() or "nan")
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--iterations", type=int, default=10)
+    ap.add_argument("--gpy-python", default="/tmp/gpyvenv/bin/python")
+    args = ap.parse_args()
+    have_gpy = (
+        Path(args.gpy_python).exists()
+        and subprocess.run([args.gpy_python, "-c", "import gpytoolbox"], capture_output=True).returncode == 0
+    )
+    if not have_gpy:
+        print(f"gpytoolbox not found at {args.gpy_python}: comparison skipped (see the module docstring)")
+    costs = first_call_costs()
+    print(
+        "first call of isotropic_remesh (tiny mesh, fresh process): "
+        + ", ".join(f"{k} {v:.2f} s" for k, v in costs.items())
+    )
+    isotropic_remesh(*datasets.icosphere(1), 0.5, iterations=1)  # warm up in this process
+    rows = []
+    for name, V, F, _, fa in meshes(args.quick):
+        h = target(name, V, F)
+        best, res = np.inf, None
+        for _ in range(2):
+            t = time.perf_counter()
+            res = isotropic_remesh(V, F, h, iterations=args.iterations, feature_angle=fa)
+            best = min(best, time.perf_counter() - t)
+        q = {"time": best, **quality(V, F, *res)}
+        rows.append((name, "ours", q))
+        if have_gpy:
+            g, err = run_gpy(args.gpy_python, V, F, h, args.iterations, fa)
+            if g is None:
+                print(f"{name}: gpytoolbox failed: {err}")
+            else:
+                qg = {"time": g[2], **quality(V, F, g[0], g[1])}
+                rows.append((name, "gpytoolbox", qg))
+                print(f"{name}: h = {h:.4g}, time ratio ours / gpytoolbox = {best / g[2]:.2f}")
+    cols = ("time", "faces", "min_angle", "below_30", "edge_cv", "valence6", "hausdorff")
+    print(f"{'mesh':<16}{'method':<12}" + "".join(f"{c:>11}" for c in cols))
+    for name, who, q in rows:
+        print(f"{name:<16}{who:<12}" + "".join(f"{q[c]:>11.4g}" for c in cols))
+    print(json.dumps({"first_call": costs}))
+
+
+if __name__ == "__main__":
+    main()

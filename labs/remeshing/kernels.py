@@ -1,0 +1,181 @@
+"""Local operations (split, collapse, flip) on a mutable corner table, compiled with numba.
+
+Why not edit :class:`geomlib.topology.HalfEdgeMesh` directly: it is frozen (its cached fields
+could otherwise go stale), so every edit would rebuild it in O(h log h). The remeshing loop does
+tens of thousands of local edits, so they run here on plain arrays and the structure is rebuilt
+(and checked) around them once per public call.
+
+The state (all arrays, edited in place):
+
+* ``V (ncap, 3)`` positions, ``F (mcap, 3)`` faces; half-edge ``h = 3 f + k`` runs from
+  ``F[f, k]`` to ``F[f, (k + 1) % 3]``;
+* ``T (3 mcap,)`` twin half-edge, -1 on a boundary edge;
+* ``VH (ncap,)`` one outgoing half-edge of every vertex (-1 for a removed vertex);
+* ``val (ncap,)`` valence; ``cls (ncap,)`` 0 free, 1 on a feature line / boundary, 2 corner;
+* ``feat (3 mcap,)`` half-edge on a feature line (boundary included when it is preserved);
+* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows.
+
+Every kernel is ``@njit(cache=True)`` and also runs as plain Python with ``NUMBA_DISABLE_JIT=1``.
+The passes are loops over edges: the algorithm is inherently sequential (each edit changes what
+the next one sees), which is why it is compiled rather than vectorised.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Largest one-ring the kernels walk (a vertex with more faces is left alone).
+RING = 256
+
+# result codes of the operations
+OK, LINK, FLIP, LONG, CONSTRAINED, VALENCE, FULL = 0, 1, 2, 3, 4, 5, 6
+
+
+@njit(cache=True)
+def nx(h):
+    return 3 * (h // 3) + (h % 3 + 1) % 3
+
+
+@njit(cache=True)
+def pv(h):
+    return 3 * (h // 3) + (h % 3 + 2) % 3
+
+
+@njit(cache=True)
+def org(F, h):
+    return F[h // 3, h % 3]
+
+
+@njit(cache=True)
+def dst(F, h):
+    return F[h // 3, (h % 3 + 1) % 3]
+
+
+@njit(cache=True)
+def ring(F, T, VH, v, out):
+    """Outgoing half-edges of ``v``, one per face around it; returns their count (-1: too many)."""
+    h0 = VH[v]
+    if h0 < 0:
+        return 0
+    n = 0
+    h = h0
+    while True:
+        if n >= len(out):
+            return -1
+        out[n] = h
+        n += 1
+        p = T[pv(h)]
+        if p == h0:
+            return n
+        if p < 0:
+            break
+        h = p
+    t = T[h0]  # open fan: walk the other way from the start
+    while t >= 0:
+        h = nx(t)
+        if n >= len(out):
+            return -1
+        out[n] = h
+        n += 1
+        t = T[h]
+    return n
+
+
+@njit(cache=True)
+def neighbours(F, T, VH, v, hes, out):
+    """Distinct neighbour vertices of ``v``; returns their count (-1: too many)."""
+    n = ring(F, T, VH, v, hes)
+    if n < 0:
+        return -1
+    k = 0
+    for i in range(n):
+        for w in (dst(F, hes[i]), org(F, pv(hes[i]))):
+            seen = False
+            for j in range(k):
+                if out[j] == w:
+                    seen = True
+                    break
+            if not seen:
+                if k >= len(out):
+                    return -1
+                out[k] = w
+                k += 1
+    return k
+
+
+@njit(cache=True)
+def normal(a, b, c):
+    return np.cross(b - a, c - a)
+
+
+@njit(cache=True)
+def length(V, F, h):
+    d = V[dst(F, h)] - V[org(F, h)]
+    return np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+
+
+@njit(cache=True)
+def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
+    """Split the edge of half-edge ``h`` at ``p``: 2 faces become 4 (1 become 2 on the boundary)."""
+    raise NotImplementedError('Task 1 (edge split): new vertex m on a->b; (a,b,c) -> (a,m,c) + (m,b,c), likewise on the twin side')
+
+
+@njit(cache=True)
+def collapse_check(V, F, T, VH, val, cls, feat, h, p, high, hes, nb1, nb2):
+    """Can ``b = dst(h)`` be merged into ``a = org(h)`` at ``p``? Returns OK or the reason code."""
+    raise NotImplementedError('Task 2 (collapse checks): link condition N(a) ∩ N(b) = opposite vertices, no valence < 3, no flipped face, no edge > high')
+
+
+@njit(cache=True)
+def _on_boundary(F, T, VH, v, hes):
+    n = ring(F, T, VH, v, hes)
+    for i in range(n):
+        if T[hes[i]] < 0 or T[pv(hes[i])] < 0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def collapse(V, F, T, VH, val, cls, feat, falive, h, p, hes):
+    """Merge ``b = dst(h)`` into ``a = org(h)``, moving ``a`` to ``p`` (checks already passed)."""
+    raise NotImplementedError('Task 2 (edge collapse): delete the faces of a-b, glue their outer edges, rename b to a')
+
+
+@njit(cache=True)
+def flip_check(V, F, T, VH, val, feat, h, hes, nb1):
+    """Can the edge of ``h`` be flipped (interior, not a feature, both new faces valid)?"""
+    raise NotImplementedError('Task 3 (flip checks): interior non-feature edge, c-d not an edge yet, valences stay >= 3, new faces keep the old orientation')
+
+
+@njit(cache=True)
+def flip(V, F, T, VH, val, feat, h):
+    """Replace edge a-b of faces (a,b,c), (b,a,d) by c-d: faces (c,a,d) and (d,b,c)."""
+    raise NotImplementedError('Task 3 (edge flip): (a,b,c) + (b,a,d) -> (c,a,d) + (d,b,c), re-link the four outer twins')
+
+
+# --------------------------------------------------------------------------------------------
+# passes over all edges
+
+
+@njit(cache=True)
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
+    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+
+    Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
+    same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
+    triangle's height). Returns ``(splits, h)``; ``h < stop`` means the pass stopped for room.
+    """
+    raise NotImplementedError('Task 4 (split long edges): every edge with |e| > 4/3 L at its midpoint, one pass over the edges present at the start')
+
+
+@njit(cache=True)
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
+    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
+    raise NotImplementedError('Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint otherwise')
+
+
+@njit(cache=True)
+def flip_pass(V, F, T, VH, val, cls, feat, falive, cnt):
+    """Flip edges when that lowers Σ|valence - target| over their four vertices (6 inside, 4 on the boundary)."""
+    raise NotImplementedError('Task 6 (equalize valences): flip a-b to c-d when Σ|val - target| over a, b, c, d drops')

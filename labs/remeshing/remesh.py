@@ -1,0 +1,464 @@
+"""Isotropic remeshing (Botsch & Kobbelt 2004): the local operations, the loop's stages, the loop.
+
+The local operations run on a mutable corner table in compiled kernels (:mod:`.kernels`); the
+public functions take ``(V, F)`` or geomlib's :class:`~geomlib.topology.HalfEdgeMesh`, build the
+table, run the kernels and rebuild a checked structure around the result.
+
+References
+----------
+M. Botsch, L. Kobbelt, "A remeshing approach to multiresolution modeling", SGP 2004.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import topology
+from geomlib.errors import MeshError
+from geomlib.geometry import closest_points
+from geomlib.validate import check_float, check_int, check_mesh
+
+from . import kernels as K
+
+__all__ = [
+    "RemeshState",
+    "make_state",
+    "state_mesh",
+    "split_edge",
+    "collapse_edge",
+    "flip_edge",
+    "sharp_edges",
+    "split_long_edges",
+    "collapse_short_edges",
+    "equalize_valences",
+    "tangential_relaxation",
+    "project_to_surface",
+    "isotropic_remesh",
+]
+
+REASONS = {
+    K.LINK: "it breaks the link condition (the two ends share a neighbour that is not opposite the edge)",
+    K.FLIP: "a face around it would turn over or become degenerate",
+    K.LONG: "it would create an edge longer than the split bound",
+    K.CONSTRAINED: "the edge is on the boundary or a feature line",
+    K.VALENCE: "a vertex would be left with fewer than 3 edges",
+}
+
+
+# --------------------------------------------------------------------------------------------
+# given: the mutable state and its conversion from / to (V, F)
+
+
+class RemeshState:
+    """The arrays the kernels edit (see :mod:`.kernels`); ``args`` passes them in kernel order."""
+
+    def __init__(self, V, F, T, cls, feat):
+        n, m = len(V), len(F)
+        self.V = np.zeros((max(2 * n, 16), 3))
+        self.V[:n] = V
+        self.F = np.zeros((max(2 * m, 16), 3), np.int64)
+        self.F[:m] = F
+        self.T = np.full(3 * len(self.F), -1, np.int64)
+        self.T[: 3 * m] = T
+        self.feat = np.zeros(3 * len(self.F), bool)
+        self.feat[: 3 * m] = feat
+        self.falive = np.zeros(len(self.F), bool)
+        self.falive[:m] = True
+        self.VH = np.full(len(self.V), -1, np.int64)
+        self.VH[F.ravel()[::-1]] = np.arange(3 * m - 1, -1, -1)
+        self.val = np.zeros(len(self.V), np.int64)
+        self.val[:n] = np.bincount(topology.unique_edges(F).ravel(), minlength=n)
+        self.cls = np.zeros(len(self.V), np.int64)
+        self.cls[:n] = cls
+        self.cnt = np.array([n, m], np.int64)
+
+    def grow(self):
+        """Double the room for vertices and faces (a split pass stopped for room)."""
+        nv, nf = len(self.V), len(self.F)
+        self.V = np.r_[self.V, np.zeros((nv, 3))]
+        self.F = np.r_[self.F, np.zeros((nf, 3), np.int64)]
+        self.T = np.r_[self.T, np.full(3 * nf, -1, np.int64)]
+        self.feat = np.r_[self.feat, np.zeros(3 * nf, bool)]
+        self.falive = np.r_[self.falive, np.zeros(nf, bool)]
+        self.VH = np.r_[self.VH, np.full(nv, -1, np.int64)]
+        self.val = np.r_[self.val, np.zeros(nv, np.int64)]
+        self.cls = np.r_[self.cls, np.zeros(nv, np.int64)]
+
+    def faces(self) -> np.ndarray:
+        """Live faces (vertex indices of the state, removed vertices unused)."""
+        nf = self.cnt[1]
+        return self.F[:nf][self.falive[:nf]]
+
+    def feature_halfedges(self) -> np.ndarray:
+        nf = self.cnt[1]
+        h = np.flatnonzero(self.feat[: 3 * nf] & np.repeat(self.falive[:nf], 3))
+        return h
+
+
+def _edge_lookup(F: np.ndarray, n: int, pairs: np.ndarray) -> np.ndarray:
+    """Half-edge flags: True where the half-edge's undirected edge is one of ``pairs``."""
+    a, b = F.ravel(), F[:, [1, 2, 0]].ravel()
+    keys = np.minimum(a, b) * n + np.maximum(a, b)
+    if len(pairs) == 0:
+        return np.zeros(len(keys), bool)
+    pk = np.minimum(pairs[:, 0], pairs[:, 1]) * n + np.maximum(pairs[:, 0], pairs[:, 1])
+    return np.isin(keys, pk)
+
+
+def make_state(V, F, feature_edges=None, *, preserve_boundary: bool = True, where: str = "make_state") -> RemeshState:
+    """Build the kernels' state of a checked manifold triangle mesh.
+
+    ``feature_edges`` (k, 2) vertex pairs are kept as feature lines; with ``preserve_boundary``
+    the boundary edges are too. A vertex on two feature edges slides along them (class 1) unless
+    the line turns there by more than 45°; there, and on one or more than two feature edges, it is
+    a corner (class 2) and stays put.
+    """
+    H = topology.halfedge_mesh(F, len(V), manifold=True, checked=True, where=where)
+    T = H.twin
+    fe = np.zeros((0, 2), np.int64) if feature_edges is None else np.asarray(feature_edges, np.int64).reshape(-1, 2)
+    feat = _edge_lookup(F, len(V), fe)
+    if preserve_boundary:
+        feat |= T < 0
+    a, b = F.ravel(), F[:, [1, 2, 0]].ravel()
+    first = feat & ((T < 0) | (np.arange(len(T)) < T))  # each feature edge once
+    count = np.bincount(np.r_[a[first], b[first]], minlength=len(V))
+    cls = np.where(count == 0, 0, np.where(count == 2, 1, 2))
+    # a line that turns by more than 45 degrees at a vertex (a square's corner) has a corner there:
+    # |d1 + d2|^2 = 2 + 2 cos(angle between the two edge directions) > 2 - sqrt(2)
+    ea, eb = a[first], b[first]
+    d = V[eb] - V[ea]
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    s = np.zeros((len(V), 3))
+    np.add.at(s, ea, d)
+    np.add.at(s, eb, -d)
+    cls[(cls == 1) & ((s**2).sum(axis=1) > 2 - np.sqrt(2))] = 2
+    return RemeshState(V, F, T, cls, feat)
+
+
+def state_mesh(S: RemeshState) -> tuple[np.ndarray, np.ndarray]:
+    """The state's mesh as compact ``(V, F)``: removed vertices dropped, indices renumbered."""
+    F = S.faces()
+    used = np.zeros(S.cnt[0], bool)
+    used[F.ravel()] = True
+    new = np.cumsum(used) - 1
+    return S.V[: S.cnt[0]][used].copy(), new[F]
+
+
+def _state_feature_edges(S: RemeshState, F_old_to_new=None) -> np.ndarray:
+    h = S.feature_halfedges()
+    a, b = S.F[h // 3, h % 3], S.F[h // 3, (h % 3 + 1) % 3]
+    return np.unique(np.sort(np.c_[a, b], axis=1), axis=0) if len(h) else np.zeros((0, 2), np.int64)
+
+
+def _positive(x, name, where):
+    x = check_float(x, name, where=where)
+    if x <= 0:
+        raise MeshError(f"{where}: {name} must be > 0, got {x}")
+    return x
+
+
+def _args(S: RemeshState):
+    return S.V, S.F, S.T, S.VH, S.val, S.cls, S.feat, S.falive, S.cnt
+
+
+def _check_edge(H, edge, where):
+    e = check_int(edge, "edge", where=where, minimum=0)
+    if e >= H.n_edges:
+        raise MeshError(f"{where}: edge {e} does not exist (the mesh has {H.n_edges} edges)")
+    if (np.diff(H.off) != 3).any():
+        raise MeshError(f"{where}: the mesh must be made of triangles")
+    return e
+
+
+def _from_halfedges(V, H, where):
+    V = np.array(V, dtype=np.float64)
+    if V.ndim != 2 or V.shape != (H.n_vertices, 3):
+        raise MeshError(f"{where}: V has shape {V.shape}, expected ({H.n_vertices}, 3)")
+    F = H.idx.reshape(-1, 3)
+    S = make_state(V, F, preserve_boundary=False, where=where)
+    return S, F
+
+
+def _halfedge_of(H, e):
+    return int(H.EH[e, 0] if H.EH[e, 0] >= 0 else H.EH[e, 1])
+
+
+# --------------------------------------------------------------------------------------------
+# Task 1-3: the local operations on geomlib's half-edge structure
+
+
+def split_edge(V, H, edge):
+    """Split edge ``edge`` of ``H`` at its midpoint.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+    H : HalfEdgeMesh
+        A manifold triangle mesh (:func:`geomlib.topology.halfedge_mesh`).
+    edge : int
+        Row of ``H.E``.
+
+    Returns
+    -------
+    V : (n + 1, 3) float
+        The new vertex is the last row.
+    H : HalfEdgeMesh
+        Two more faces (one on a boundary edge); passes :func:`geomlib.topology.check_halfedges`.
+    """
+    where = "split_edge"
+    e = _check_edge(H, edge, where)
+    S, F = _from_halfedges(V, H, where)
+    a, b = H.E[e]
+    K.split(*_args(S), _halfedge_of(H, e), 0.5 * (S.V[a] + S.V[b]))
+    V2, F2 = S.V[: S.cnt[0]].copy(), S.faces()
+    return V2, topology.halfedge_mesh(F2, len(V2), checked=True)
+
+
+def collapse_edge(V, H, edge, *, high=np.inf):
+    """Collapse edge ``(a, b) = H.E[edge]``: ``b`` merges into ``a`` at the midpoint, or at the
+    position of the end on the boundary when only one end is.
+
+    Raises :class:`MeshError` naming the rule when the collapse is not allowed: the link condition
+    (``N(a) ∩ N(b)`` must be exactly the vertices opposite the edge), a face turning over, an edge
+    longer than ``high`` appearing, an interior edge joining two boundary vertices, a vertex left
+    with fewer than 3 edges.
+
+    Returns
+    -------
+    V : (n - 1, 3) float
+        Row ``b`` removed (later vertices move down one index).
+    H : HalfEdgeMesh
+    """
+    where = "collapse_edge"
+    e = _check_edge(H, edge, where)
+    high = _positive(high, "high", where) if np.isfinite(high) else np.inf
+    S, F = _from_halfedges(V, H, where)
+    h = _halfedge_of(H, e)
+    a, b = int(F.ravel()[h]), int(F[h // 3, (h % 3 + 1) % 3])
+    bnd = H.boundary_vertex
+    if bnd[b] and not bnd[a]:
+        if S.T[h] < 0:
+            raise MeshError(f"{where}: internal error (boundary edge with an interior end)")
+        h = int(S.T[h])
+        a, b = b, a
+    p = S.V[a].copy() if bnd[a] != bnd[b] else 0.5 * (S.V[a] + S.V[b])
+    hes, n1, n2 = (np.empty(K.RING, np.int64) for _ in range(3))
+    code = K.collapse_check(*_args(S)[:7], h, p, high, hes, n1, n2)
+    if code != K.OK:
+        raise MeshError(f"{where}: edge ({H.E[e, 0]}, {H.E[e, 1]}) cannot be collapsed: {REASONS[code]}")
+    K.collapse(*_args(S)[:8], h, p, hes)
+    V2, F2 = state_mesh(S)
+    return V2, topology.halfedge_mesh(F2, len(V2), checked=True)
+
+
+def flip_edge(V, H, edge):
+    """Flip interior edge ``a-b`` of faces ``(a, b, c)``, ``(b, a, d)`` to ``c-d``.
+
+    Raises :class:`MeshError` when the edge is on the boundary, ``c-d`` is already an edge, ``a``
+    or ``b`` would keep fewer than 3 edges, or a new face would turn over or be degenerate.
+
+    Returns
+    -------
+    V : (n, 3) float (unchanged)
+    H : HalfEdgeMesh
+        Same faces rows ``f`` and ``f2`` now ``(c, a, d)`` and ``(d, b, c)``.
+    """
+    where = "flip_edge"
+    e = _check_edge(H, edge, where)
+    S, F = _from_halfedges(V, H, where)
+    h = _halfedge_of(H, e)
+    hes, nb = np.empty(K.RING, np.int64), np.empty(K.RING, np.int64)
+    code = K.flip_check(S.V, S.F, S.T, S.VH, S.val, S.feat, h, hes, nb)
+    if code != K.OK:
+        raise MeshError(f"{where}: edge ({H.E[e, 0]}, {H.E[e, 1]}) cannot be flipped: {REASONS[code]}")
+    K.flip(S.V, S.F, S.T, S.VH, S.val, S.feat, h)
+    V2, F2 = S.V[: S.cnt[0]].copy(), S.faces()
+    return V2, topology.halfedge_mesh(F2, len(V2), checked=True)
+
+
+# --------------------------------------------------------------------------------------------
+# Task 7: features
+
+
+def sharp_edges(V, F, feature_angle):
+    """Edges whose dihedral angle (between the two face normals) exceeds ``feature_angle`` degrees.
+
+    Returns
+    -------
+    E : (k, 2) int64
+        Sorted vertex pairs, rows in lexicographic order.
+    """
+    where = "sharp_edges"
+    V, F = check_mesh(V, F, where=where, manifold=True)
+    angle = check_float(feature_angle, "feature_angle", where=where, minimum=0.0, maximum=180.0)
+    raise NotImplementedError('Task 7 (features): angle between the normals of the two faces of an interior edge > feature_angle')
+
+
+# --------------------------------------------------------------------------------------------
+# Tasks 4-6 and 8-9: the stages
+
+
+def _stage_input(V, F, feature_edges, where):
+    V, F = check_mesh(V, F, where=where, manifold=True)
+    if feature_edges is not None:
+        fe = np.asarray(feature_edges)
+        if fe.size and (fe.ndim != 2 or fe.shape[1] != 2 or fe.min() < 0 or fe.max() >= len(V)):
+            raise MeshError(f"{where}: feature_edges must be (k, 2) vertex indices below {len(V)}")
+    return V, F
+
+
+def _split_all(S: RemeshState, high: float) -> int:
+    total, h, stop = 0, 0, 3 * int(S.cnt[1])
+    while True:
+        done, h = K.split_pass(*_args(S), high, h, stop)
+        total += done
+        if h >= stop:
+            return total
+        S.grow()
+
+
+def split_long_edges(V, F, high, *, feature_edges=None, preserve_boundary=True):
+    """Split every edge longer than ``high`` at its midpoint, in one pass over the input's edges (stage 1).
+
+    Edges created by the pass are not split again in it (the next iteration of the loop sees
+    them); an edge longer than ``2 high`` therefore leaves two halves longer than ``high``.
+
+    Returns
+    -------
+    V, F : the refined mesh; the input vertices keep their indices and positions, new vertices follow.
+    """
+    where = "split_long_edges"
+    V, F = _stage_input(V, F, feature_edges, where)
+    high = _positive(high, "high", where)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    _split_all(S, high)
+    return state_mesh(S)
+
+
+def collapse_short_edges(V, F, low, high, *, feature_edges=None, preserve_boundary=True):
+    """Collapse edges shorter than ``low`` when the collapse is allowed (stage 2).
+
+    Constrained ends (boundary, feature lines, corners) keep their position; two free ends meet
+    at the midpoint. A collapse never creates an edge longer than ``high``.
+    """
+    where = "collapse_short_edges"
+    V, F = _stage_input(V, F, feature_edges, where)
+    low = _positive(low, "low", where)
+    high = _positive(high, "high", where)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    while K.collapse_pass(*_args(S), low, high):
+        pass
+    return state_mesh(S)
+
+
+def equalize_valences(V, F, *, feature_edges=None):
+    """Flip edges while that lowers Σ|valence − target| (target 6 inside, 4 on the boundary) (stage 3)."""
+    where = "equalize_valences"
+    V, F = _stage_input(V, F, feature_edges, where)
+    S = make_state(V, F, feature_edges, preserve_boundary=True, where=where)
+    for _ in range(10):
+        if not K.flip_pass(*_args(S)):
+            break
+    return state_mesh(S)
+
+
+def _line_tangents(V, E_feat, n):
+    """Unit tangent of the feature line at every vertex (principal direction of its feature edges)."""
+    d = V[E_feat[:, 1]] - V[E_feat[:, 0]]
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    M = np.zeros((n, 3, 3))
+    outer = d[:, :, None] * d[:, None, :]
+    np.add.at(M, E_feat[:, 0], outer)
+    np.add.at(M, E_feat[:, 1], outer)
+    return np.linalg.eigh(M)[1][:, :, 2]
+
+
+def _relax(V, F, cls, E_feat, damping):
+    """Tangential relaxation on faces ``F`` of ``V`` (rows no face uses are left alone)."""
+    n = len(V)
+    raise NotImplementedError('Task 8 (tangential relaxation): p += λ (I - n nᵀ)(c - p), c = Σ A_f c_f / Σ A_f; feature vertices along their line')
+
+
+def tangential_relaxation(V, F, *, damping=0.5, feature_edges=None, preserve_boundary=True):
+    """Move every vertex toward the area-weighted centroid of its faces, within its tangent plane (stage 4).
+
+    ``p ← p + λ (I − n nᵀ)(c − p)`` with ``c = Σ A_f c_f / Σ A_f`` over the faces around ``p``
+    (``c_f`` centroids, ``A_f`` areas), ``n`` the area-weighted vertex normal, ``λ = damping``.
+    Vertices on a feature line or the preserved boundary move along it toward the midpoint of their
+    two line neighbours; corners stay.
+
+    Returns
+    -------
+    V : (n, 3) float
+    """
+    where = "tangential_relaxation"
+    V, F = _stage_input(V, F, feature_edges, where)
+    lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    return _relax(V, F, S.cls[: len(V)], _state_feature_edges(S), lam)
+
+
+def _closest_on_segments(P, A, B, chunk=2048):
+    """Closest point of every row of ``P`` on the segments ``A[i]B[i]`` (brute force in chunks)."""
+    out = np.empty_like(P)
+    AB = B - A
+    L2 = np.maximum(np.einsum("ij,ij->i", AB, AB), 1e-300)
+    step = max(1, chunk * 256 // max(len(A), 1))
+    for s in range(0, len(P), step):
+        Q = P[s : s + step]
+        t = np.clip(np.einsum("qij,ij->qi", Q[:, None, :] - A[None], AB) / L2, 0.0, 1.0)
+        X = A[None] + t[:, :, None] * AB[None]
+        d = ((X - Q[:, None, :]) ** 2).sum(axis=2)
+        out[s : s + step] = X[np.arange(len(Q)), d.argmin(axis=1)]
+    return out
+
+
+def project_to_surface(P, V0, F0):
+    """Closest point of every row of ``P`` on the input surface ``(V0, F0)`` (stage 5).
+
+    Uses :func:`geomlib.geometry.closest_points` (libigl's AABB tree), which the lab gives.
+    """
+    where = "project_to_surface"
+    V0, F0 = check_mesh(V0, F0, where=where, vname="V0", fname="F0")
+    P = np.asarray(P, dtype=np.float64)
+    if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
+        raise MeshError(f"{where}: P must be a finite (k, 3) array, got shape {P.shape}")
+    raise NotImplementedError('Task 9 (projection): the closest point on the input surface')
+
+
+# --------------------------------------------------------------------------------------------
+# the loop
+
+
+def isotropic_remesh(V, F, target_length, *, iterations=10, feature_angle=None, preserve_boundary=True, damping=0.5):
+    """Remesh a triangle mesh toward equilateral triangles with edges of about ``target_length``.
+
+    Each iteration: split edges longer than ``4/3 L``; collapse edges shorter than ``4/5 L``;
+    flip edges to bring valences toward 6 (4 on the boundary); tangential relaxation; projection
+    of the vertices back onto the input (feature-line and boundary vertices onto the input's
+    lines, the others onto its surface).
+
+    Parameters
+    ----------
+    V : (n, 3) float
+    F : (m, 3) int
+        A manifold, consistently oriented triangle mesh.
+    target_length : float
+        ``L`` (same units as ``V``).
+    iterations : int
+    feature_angle : float, optional
+        Edges whose dihedral angle exceeds it (degrees) are kept as feature lines.
+    preserve_boundary : bool
+        Keep the boundary on the input boundary (boundary vertices slide along it).
+
+    Returns
+    -------
+    V, F : the remeshed surface (compact: every vertex used).
+    """
+    where = "isotropic_remesh"
+    V0, F0 = check_mesh(V, F, where=where, manifold=True)
+    L = _positive(target_length, "target_length", where)
+    its = check_int(iterations, "iterations", where=where, minimum=0)
+    lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
+    fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
+    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat')

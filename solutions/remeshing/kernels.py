@@ -1,0 +1,440 @@
+"""Local operations (split, collapse, flip) on a mutable corner table, compiled with numba.
+
+Why not edit :class:`geomlib.topology.HalfEdgeMesh` directly: it is frozen (its cached fields
+could otherwise go stale), so every edit would rebuild it in O(h log h). The remeshing loop does
+tens of thousands of local edits, so they run here on plain arrays and the structure is rebuilt
+(and checked) around them once per public call.
+
+The state (all arrays, edited in place):
+
+* ``V (ncap, 3)`` positions, ``F (mcap, 3)`` faces; half-edge ``h = 3 f + k`` runs from
+  ``F[f, k]`` to ``F[f, (k + 1) % 3]``;
+* ``T (3 mcap,)`` twin half-edge, -1 on a boundary edge;
+* ``VH (ncap,)`` one outgoing half-edge of every vertex (-1 for a removed vertex);
+* ``val (ncap,)`` valence; ``cls (ncap,)`` 0 free, 1 on a feature line / boundary, 2 corner;
+* ``feat (3 mcap,)`` half-edge on a feature line (boundary included when it is preserved);
+* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows.
+
+Every kernel is ``@njit(cache=True)`` and also runs as plain Python with ``NUMBA_DISABLE_JIT=1``.
+The passes are loops over edges: the algorithm is inherently sequential (each edit changes what
+the next one sees), which is why it is compiled rather than vectorised.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: Largest one-ring the kernels walk (a vertex with more faces is left alone).
+RING = 256
+
+# result codes of the operations
+OK, LINK, FLIP, LONG, CONSTRAINED, VALENCE, FULL = 0, 1, 2, 3, 4, 5, 6
+
+
+@njit(cache=True)
+def nx(h):
+    return 3 * (h // 3) + (h % 3 + 1) % 3
+
+
+@njit(cache=True)
+def pv(h):
+    return 3 * (h // 3) + (h % 3 + 2) % 3
+
+
+@njit(cache=True)
+def org(F, h):
+    return F[h // 3, h % 3]
+
+
+@njit(cache=True)
+def dst(F, h):
+    return F[h // 3, (h % 3 + 1) % 3]
+
+
+@njit(cache=True)
+def ring(F, T, VH, v, out):
+    """Outgoing half-edges of ``v``, one per face around it; returns their count (-1: too many)."""
+    h0 = VH[v]
+    if h0 < 0:
+        return 0
+    n = 0
+    h = h0
+    while True:
+        if n >= len(out):
+            return -1
+        out[n] = h
+        n += 1
+        p = T[pv(h)]
+        if p == h0:
+            return n
+        if p < 0:
+            break
+        h = p
+    t = T[h0]  # open fan: walk the other way from the start
+    while t >= 0:
+        h = nx(t)
+        if n >= len(out):
+            return -1
+        out[n] = h
+        n += 1
+        t = T[h]
+    return n
+
+
+@njit(cache=True)
+def neighbours(F, T, VH, v, hes, out):
+    """Distinct neighbour vertices of ``v``; returns their count (-1: too many)."""
+    n = ring(F, T, VH, v, hes)
+    if n < 0:
+        return -1
+    k = 0
+    for i in range(n):
+        for w in (dst(F, hes[i]), org(F, pv(hes[i]))):
+            seen = False
+            for j in range(k):
+                if out[j] == w:
+                    seen = True
+                    break
+            if not seen:
+                if k >= len(out):
+                    return -1
+                out[k] = w
+                k += 1
+    return k
+
+
+@njit(cache=True)
+def normal(a, b, c):
+    return np.cross(b - a, c - a)
+
+
+@njit(cache=True)
+def length(V, F, h):
+    d = V[dst(F, h)] - V[org(F, h)]
+    return np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+
+
+@njit(cache=True)
+def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
+    """Split the edge of half-edge ``h`` at ``p``: 2 faces become 4 (1 become 2 on the boundary)."""
+    # BEGIN SOLUTION: Task 1 (edge split): new vertex m on a->b; (a,b,c) -> (a,m,c) + (m,b,c), likewise on the twin side
+    t = T[h]
+    nf = cnt[1]
+    need = 2 if t >= 0 else 1
+    if cnt[0] + 1 > len(V) or nf + need > len(F):
+        return FULL
+    f, k = h // 3, h % 3
+    b, c = F[f, (k + 1) % 3], F[f, (k + 2) % 3]
+    m = cnt[0]
+    cnt[0] += 1
+    V[m] = p
+    hn = nx(h)
+    out_bc = T[hn]
+    g = nf
+    F[f, (k + 1) % 3] = m  # f = (a, m, c)
+    F[g, 0], F[g, 1], F[g, 2] = m, b, c  # g = (m, b, c)
+    falive[g] = True
+    g0, g1, g2 = 3 * g, 3 * g + 1, 3 * g + 2
+    T[g1] = out_bc
+    feat[g1] = feat[hn]
+    if out_bc >= 0:
+        T[out_bc] = g1
+    feat[hn] = False
+    T[hn], T[g2] = g2, hn
+    feat[g2] = False
+    feat[g0] = feat[h]
+    VH[m] = g0
+    VH[b] = g1
+    val[m] = 4 if t >= 0 else 3
+    val[c] += 1
+    cls[m] = 1 if feat[h] else 0
+    if t >= 0:
+        f2, k2 = t // 3, t % 3
+        d = F[f2, (k2 + 2) % 3]
+        q = nf + 1
+        tp = pv(t)
+        out_db = T[tp]
+        F[f2, k2] = m  # f2 = (m, a, d)
+        F[q, 0], F[q, 1], F[q, 2] = b, m, d  # q = (b, m, d)
+        falive[q] = True
+        q0, q1, q2 = 3 * q, 3 * q + 1, 3 * q + 2
+        T[q2] = out_db
+        feat[q2] = feat[tp]
+        if out_db >= 0:
+            T[out_db] = q2
+        feat[tp] = False
+        T[tp], T[q1] = q1, tp
+        feat[q1] = False
+        feat[q0] = feat[t]
+        T[h], T[t] = t, h
+        T[g0], T[q0] = q0, g0
+        val[d] += 1
+    else:
+        T[h] = -1
+        T[g0] = -1
+    cnt[1] = nf + need
+    return OK
+    # END SOLUTION
+
+
+@njit(cache=True)
+def collapse_check(V, F, T, VH, val, cls, feat, h, p, high, hes, nb1, nb2):
+    """Can ``b = dst(h)`` be merged into ``a = org(h)`` at ``p``? Returns OK or the reason code."""
+    # BEGIN SOLUTION: Task 2 (collapse checks): link condition N(a) ∩ N(b) = opposite vertices, no valence < 3, no flipped face, no edge > high
+    a, b = org(F, h), dst(F, h)
+    t = T[h]
+    c = org(F, pv(h))
+    d = org(F, pv(t)) if t >= 0 else -1
+    if t >= 0 and _on_boundary(F, T, VH, a, hes) and _on_boundary(F, T, VH, b, hes):
+        return LINK  # an interior edge joining two boundary points would pinch the surface
+    na = neighbours(F, T, VH, a, hes, nb1)
+    nb = neighbours(F, T, VH, b, hes, nb2)
+    if na < 0 or nb < 0:
+        return VALENCE
+    common = 0
+    for i in range(na):
+        for j in range(nb):
+            if nb1[i] == nb2[j]:
+                if nb1[i] != c and nb1[i] != d:
+                    return LINK
+                common += 1
+    if common != (2 if t >= 0 else 1):
+        return LINK
+    if val[c] <= 3 or (d >= 0 and val[d] <= 3):
+        return VALENCE
+    if na + nb - 2 - common < 3:
+        return VALENCE
+    for j in range(nb):  # the edges b had become edges of a
+        w = nb2[j]
+        if w != a:
+            e = V[w] - p
+            if np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2) > high:
+                return LONG
+    for v in (a, b):  # no face around a or b may turn over
+        n = ring(F, T, VH, v, hes)
+        for i in range(n):
+            g = hes[i]
+            x, y = dst(F, g), org(F, pv(g))
+            if x == a or x == b or y == a or y == b:
+                continue  # one of the two faces that disappear
+            n0 = normal(V[v], V[x], V[y])
+            n1 = normal(p, V[x], V[y])
+            l0 = np.sqrt(np.sum(n0 * n0))
+            l1 = np.sqrt(np.sum(n1 * n1))
+            if l1 <= 1e-12 * (1.0 + l0) or np.dot(n0, n1) < 0.2 * l0 * l1:
+                return FLIP
+    return OK
+    # END SOLUTION
+
+
+@njit(cache=True)
+def _on_boundary(F, T, VH, v, hes):
+    n = ring(F, T, VH, v, hes)
+    for i in range(n):
+        if T[hes[i]] < 0 or T[pv(hes[i])] < 0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def collapse(V, F, T, VH, val, cls, feat, falive, h, p, hes):
+    """Merge ``b = dst(h)`` into ``a = org(h)``, moving ``a`` to ``p`` (checks already passed)."""
+    # BEGIN SOLUTION: Task 2 (edge collapse): delete the faces of a-b, glue their outer edges, rename b to a
+    a, b = org(F, h), dst(F, h)
+    t = T[h]
+    n = ring(F, T, VH, b, hes)
+    for i in range(n):  # rename b -> a in every face around b
+        g = hes[i]
+        F[g // 3, g % 3] = a
+    c = org(F, pv(h))
+    x1, x2 = T[nx(h)], T[pv(h)]  # twins of b->c and c->a: (c->b, now) c->a and a->c
+    fe = feat[nx(h)] or feat[pv(h)]
+    if x1 >= 0:
+        T[x1] = x2
+        feat[x1] = fe or feat[x1]
+    if x2 >= 0:
+        T[x2] = x1
+        feat[x2] = fe or feat[x2]
+    falive[h // 3] = False
+    VH[c] = x1 if x1 >= 0 else nx(x2)
+    val[c] -= 1
+    cand = x2
+    if t >= 0:
+        d = org(F, pv(t))
+        y1, y2 = T[nx(t)], T[pv(t)]  # twins of a->d and d->b: d->a and (b->d, now) a->d
+        fe = feat[nx(t)] or feat[pv(t)]
+        if y1 >= 0:
+            T[y1] = y2
+            feat[y1] = fe or feat[y1]
+        if y2 >= 0:
+            T[y2] = y1
+            feat[y2] = fe or feat[y2]
+        falive[t // 3] = False
+        VH[d] = y1 if y1 >= 0 else nx(y2)
+        val[d] -= 1
+        if cand < 0:
+            cand = y2 if y2 >= 0 else (nx(y1) if y1 >= 0 else -1)
+        val[a] = val[a] + val[b] - 4
+    else:
+        val[a] = val[a] + val[b] - 3
+    if cand < 0:
+        cand = nx(x1)
+    VH[a] = cand
+    VH[b] = -1
+    cls[a] = max(cls[a], cls[b])
+    V[a] = p
+    return OK
+    # END SOLUTION
+
+
+@njit(cache=True)
+def flip_check(V, F, T, VH, val, feat, h, hes, nb1):
+    """Can the edge of ``h`` be flipped (interior, not a feature, both new faces valid)?"""
+    # BEGIN SOLUTION: Task 3 (flip checks): interior non-feature edge, c-d not an edge yet, valences stay >= 3, new faces keep the old orientation
+    t = T[h]
+    if t < 0 or feat[h]:
+        return CONSTRAINED
+    a, b = org(F, h), dst(F, h)
+    c, d = org(F, pv(h)), org(F, pv(t))
+    if c == d:
+        return VALENCE
+    if val[a] <= (2 if _on_boundary(F, T, VH, a, hes) else 3) or val[b] <= (2 if _on_boundary(F, T, VH, b, hes) else 3):
+        return VALENCE  # each end keeps at least 3 edges inside, 2 on the boundary
+    k = neighbours(F, T, VH, c, hes, nb1)
+    if k < 0:
+        return VALENCE
+    for i in range(k):
+        if nb1[i] == d:
+            return LINK
+    n_old1 = normal(V[a], V[b], V[c])
+    n_old2 = normal(V[b], V[a], V[d])
+    n1 = normal(V[c], V[a], V[d])
+    n2 = normal(V[d], V[b], V[c])
+    for nn in (n1, n2):
+        ln = np.sqrt(np.sum(nn * nn))
+        if ln <= 1e-12:
+            return FLIP
+        for no in (n_old1, n_old2):
+            if np.dot(nn, no) <= 0.0:
+                return FLIP
+    return OK
+    # END SOLUTION
+
+
+@njit(cache=True)
+def flip(V, F, T, VH, val, feat, h):
+    """Replace edge a-b of faces (a,b,c), (b,a,d) by c-d: faces (c,a,d) and (d,b,c)."""
+    # BEGIN SOLUTION: Task 3 (edge flip): (a,b,c) + (b,a,d) -> (c,a,d) + (d,b,c), re-link the four outer twins
+    t = T[h]
+    f, f2 = h // 3, t // 3
+    a, b = org(F, h), dst(F, h)
+    c, d = org(F, pv(h)), org(F, pv(t))
+    o_bc, o_ca = T[nx(h)], T[pv(h)]
+    o_ad, o_db = T[nx(t)], T[pv(t)]
+    e_bc, e_ca = feat[nx(h)], feat[pv(h)]
+    e_ad, e_db = feat[nx(t)], feat[pv(t)]
+    F[f, 0], F[f, 1], F[f, 2] = c, a, d
+    F[f2, 0], F[f2, 1], F[f2, 2] = d, b, c
+    new = ((3 * f, o_ca, e_ca), (3 * f + 1, o_ad, e_ad), (3 * f2, o_db, e_db), (3 * f2 + 1, o_bc, e_bc))
+    for hh, o, e in new:
+        T[hh] = o
+        feat[hh] = e
+        if o >= 0:
+            T[o] = hh
+    T[3 * f + 2], T[3 * f2 + 2] = 3 * f2 + 2, 3 * f + 2
+    feat[3 * f + 2] = False
+    feat[3 * f2 + 2] = False
+    VH[a], VH[b], VH[c], VH[d] = 3 * f + 1, 3 * f2 + 1, 3 * f, 3 * f2
+    val[a] -= 1
+    val[b] -= 1
+    val[c] += 1
+    val[d] += 1
+    return OK
+    # END SOLUTION
+
+
+# --------------------------------------------------------------------------------------------
+# passes over all edges
+
+
+@njit(cache=True)
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
+    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+
+    Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
+    same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
+    triangle's height). Returns ``(splits, h)``; ``h < stop`` means the pass stopped for room.
+    """
+    # BEGIN SOLUTION: Task 4 (split long edges): every edge with |e| > 4/3 L at its midpoint, one pass over the edges present at the start
+    done = 0
+    for h in range(start, stop):
+        if falive[h // 3] and (T[h] < 0 or h < T[h]) and length(V, F, h) > high:
+            p = 0.5 * (V[org(F, h)] + V[dst(F, h)])
+            if split(V, F, T, VH, val, cls, feat, falive, cnt, h, p) == FULL:
+                return done, h
+            done += 1
+    return done, stop
+    # END SOLUTION
+
+
+@njit(cache=True)
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
+    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
+    # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint otherwise
+    hes = np.empty(RING, np.int64)
+    nb1 = np.empty(RING, np.int64)
+    nb2 = np.empty(RING, np.int64)
+    done = 0
+    for h in range(3 * cnt[1]):
+        if not falive[h // 3] or length(V, F, h) >= low:
+            continue
+        t = T[h]
+        if t >= 0 and t < h and falive[t // 3]:
+            continue  # each edge once (from its lower half-edge)
+        a, b = org(F, h), dst(F, h)
+        hh = h
+        if cls[b] > cls[a]:  # keep the more constrained end
+            if t < 0:
+                continue  # a boundary half-edge has no twin to turn around
+            hh = t
+            a, b = b, a
+        if cls[b] == 2:
+            continue  # corners stay
+        if cls[b] == 1 and not feat[hh]:
+            continue  # a feature vertex may only slide along its own line
+        if cls[a] == 0 and cls[b] == 0:
+            p = 0.5 * (V[a] + V[b])
+        else:
+            p = V[a].copy()
+        if collapse_check(V, F, T, VH, val, cls, feat, hh, p, high, hes, nb1, nb2) == OK:
+            collapse(V, F, T, VH, val, cls, feat, falive, hh, p, hes)
+            done += 1
+    return done
+    # END SOLUTION
+
+
+@njit(cache=True)
+def flip_pass(V, F, T, VH, val, cls, feat, falive, cnt):
+    """Flip edges when that lowers Σ|valence - target| over their four vertices (6 inside, 4 on the boundary)."""
+    # BEGIN SOLUTION: Task 6 (equalize valences): flip a-b to c-d when Σ|val - target| over a, b, c, d drops
+    hes = np.empty(RING, np.int64)
+    nb1 = np.empty(RING, np.int64)
+    done = 0
+    for h in range(3 * cnt[1]):
+        t = T[h]
+        if not falive[h // 3] or t < 0 or t < h:
+            continue
+        a, b = org(F, h), dst(F, h)
+        c, d = org(F, pv(h)), org(F, pv(t))
+        ta = 4 if _on_boundary(F, T, VH, a, hes) else 6
+        tb = 4 if _on_boundary(F, T, VH, b, hes) else 6
+        tc = 4 if _on_boundary(F, T, VH, c, hes) else 6
+        td = 4 if _on_boundary(F, T, VH, d, hes) else 6
+        before = abs(val[a] - ta) + abs(val[b] - tb) + abs(val[c] - tc) + abs(val[d] - td)
+        after = abs(val[a] - 1 - ta) + abs(val[b] - 1 - tb) + abs(val[c] + 1 - tc) + abs(val[d] + 1 - td)
+        if after < before and flip_check(V, F, T, VH, val, feat, h, hes, nb1) == OK:
+            flip(V, F, T, VH, val, feat, h)
+            done += 1
+    return done
+    # END SOLUTION

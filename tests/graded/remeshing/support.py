@@ -1,0 +1,132 @@
+"""Meshes and checks shared by the graded remeshing tests (public: shipped with the lab).
+
+Nothing here calls a lab implementation: a remeshed surface is judged by properties measured
+here (validity, boundary loops, angles, edge lengths, valences, distance to the input), with
+thresholds set from runs of the reference solution with a margin (numbers beside each threshold).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets, topology
+from geomlib.geometry import mesh_distance
+from geomlib.grading import checks
+
+#: Unit square of two triangles, diagonal 0-2, facing +z.
+SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
+
+#: Regular tetrahedron, outward oriented: every edge fails the link condition.
+TET_V = np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
+TET_F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+
+
+def halfedges(V, F):
+    return topology.halfedge_mesh(np.asarray(F), len(V), manifold=True)
+
+
+def edge_index(H, a, b) -> int:
+    a, b = min(a, b), max(a, b)
+    return int(np.flatnonzero((H.E[:, 0] == a) & (H.E[:, 1] == b))[0])
+
+
+def bumpy_sphere(level=3, seed=2):
+    V, F = datasets.icosphere(level)
+    return datasets.add_noise(V, 0.02, seed=seed, direction="normal", F=F), F
+
+
+def wavy_patch(n=12, seed=0):
+    V, F = datasets.grid_patch(n)
+    V[:, 2] = 0.15 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    return V, F
+
+
+def angles_deg(V, F) -> np.ndarray:
+    out = []
+    for k in range(3):
+        a = V[F[:, (k + 1) % 3]] - V[F[:, k]]
+        b = V[F[:, (k + 2) % 3]] - V[F[:, k]]
+        c = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        out.append(np.degrees(np.arccos(np.clip(c, -1, 1))))
+    return np.concatenate(out)
+
+
+def quality(V0, F0, V, F) -> dict:
+    """The issue's quality measures of a remeshed surface ``(V, F)`` of ``(V0, F0)``."""
+    H = topology.halfedge_mesh(F, len(V), manifold=True)
+    e = np.linalg.norm(V[H.E[:, 0]] - V[H.E[:, 1]], axis=1)
+    ang = angles_deg(V, F)
+    inner = ~H.boundary_vertex
+    return {
+        "min_angle": float(ang.min()),
+        "below_30": float(np.mean(ang < 30)),
+        "edge_cv": float(e.std() / e.mean()),
+        "valence6": float(np.mean(H.valence[inner] == 6)) if inner.any() else 1.0,
+        "hausdorff": mesh_distance(V0, F0, V, F, n_samples=20000)["hausdorff"],
+        "mean_edge": float(e.mean()),
+    }
+
+
+def validity_problem(V0, F0, V, F) -> str | None:
+    """What is wrong with ``(V, F)`` as a remeshing of ``(V0, F0)`` (None: nothing)."""
+    V, F = np.asarray(V, float), np.asarray(F)
+    if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3:
+        return f"expected V (n, 3) and F (m, 3), got shapes {V.shape} and {F.shape}"
+    if not np.issubdtype(F.dtype, np.integer) or len(F) == 0 or F.min() < 0 or F.max() >= len(V):
+        return "F must hold integer indices into V"
+    if not np.isfinite(V).all():
+        return "V contains NaN or inf"
+    if len(np.setdiff1d(np.arange(len(V)), F.ravel())):
+        return "some vertices are not used by any face: compact the mesh before returning it"
+    try:
+        topology.halfedge_mesh(F, len(V), manifold=True)
+    except Exception as exc:  # noqa: BLE001 - the message is the feedback
+        return f"the result is not a manifold, consistently oriented mesh: {exc}"
+    nb0 = len(topology.boundary_loops(F0)) if len(topology.boundary_edges(F0)) else 0
+    nb = len(topology.boundary_loops(F)) if len(topology.boundary_edges(F)) else 0
+    if nb != nb0:
+        return f"the input has {nb0} boundary loop(s), the result {nb}: boundary loops must be kept"
+    if topology.euler_characteristic(F) != topology.euler_characteristic(F0):
+        return "the Euler characteristic changed: a collapse or flip changed the topology"
+    return None
+
+
+def remesh_check(make, L, *, min_angle, below_30, edge_cv, valence6, hausdorff, length_tol=0.25):
+    """A check for ``isotropic_remesh`` outputs: validity plus one threshold per quality measure."""
+
+    def fn(expected, got, ctx):
+        d = make()
+        problem = validity_problem(d["V"], d["F"], got.get("V"), got.get("F"))
+        if problem:
+            return problem
+        q = quality(d["V"], d["F"], np.asarray(got["V"], float), np.asarray(got["F"]))
+        if abs(q["mean_edge"] / L - 1) > length_tol:
+            return f"mean edge length {q['mean_edge']:.4g} is not within {length_tol:.0%} of the target {L:.4g}"
+        for key, bound, lower in (
+            ("min_angle", min_angle, True),
+            ("valence6", valence6, True),
+            ("below_30", below_30, False),
+            ("edge_cv", edge_cv, False),
+            ("hausdorff", hausdorff, False),
+        ):
+            if (q[key] < bound) if lower else (q[key] > bound):
+                return (
+                    f"{key} = {q[key]:.4g}, needs {'>=' if lower else '<='} {bound:g} (measures: "
+                    + ", ".join(f"{k} {v:.3g}" for k, v in q.items())
+                    + ")"
+                )
+        return None
+
+    return checks.Custom(fn)
+
+
+def same_vertex_set(expected, got, ctx):
+    """Split results: the same vertex positions (input vertices plus midpoints), in any order."""
+    Ve, Vg = np.asarray(expected["V"]), np.asarray(got.get("V"))
+    if Vg.shape != Ve.shape:
+        return f"V has shape {Vg.shape}, expected {Ve.shape} (one new vertex per edge longer than high)"
+    a, b = Ve[np.lexsort(Ve.T)], Vg[np.lexsort(Vg.T)]
+    if not np.allclose(a, b, atol=1e-9):
+        return "the new vertices are not the midpoints of the long edges"
+    return validity_problem(expected["V"], expected["F"], got["V"], got["F"])

@@ -1,0 +1,176 @@
+"""Graded tests of the remeshing lab.
+
+``test_references`` compares with stored references and quality thresholds (``cases.py``); the
+tests below apply one local operation to tiny meshes written out by hand, check the half-edge
+structure's invariants after it (``check_halfedges``) and the answer worked out in the docstring,
+and check bad input. Expected values never come from running a solution at test time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from geomlib import datasets, topology
+from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading.errors import Mismatch
+
+from .cases import CASES
+from .support import SQUARE_F, SQUARE_V, TET_F, TET_V, edge_index, halfedges
+
+test_references = reference_tests(CASES)
+
+
+def expect_true(label: str, condition: bool, message: str) -> None:
+    if not condition:
+        raise Mismatch(f"{label}: {message}")
+
+
+def expect_valid(label: str, V, H) -> np.ndarray:
+    try:
+        topology.check_halfedges(H)
+    except Exception as exc:  # noqa: BLE001 - the message is the feedback
+        raise Mismatch(f"{label}: the half-edge structure is broken: {exc}") from None
+    expect_true(
+        label, np.asarray(V).shape == (H.n_vertices, 3), f"V has shape {np.shape(V)}, H {H.n_vertices} vertices"
+    )
+    return np.sort(np.sort(H.idx.reshape(-1, 3), axis=1), axis=0)
+
+
+def rebuilt(H):
+    """A fresh structure of the returned faces (the returned one may be a plain record of its arrays)."""
+    return topology.halfedge_mesh(np.asarray(H.idx).reshape(-1, 3), int(H.n_vertices))
+
+
+def faces_as_sets(H):
+    return sorted(tuple(sorted(f)) for f in H.idx.reshape(-1, 3).tolist())
+
+
+# --------------------------------------------------------------------------------------------
+# Task 1: split
+
+
+@graded(points=1, part="local operations")
+def test_split_the_diagonal_of_a_square(lab):
+    """square (0,0),(1,0),(1,1),(0,1) split on diagonal 0-2: vertex 4 = (0.5, 0.5), four triangles around it"""
+    H = halfedges(SQUARE_V, SQUARE_F)
+    V, H2 = lab.split_edge(SQUARE_V, H, edge_index(H, 0, 2))
+    expect_valid("split_edge on the square", V, H2)
+    expect_close("split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.5, 0.0], name="V[4]")
+    expect_true(
+        "split_edge on the square",
+        faces_as_sets(H2) == [(0, 1, 4), (0, 3, 4), (1, 2, 4), (2, 3, 4)],
+        f"faces {faces_as_sets(H2)}, expected the four triangles (0,1,4), (1,2,4), (2,3,4), (3,0,4)",
+    )
+
+
+@graded(points=1, part="local operations")
+def test_split_a_boundary_edge(lab):
+    """square split on boundary edge 0-1: vertex 4 = (0.5, 0), three triangles, boundary still one loop of 5"""
+    H = halfedges(SQUARE_V, SQUARE_F)
+    V, H2 = lab.split_edge(SQUARE_V, H, edge_index(H, 0, 1))
+    expect_valid("split_edge on a boundary edge", V, H2)
+    expect_close("split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.0, 0.0], name="V[4]")
+    expect_true(
+        "split_edge on a boundary edge",
+        rebuilt(H2).n_faces == 3 and int(rebuilt(H2).boundary_edge.sum()) == 5,
+        f"{rebuilt(H2).n_faces} faces and {int(rebuilt(H2).boundary_edge.sum())} boundary edges, expected 3 and 5",
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Task 3: flip
+
+
+@graded(points=1, part="local operations")
+def test_flip_the_diagonal_of_a_square(lab):
+    """square with diagonal 0-2 flipped: diagonal 1-3, faces {0,1,3} and {1,2,3}, both still facing +z"""
+    H = halfedges(SQUARE_V, SQUARE_F)
+    V, H2 = lab.flip_edge(SQUARE_V, H, edge_index(H, 0, 2))
+    expect_valid("flip_edge on the square", V, H2)
+    expect_true(
+        "flip_edge on the square",
+        faces_as_sets(H2) == [(0, 1, 3), (1, 2, 3)],
+        f"faces {faces_as_sets(H2)}, expected (0,1,3) and (1,2,3)",
+    )
+    F = H2.idx.reshape(-1, 3)
+    n = np.cross(SQUARE_V[F[:, 1]] - SQUARE_V[F[:, 0]], SQUARE_V[F[:, 2]] - SQUARE_V[F[:, 0]])
+    expect_true("flip_edge on the square", (n[:, 2] > 0).all(), "a new face is turned over (orientation lost)")
+
+
+@graded(points=1, part="local operations")
+def test_flip_refuses_boundary_and_tetrahedron_edges(lab):
+    """a boundary edge has one face; a tetrahedron's flip would duplicate an edge (valence 3)"""
+    H = halfedges(SQUARE_V, SQUARE_F)
+    expect_raises(lambda: lab.flip_edge(SQUARE_V, H, edge_index(H, 0, 1)), "MeshError", match="cannot be flipped")
+    T = halfedges(TET_V, TET_F)
+    expect_raises(lambda: lab.flip_edge(TET_V, T, 0), "MeshError", match="cannot be flipped")
+
+
+# --------------------------------------------------------------------------------------------
+# Task 2: collapse
+
+
+@graded(points=1, part="local operations")
+def test_collapse_on_an_octahedron(lab):
+    """octahedron edge (0, 2) of +x and +y: 5 vertices, 6 faces, merged vertex at (0.5, 0.5, 0)"""
+    V0 = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+    F0 = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    H = halfedges(V0, F0)
+    V, H2 = lab.collapse_edge(V0, H, edge_index(H, 0, 2))
+    expect_valid("collapse_edge on the octahedron", V, H2)
+    expect_true(
+        "collapse_edge on the octahedron",
+        rebuilt(H2).n_faces == 6 and rebuilt(H2).n_vertices == 5,
+        f"{rebuilt(H2).n_vertices} vertices and {rebuilt(H2).n_faces} faces, expected 5 and 6",
+    )
+    expect_true(
+        "collapse_edge on the octahedron",
+        np.isclose(np.asarray(V), [0.5, 0.5, 0]).all(axis=1).any(),
+        "no vertex at the midpoint (0.5, 0.5, 0)",
+    )
+
+
+@graded(points=1, part="local operations")
+def test_collapse_refuses_the_link_condition(lab):
+    """octahedron with face (0, 2, 4) split at a new vertex 6: ends 0 and 2 share neighbour 4, which is
+    not opposite edge (0, 2) (6 and 5 are); a tetrahedron's collapse would leave valence-2 vertices"""
+    V0 = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [0.5, 0.5, 0.5]])
+    F0 = np.array([[0, 2, 6], [2, 4, 6], [4, 0, 6], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5],
+                   [3, 1, 5], [0, 3, 5]])  # fmt: skip
+    H = halfedges(V0, F0)
+    expect_raises(lambda: lab.collapse_edge(V0, H, edge_index(H, 0, 2)), "MeshError", match="link condition")
+    T = halfedges(TET_V, TET_F)
+    expect_raises(lambda: lab.collapse_edge(TET_V, T, 0), "MeshError", match="cannot be collapsed")
+
+
+@graded(points=1, part="local operations")
+def test_collapse_refuses_long_edges_and_flips(lab):
+    """grid 4x4: the collapse of a short interior edge is allowed; with high smaller than the new edges, refused"""
+    V0, F0 = datasets.grid_patch(4)
+    H = halfedges(V0, F0)
+    inner = np.flatnonzero(~H.boundary_vertex[H.E].any(axis=1))
+    e = int(inner[0])
+    V, H2 = lab.collapse_edge(V0, H, e)
+    expect_valid("collapse_edge on the grid", V, H2)
+    expect_raises(lambda: lab.collapse_edge(V0, H, e, high=0.26), "MeshError", match="longer than")
+    # fold the grid: moving a vertex across its neighbours would turn faces over
+    Vf = V0.copy()
+    a, b = H.E[e]
+    Vf[b] = Vf[a] + 3.0 * (Vf[b] - Vf[a])  # b far beyond a: the midpoint is outside a's fan
+    expect_raises(lambda: lab.collapse_edge(Vf, H, e), "MeshError", match="turn over")
+
+
+# --------------------------------------------------------------------------------------------
+# bad input (given validation: no points)
+
+
+@graded(points=0, part="bad input")
+def test_rejects_bad_input(lab):
+    """a negative target length, an edge index past the end and a non-manifold mesh give MeshErrors"""
+    expect_raises(lambda: lab.isotropic_remesh(SQUARE_V, SQUARE_F, -1.0), "MeshError", match="target_length")
+    H = halfedges(SQUARE_V, SQUARE_F)
+    expect_raises(lambda: lab.split_edge(SQUARE_V, H, 99), "MeshError", match="does not exist")
+    Fnm = np.array([[0, 1, 2], [0, 2, 3], [0, 2, 4]])
+    Vnm = np.r_[SQUARE_V, [[0.5, 0.5, 1.0]]]
+    expect_raises(lambda: lab.isotropic_remesh(Vnm, Fnm, 0.3), "MeshError", match="edge")
+    expect_raises(lambda: lab.isotropic_remesh(SQUARE_V, SQUARE_F, 0.3, iterations=-1), "MeshError", match="iterations")
