@@ -21,7 +21,7 @@ __all__ = ["lab_figure_modules", "build_all"]
 
 def lab_figure_modules() -> list[str]:
     """Labs whose reference solution has a ``figures.py``, in course order."""
-    order = ["subdivision", "simplification", "maps", "denoise", "shadows", "vdm", "sdf"]
+    order = ["subdivision", "simplification", "remeshing", "maps", "denoise", "shadows", "vdm", "sdf", "relief"]
     sol = course_root() / "solutions"
     names = [p.parent.name for p in sol.glob("*/figures.py")] if sol.is_dir() else []
     return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
