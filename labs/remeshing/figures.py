@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import importlib
+import re
 from pathlib import Path
 
 import numpy as np
@@ -103,6 +104,7 @@ def fig_operations(out: Path, lab, quick: bool) -> Figure:
     e = int(inner[len(inner) // 2])
     size = (200, 200) if quick else (260, 260)
     kw = dict(camera="top", size=size, supersample=1 if quick else 2, wireframe=True, flat=True)
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
     imgs, caps = (
         [render(V, F, highlight_points=H.E[e], **kw)],
         [f"patch, edge ({int(H.E[e, 0])}, {int(H.E[e, 1])}) marked"],
@@ -113,7 +115,8 @@ def fig_operations(out: Path, lab, quick: bool) -> Figure:
             G = np.asarray(H2.idx).reshape(-1, 3)
             imgs.append(render(np.asarray(U), G, **kw))
             caps.append(f"{name}: {len(G)} faces")
-        except NotImplementedError:
+        except NotImplementedError as err:
+            missing.append(err)
             imgs.append(np.full((size[1], size[0], 3), 255, np.uint8))
             caps.append(f"{name}: not implemented yet")
     try:
@@ -124,14 +127,18 @@ def fig_operations(out: Path, lab, quick: bool) -> Figure:
         caps.append("interior vertices jittered")
         imgs.append(render(W, F, **kw))
         caps.append("after tangential_relaxation")
-    except NotImplementedError:
+    except NotImplementedError as err:
+        missing.append(err)
         imgs.append(np.full((size[1], size[0], 3), 255, np.uint8))
         caps.append("tangential_relaxation: not implemented yet")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
     path = save_png(out / "operations.png", img)
+    first = re.search(r"Task \d+[a-z]?", str(missing[0])) if missing else None
+    todo = f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: " if missing else ""
     return Figure(
         path,
-        "One interior edge of a grid patch (marked) split, collapsed and flipped; a patch with jittered interior "
+        todo
+        + "One interior edge of a grid patch (marked) split, collapsed and flipped; a patch with jittered interior "
         "vertices before and after one tangential relaxation step (damping 0.5).",
         LAB,
     )
