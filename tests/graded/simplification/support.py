@@ -135,8 +135,8 @@ def flipped_faces(V0, F0, V, F) -> np.ndarray:
     for a well-shaped face (quality ``4√3 area / Σ edge² > 0.3``; 1 for an equilateral triangle):
     a sliver's normal is ill-defined, so a sliver standing on edge is not called flipped.
     """
-    C = V[F].mean(axis=1)
-    _, face, _ = closest_points(V0, F0, C)
+    centroids = V[F].mean(axis=1)
+    _, face, _ = closest_points(V0, F0, centroids)
     cos = np.einsum("ij,ij->i", face_normals(V, F), face_normals(V0, F0)[face])
     area2 = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
     quality = 2 * np.sqrt(3) * area2 / ((V[F] - V[F[:, [1, 2, 0]]]) ** 2).sum(axis=(1, 2))
