@@ -19,7 +19,9 @@ Targets (issue 16): full 128^3 <= 1.5x igl pseudonormal; band <= 1x igl's band; 
 the diagonal; bricks >= 25x smaller than dense float32 with error <= 0.5 step; tracing 512^2 <= 0.5 s,
 shadows <= 0.5 s more. Peak memory: the process's peak resident set size after each stage
 (``resource.getrusage``; it covers numba's and libigl's allocations) and the tracemalloc peak of one
-NumPy-side grid call. Times are the best of ``--repeat`` runs.
+NumPy-side grid call. Times are the best of ``--repeat`` runs, except sphere tracing and soft shadows:
+medians of at least 5 runs, wall-clock and CPU time (the CPU time is the steadier number on a shared
+machine).
 """
 
 from __future__ import annotations
@@ -154,11 +156,38 @@ def bricks(g):
     dense = g.values.astype(np.float32).nbytes
     inb = np.abs(g.values) < B.r
     err = np.abs(B.sample(g.points()) - g.values.ravel())[inb.ravel()] / B.step
+    # the tightest correct rule keeps a brick iff one of its 8^3 stored samples is in the band (|d| < r)
+    n = np.array(B.table.shape)
+    G = np.pad(g.values, [(0, int(7 * k + 1 - s)) for k, s in zip(n, g.shape, strict=True)], mode="edge")
+    inband = np.abs(G) < B.r
+    tight = sum(
+        bool(inband[7 * i : 7 * i + 8, 7 * j : 7 * j + 8, 7 * k : 7 * k + 8].any())
+        for i in range(n[0])
+        for j in range(n[1])
+        for k in range(n[2])
+    )  # a few thousand bricks: a check, not a hot path
+    needed = int((dense / 25 - B.table.nbytes) // B.codes[0].nbytes)
     print(
-        f"\n3. bricks r = 4 voxels on {g.shape[0]}^3: {len(B.codes)} of {B.table.size} bricks kept, "
-        f"{B.nbytes / 1024:.0f} KiB vs dense float32 {dense / 1024:.0f} KiB = {dense / B.nbytes:.1f}x smaller; "
+        f"\n3. bricks r = 4 voxels on {g.shape[0]}^3: {len(B.codes)} of {B.table.size} bricks kept "
+        f"(bricks with a stored sample in the band: {tight}; 25x would allow {needed}), "
+        f"{B.nbytes / 1024:.0f} KiB (codes {B.codes.nbytes / 1024:.0f} + table {B.table.nbytes / 1024:.0f}) "
+        f"vs dense float32 {dense / 1024:.0f} KiB = {dense / B.nbytes:.1f}x smaller; "
         f"error in band <= {err.max():.3f} step (p99 {np.percentile(err, 99):.3f})"
     )
+
+
+def medians(fn, repeat: int):
+    """Median wall-clock and CPU (``time.process_time``) seconds of ``repeat`` runs, and the last result.
+
+    On a shared machine the CPU time is the steadier number: wall time also counts waiting for a core.
+    """
+    wall, cpu, out = [], [], None
+    for _ in range(repeat):
+        t, c = time.perf_counter(), time.process_time()
+        out = fn()
+        wall.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
+    return float(np.median(wall)), float(np.median(cpu)), out
 
 
 def tracing(g, V, repeat):
@@ -167,17 +196,20 @@ def tracing(g, V, repeat):
     eye = c + R * np.array([0.4, -2.2, 1.0])
     M = camera.perspective(40, 1.0, 0.05 * R, 8 * R) @ camera.look_at(eye, c, [0, 0, 1])
     O, D = camera_rays(M, 512, 512)
-    t_tr, (t, hit, steps) = best(lambda: sphere_trace(g, O, D, max_steps=64, eps=1e-4 * R, t_max=6 * R), repeat)
+    runs = max(repeat, 5)
+    w_tr, c_tr, (t, hit, steps) = medians(lambda: sphere_trace(g, O, D, max_steps=64, eps=1e-4 * R, t_max=6 * R), runs)
     X = O[hit] + t[hit, None] * D[hit]
     t6, _ = best(lambda: gradient_central(g, X, 0.5 * g.spacing), repeat)
     t4, N = best(lambda: gradient_tetra(g, X, 0.5 * g.spacing), repeat)
     light = c + R * np.array([1.5, -1.0, 3.0])
     Ps = X + 2 * g.spacing * N
-    t_sh, vis = best(lambda: soft_shadow(g, Ps, light, 0.3 * R, max_steps=32), repeat)
+    w_sh, c_sh, vis = medians(lambda: soft_shadow(g, Ps, light, 0.3 * R, max_steps=32), runs)
+    evals = int(steps.sum())
     print(
-        f"\n4. sphere tracing 512^2 of the {g.shape[0]}^3 field: {t_tr:.2f} s, {hit.sum()} hits, "
-        f"mean {steps.mean():.1f} steps (max 64); normals 6-tap {t6:.3f} s, 4-tap {t4:.3f} s; "
-        f"soft shadows {t_sh:.2f} s (mean V {vis.mean():.2f})   peak RSS {rss_mib():.0f} MiB"
+        f"\n4. sphere tracing 512^2 of the {g.shape[0]}^3 field (medians of {runs} runs, wall / CPU): "
+        f"{w_tr:.2f} / {c_tr:.2f} s, {hit.sum()} hits, mean {steps.mean():.1f} steps (max 64), "
+        f"{c_tr / evals * 1e9:.0f} ns CPU per field evaluation; normals 6-tap {t6:.3f} s, 4-tap {t4:.3f} s; "
+        f"soft shadows {w_sh:.2f} / {c_sh:.2f} s (mean V {vis.mean():.2f})   peak RSS {rss_mib():.0f} MiB"
     )
 
 

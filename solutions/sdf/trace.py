@@ -64,21 +64,26 @@ def sphere_trace(sdf, origins, directions, *, max_steps: int = 64, eps: float = 
     t_max = np.inf if t_max is None else check_float(t_max, "t_max", minimum=0.0, where=where)
     # BEGIN SOLUTION: Task 8 (sphere tracing): keep an index array of active rays; each step: d = phi(o + t dir) for them, steps += 1, d < eps -> hit; t += max(d, eps); t > t_max -> miss; drop finished rays
     n = len(O)
-    t = np.zeros(n)
+    t = np.full(n, np.inf)
     hit = np.zeros(n, bool)
-    steps = np.zeros(n, np.int64)
-    active = np.arange(n)
-    for _ in range(max_steps):  # the march itself is sequential; every step is vectorised over rays
-        if len(active) == 0:
+    steps = np.full(n, max_steps, np.int64)  # rays that never stop use the whole budget
+    # the rays still marching: their numbers and compacted copies of their origins, directions, t
+    ray, o, dr, s = np.arange(n), O, D, np.zeros(n)
+    for k in range(max_steps):  # the march itself is sequential; every step is vectorised over rays
+        if len(ray) == 0:
             break
-        d = np.asarray(phi(O[active] + t[active, None] * D[active]), np.float64)
-        steps[active] += 1
-        h = d < eps
-        hit[active[h]] = True
-        go = active[~h]
-        t[go] += np.maximum(d[~h], eps)
-        active = go[t[go] <= t_max]
-    t[~hit] = np.inf
+        X = dr * s[:, None]
+        X += o
+        d = np.asarray(phi(X), np.float64)
+        stop = d < eps
+        t[ray[stop]] = s[stop]
+        hit[ray[stop]] = True
+        s = s + np.maximum(d, eps)
+        stop |= ~(s <= t_max)  # (a NaN distance stops the ray too)
+        if stop.any():
+            steps[ray[stop]] = k + 1
+            go = ~stop
+            ray, o, dr, s = ray[go], o[go], dr[go], s[go]
     return t, hit, steps
     # END SOLUTION
 

@@ -46,6 +46,9 @@ from solutions.sdf import (
     sphere_trace,
     winding_number,
 )
+from solutions.sdf.bricks import BRICK
+from solutions.sdf.field import outside_rule
+from solutions.sdf.trace import camera_rays
 
 ROOT = Path(__file__).resolve().parents[2]
 FANDISK = Path("/work/shared/data/meshes/fandisk.obj")
@@ -158,7 +161,15 @@ def test_bricks_error_and_memory():
     in_band = np.abs(g.values.ravel()) < B.r
     err = np.abs(B.sample(X) - g.values.ravel())[in_band] / B.step
     assert err.max() <= 0.5 + 1e-9
+    assert B.nbytes == B.codes.nbytes + B.table.nbytes == len(B.codes) * BRICK**3 + 4 * 7**3
     assert B.nbytes < g.values.astype(np.float32).nbytes / 3
+    # the tightest correct rule: a brick is kept iff one of its 8^3 stored samples is in the band
+    inband = np.abs(g.values) < B.r
+    needed = [
+        [[inband[7 * i : 7 * i + 8, 7 * j : 7 * j + 8, 7 * k : 7 * k + 8].any() for k in range(7)] for j in range(7)]
+        for i in range(7)
+    ]
+    np.testing.assert_array_equal(B.table >= 0, needed)
     # between samples the bricked field follows the dense one's trilinear interpolation
     P = _points(V, 3000, 9, margin=0.0)
     near = np.abs(g.sample(P)) < 0.5 * B.r
@@ -185,6 +196,11 @@ def test_outside_the_box_is_a_lower_bound():
     true = np.linalg.norm(P, axis=1) - 1
     far = np.any((P < g.origin) | (P > g.upper), axis=1)
     assert np.all(d[far] <= true[far] + 2e-2)
+    # the lookup applies the outside rule to the value at the clamped point, and inside the box the
+    # rule changes nothing (the lookup skips it there): exactly, not just to round-off
+    Q = np.clip(P, g.origin, g.upper)
+    np.testing.assert_array_equal(d, outside_rule(P, Q, g.sample(Q)))
+    np.testing.assert_array_equal(d[~far], outside_rule(P[~far], P[~far], d[~far]))
 
 
 def test_instancing_scales_distances():
@@ -272,6 +288,40 @@ def test_sphere_trace_misses_are_inf_and_budget_holds():
         sc, np.array([[0, 0, 5.0], [5, 5, 5.0]]), np.array([[0, 0, -1.0], [0, 0, -1.0]]), max_steps=20
     )
     assert hit.tolist() == [True, False] and np.isinf(t[1]) and steps.max() <= 20
+
+
+def _plain_sphere_trace(phi, O, D, max_steps, eps, t_max):
+    """The march written plainly: every ray evaluated at every step, finished ones masked out."""
+    D = D / np.linalg.norm(D, axis=1, keepdims=True)  # as sphere_trace does
+    t, hit, steps = np.zeros(len(O)), np.zeros(len(O), bool), np.zeros(len(O), np.int64)
+    live = np.ones(len(O), bool)
+    for _ in range(max_steps):
+        d = phi(O + t[:, None] * D)
+        steps[live] += 1
+        hit |= live & (d < eps)
+        live &= d >= eps
+        t[live] += np.maximum(d[live], eps)
+        live &= t <= t_max
+    return np.where(hit, t, np.inf), hit, steps
+
+
+def test_sphere_trace_equals_the_plain_march_exactly():
+    """Active-ray compaction is only bookkeeping: t, hits and step counts equal the plain march bit for bit."""
+    V, F = datasets.torus(1.0, 0.35, 32, 16)
+    g = sdf_grid(V, F, 24)
+    M = camera.perspective(40, 1.0, 0.1, 20) @ camera.look_at([0.5, -3.5, 2.0], [0, 0, 0], [0, 0, 1])
+    O, D = camera_rays(M, 40, 40)
+    for max_steps, t_max in ((64, 8.0), (10, 8.0), (64, 4.0)):
+        got = sphere_trace(g, O, D, max_steps=max_steps, eps=1e-4, t_max=t_max)
+        want = _plain_sphere_trace(g.sample, O, D, max_steps, 1e-4, t_max)
+        for a, b in zip(got, want, strict=True):
+            np.testing.assert_array_equal(a, b)
+        t, hit, steps = got
+        assert hit.any() and (~hit).any()
+        if max_steps == 10:  # some rays run out of budget
+            assert np.any(~hit & (steps == 10))
+        if t_max == 4.0:  # some rays stop beyond t_max
+            assert np.any(~hit & (steps < max_steps))
 
 
 def test_kernels_run_without_jit():
