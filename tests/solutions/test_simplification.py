@@ -35,7 +35,6 @@ from solutions.simplification import (
     vertex_quadrics,
 )
 from solutions.simplification.contraction import contract_pair, neighbors
-from solutions.simplification.jit_cache import choose_cache_dir
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -446,24 +445,6 @@ def test_importing_the_lab_does_not_import_numba():
     # The graded functions never use the compiled loop; workers must not pay numba's import.
     code = "import sys, solutions.simplification; print('numba' in sys.modules)"
     assert run_python(code) == "False"
-
-
-def test_cache_folder_when_the_package_folder_is_not_writable(tmp_path, monkeypatch):
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
-    package = tmp_path / "package"
-    package.mkdir()
-    assert choose_cache_dir(package, tmp_path) is None  # numba's default (__pycache__ next to the source)
-    blocked = tmp_path / "a-file"
-    blocked.write_text("")  # a folder inside a file cannot be created: not writable for anyone
-    chosen = Path(choose_cache_dir(blocked / "package", tmp_path))
-    assert chosen == tmp_path / f"geomlib-numba-cache-{os.getuid()}"
-    assert chosen.is_dir() and chosen.stat().st_mode & 0o777 == 0o700
-    assert choose_cache_dir(blocked / "package", tmp_path) == str(chosen)  # the next process reuses it
-    chosen.chmod(0o777)  # someone else could plant pickles there: not used
-    other = Path(choose_cache_dir(blocked / "package", tmp_path))
-    assert other != chosen and other.parent == tmp_path and other.stat().st_mode & 0o777 == 0o700
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))
-    assert choose_cache_dir(blocked / "package", tmp_path) == str(tmp_path / "mine")
 
 
 def distance_to_polyline(P, A, B) -> np.ndarray:
