@@ -40,6 +40,17 @@ TILTED_F = np.array([[0, 1, 2]])
 TILTED_P = np.array([1.0, 1.0, 1.0, -1.0]) / np.sqrt(3)  # unit normal, d = -n · v0
 
 
+def expect_tilted_face_quadric(lab) -> None:
+    """The area-weighted quadric of the tilted triangle: K = (√3 / 2) p pᵀ."""
+    K = lab.face_quadrics(TILTED_V, TILTED_F)
+    expect_close(
+        "face_quadrics on the tilted triangle",
+        np.asarray(K)[0],
+        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
+        name="K[0]",
+    )
+
+
 def expect_true(label: str, condition: bool, message: str) -> None:
     if not condition:
         raise Mismatch(f"{label}: {message}")
@@ -52,13 +63,7 @@ def expect_true(label: str, condition: bool, message: str) -> None:
 @graded(points=1, part="quadrics")
 def test_face_quadric_of_a_tilted_triangle(lab):
     """plane x + y + z = 1: p = (1, 1, 1, -1)/√3, K = area · p pᵀ with area √3/2"""
-    K = lab.face_quadrics(TILTED_V, TILTED_F)
-    expect_close(
-        "face_quadrics on the tilted triangle",
-        np.asarray(K)[0],
-        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
-        name="K[0]",
-    )
+    expect_tilted_face_quadric(lab)
     K = lab.face_quadrics(TILTED_V, TILTED_F, weighting="uniform")
     expect_close(
         'face_quadrics(weighting="uniform") on the tilted triangle',
@@ -107,13 +112,7 @@ def test_vertex_quadrics_vanish_at_their_vertex(lab):
 @graded(points=1, part="quadrics")
 def test_quadrics_reject_an_unknown_weighting(lab):
     """a correct result on valid input, then a MeshError naming the bad weighting"""
-    K = lab.face_quadrics(TILTED_V, TILTED_F)
-    expect_close(
-        "face_quadrics on the tilted triangle",
-        np.asarray(K)[0],
-        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
-        name="K[0]",
-    )
+    expect_tilted_face_quadric(lab)
     expect_raises(lambda: lab.face_quadrics(TILTED_V, TILTED_F, weighting="volume"), "MeshError", match="weighting")
 
 
