@@ -1,6 +1,6 @@
 """Figure helpers: image panels with captions, colour maps and bars, line plots, deterministic PNGs.
 
-Longer than most modules (about 800 lines) on purpose: it is the one place every figure of every
+Longer than most modules (about 850 lines) on purpose: it is the one place every figure of every
 lab is composed, and its parts (panels, text, colour maps and bars, line plots, placeholder
 figures for unfinished tasks) share the same uint8 canvas conventions and font handling.
 
@@ -49,6 +49,8 @@ __all__ = [
     "write_index",
     "lab_package",
     "missing_task_figure",
+    "lab_figures",
+    "lab_view",
     "figures_or_placeholders",
 ]
 
@@ -727,6 +729,35 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
             out = missing_task_figure(Path(out_dir) / f"{name}.png", e, lab_name)
         figures.extend(out if isinstance(out, list) else [out])
     return figures
+
+
+def lab_figures(builders, out_dir, lab_name: str, *args) -> list[Figure]:
+    """The body of a lab's ``make_figures``: create ``out_dir``, then :func:`figures_or_placeholders`.
+
+    Parameters
+    ----------
+    builders : sequence of callables
+        ``build(out_dir, *args)``, as for :func:`figures_or_placeholders`.
+    out_dir : str or Path
+        Folder for the PNG files (created if missing).
+    lab_name : str
+    *args
+        Passed on to every builder (typically the lab module from :func:`lab_package`, and ``quick``).
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    return figures_or_placeholders(builders, out, lab_name, *args)
+
+
+def lab_view(builder, out_dir, lab_name: str, *args) -> Figure:
+    """The body of a lab's ``make_view``: write its interactive 3D view (:mod:`geomlib.viewer`).
+
+    ``builder(out_dir, *args)`` writes ``<lab>_3d.html`` into ``out_dir`` (created if missing) and
+    returns its :class:`Figure`. Open the page in a browser and turn the result with the mouse;
+    ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the figure
+    returned is a "Task N not implemented yet" picture instead.
+    """
+    return lab_figures((builder,), out_dir, lab_name, *args)[0]
 
 
 # --------------------------------------------------------------------------------------------

@@ -121,6 +121,24 @@ def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> Non
         (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
 
 
+def _build_outputs(lab: str, cases, path_of, folders: dict, note: str, log) -> list[Path]:
+    """Run the solution on each case, write one ``.npz`` per case at ``path_of(lab, case)`` and the
+    public/hidden manifests into ``folders``; return the files written."""
+    ref = _impl.reference_dir()
+    written = []
+    manifests = {False: {}, True: {}}
+    for case in cases:
+        arrays, digest = _run_solution(lab, case)
+        path = path_of(lab, case)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(_npz_bytes(arrays))
+        written.append(path)
+        manifests[case.hidden][case.id] = _entry(case, digest, arrays)
+        log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
+    _write_manifests(lab, manifests, folders, note)
+    return written
+
+
 def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
     """Run the solutions on every stored input and every declared case and store the outputs.
 
@@ -132,32 +150,15 @@ def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
     ref = _impl.reference_dir()
     for lab in labs:
         stored = load_stored(lab)
-        if stored:
-            manifests = {False: {}, True: {}}
-            for case in stored:
-                arrays, digest = _run_solution(lab, case)
-                path = stored_path(lab, case)
-                path.parent.mkdir(parents=True, exist_ok=True)
-                path.write_bytes(_npz_bytes(arrays))
-                written.append(path)
-                manifests[case.hidden][case.id] = _entry(case, digest, arrays)
-                log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
+        if stored:  # before the cases, whose inputs may read them
             folders = {False: ref / lab / "inputs", True: ref / lab / "hidden" / "inputs"}
-            _write_manifests(lab, manifests, folders, "inputs of graded tests, from solutions/; do not edit by hand")
+            note = "inputs of graded tests, from solutions/; do not edit by hand"
+            written += _build_outputs(lab, stored, stored_path, folders, note, log)
         cases = load_cases(lab)
-        if not cases:
-            continue
-        manifests = {False: {}, True: {}}
-        for case in cases:
-            arrays, digest = _run_solution(lab, case)
-            path = reference_path(lab, case)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_bytes(_npz_bytes(arrays))
-            written.append(path)
-            manifests[case.hidden][case.id] = _entry(case, digest, arrays)
-            log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
-        folders = {False: ref / lab, True: ref / lab / "hidden"}
-        _write_manifests(lab, manifests, folders, "generated from solutions/; do not edit by hand")
+        if cases:
+            folders = {False: ref / lab, True: ref / lab / "hidden"}
+            note = "generated from solutions/; do not edit by hand"
+            written += _build_outputs(lab, cases, reference_path, folders, note, log)
     return written
 
 

@@ -199,28 +199,28 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
     os.chdir(req.get("cwd") or "/")
 
 
+def _read_error(path: str) -> OSError | None:
+    """Why the current user cannot read ``path`` (list a folder, read a file's first byte), or None."""
+    try:
+        if os.path.isdir(path):
+            os.listdir(path)
+        else:
+            with open(path, "rb") as f:
+                f.read(1)
+    except OSError as e:
+        return e
+    return None
+
+
 def _probe(req: dict) -> dict:
     """What the sandboxed user can and cannot read (run inside a confined worker)."""
     problems = []
     for what, path in req.get("must_read", []):
-        try:
-            if os.path.isdir(path):
-                os.listdir(path)
-            else:
-                with open(path, "rb") as f:
-                    f.read(1)
-        except OSError as e:
+        if (e := _read_error(path)) is not None:
             problems.append(f"the sandbox cannot read {what} ({path}: {e.strerror})")
     for path in req.get("must_hide", []):
-        try:
-            if os.path.isdir(path):
-                os.listdir(path)
-            else:
-                with open(path, "rb") as f:
-                    f.read(1)
-        except OSError:
-            continue
-        problems.append(f"student code could read {path}, which must stay hidden")
+        if _read_error(path) is None:
+            problems.append(f"student code could read {path}, which must stay hidden")
     return {"kind": "probe", "problems": problems, "uid": os.getuid()}
 
 

@@ -440,12 +440,7 @@ def _ply_assemble(src: _Source, values: dict, lines: dict) -> PlyData:
 
     parts_idx, parts_off = [], []
     if "face" in values:
-        face = values["face"]
-        key = next((k for k in ("vertex_indices", "vertex_index") if isinstance(face.get(k), tuple)), None)
-        if key is None:
-            raise src.error("the 'face' element has no list property 'vertex_indices' (or 'vertex_index')")
-        idx, off = face[key]
-        idx = idx.astype(np.int64)
+        idx, off = _ply_index_lists(src, values, "face")
         lens = np.diff(off)
         if (lens < 3).any():
             f = int(np.flatnonzero(lens < 3)[0])
@@ -455,12 +450,7 @@ def _ply_assemble(src: _Source, values: dict, lines: dict) -> PlyData:
         parts_idx.append(idx)
         parts_off.append(off)
     if "tristrips" in values:
-        ts = values["tristrips"]
-        key = next((k for k in ("vertex_indices", "vertex_index") if isinstance(ts.get(k), tuple)), None)
-        if key is None:
-            raise src.error("the 'tristrips' element has no list property 'vertex_indices'")
-        sidx, soff = ts[key]
-        sidx = sidx.astype(np.int64)
+        sidx, soff = _ply_index_lists(src, values, "tristrips")
         bad = (sidx < -1) | (sidx >= nv)
         if bad.any():
             j = int(np.flatnonzero(bad)[0])
@@ -481,6 +471,16 @@ def _ply_assemble(src: _Source, values: dict, lines: dict) -> PlyData:
     else:
         faces = np.zeros((0, 3), np.int64)
     return PlyData(V=V, faces=faces, N=N, UV=UV, colors=colors, vertex_properties=scalars)
+
+
+def _ply_index_lists(src, values, element: str) -> tuple[np.ndarray, np.ndarray]:
+    """The ``(idx, off)`` vertex-index lists of ``element`` (``face`` or ``tristrips``), idx as int64."""
+    props = values[element]
+    key = next((k for k in ("vertex_indices", "vertex_index") if isinstance(props.get(k), tuple)), None)
+    if key is None:
+        raise src.error(f"the '{element}' element has no list property 'vertex_indices' (or 'vertex_index')")
+    idx, off = props[key]
+    return idx.astype(np.int64), off
 
 
 def _ply_check_indices(src, idx, off, nv, name, ln) -> None:

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets, raster
-from geomlib.plot import Figure, colorbar, figures_or_placeholders, heatmap_image, panels, save_png
+from geomlib.plot import Figure, colorbar, heatmap_image, lab_view, panels, save_png
 from geomlib.viewer import write_html
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
@@ -464,14 +464,11 @@ fig_view.figure_name = "sdf_3d"
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``sdf_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``sdf_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`; before the tasks it needs are implemented, the returned
-    figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     try:
-        return figures_or_placeholders((fig_view,), out, "sdf", quick)[0]
+        return lab_view(fig_view, out_dir, "sdf", quick)
     finally:
         _CACHE.clear()

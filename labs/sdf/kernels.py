@@ -13,44 +13,14 @@ vertices ``a, b, c``, ``4, 5, 6`` the edges ``ab, bc, ca``.
 
 from __future__ import annotations
 
-import os
-import tempfile
-from pathlib import Path
-
-import numba
 import numpy as np
 from numba import njit, prange
 
+from geomlib.jit import use_cache_folder
 
-def _writable_cache() -> None:
-    """Where ``cache=True`` keeps the compiled kernels (given).
-
-    numba's cache holds references to the module by its import name, and one file can be imported
-    under several names (``labs.sdf.kernels`` in your notebook, another name in the grader's
-    workers); a cache written under one name fails to load under another. So each import name gets
-    its own folder under ``__pycache__`` (or under ``NUMBA_CACHE_DIR`` if set). Where this folder is
-    read-only (an autograder may run your code as an unprivileged user), the cache goes to a per-user
-    folder in the temporary directory, so every worker process still loads the kernels instead of
-    compiling them.
-    """
-    name = "numba-" + __name__.replace(".", "_")
-    env = os.environ.get("NUMBA_CACHE_DIR")
-    candidates = [Path(env) / name] if env else []
-    candidates += [
-        Path(__file__).resolve().parent / "__pycache__" / name,
-        Path(tempfile.gettempdir()) / f"geomlib-numba-{os.getuid()}" / name,
-    ]
-    for path in candidates:
-        try:
-            path.mkdir(parents=True, exist_ok=True)
-            tempfile.TemporaryFile(dir=path).close()
-        except OSError:
-            continue
-        numba.config.CACHE_DIR = str(path)
-        return
-
-
-_writable_cache()
+# numba's cache refers to this module by its import name, and the grader imports the lab under
+# another name than your notebook does: one cache folder per import name (given; see geomlib.jit).
+use_cache_folder(__name__, __file__)
 
 STACK = 128  # deeper than any median-split tree over < 2**100 triangles needs
 BLOCK = 64  # consecutive query points walked by one thread, warm-started from each other

@@ -28,7 +28,7 @@ same order (``tests/solutions/test_simplification.py`` checks it).
 Debugging: with the environment variable ``NUMBA_DISABLE_JIT=1`` numba leaves the functions as
 they are and the module runs as ordinary Python (slowly: use a small mesh), so ``print`` and a
 debugger work inside it. Compiled code is cached on disk (``cache=True``), so only the first call
-on a machine compiles (a few seconds); see :mod:`.jit_cache` for where the cache goes.
+on a machine compiles (a few seconds); see :mod:`geomlib.jit` for where the cache goes.
 """
 
 from __future__ import annotations
@@ -36,14 +36,17 @@ from __future__ import annotations
 import heapq
 
 import numpy as np
+from numba import njit
 
+from geomlib.jit import use_cache_folder
 from geomlib.topology import boundary_edges
 
 from .contraction import DEGENERATE_RTOL, _cross
-from .jit_cache import njit
 from .placement import SINGULAR_RCOND, TIE_RTOL
 
 __all__ = ["compiled_collapse"]
+
+use_cache_folder(__name__, __file__)  # before the first @njit(cache=True): see geomlib.jit
 
 
 # ----------------------------------------------------------------------------- placement

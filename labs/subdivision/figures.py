@@ -15,9 +15,10 @@ from geomlib import datasets, topology
 from geomlib.plot import (
     Figure,
     colorbar,
-    figures_or_placeholders,
     heat_colors,
+    lab_figures,
     lab_package,
+    lab_view,
     line_plot,
     panels,
     save_png,
@@ -289,11 +290,9 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         Every figure; one whose tasks are not implemented yet is a picture saying
         "Task N not implemented yet" (under the same file name).
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders(
+    return lab_figures(
         (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence),
-        out,
+        out_dir,
         LAB,
         lab_package(lab, __package__),
         quick,
@@ -301,12 +300,8 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``subdivision_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``subdivision_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
-    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
-    returned figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]
+    return lab_view(fig_view, out_dir, LAB, lab_package(lab, __package__), quick)

@@ -22,9 +22,8 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.geometry import closest_points
-from geomlib.validate import MeshError, as_array, check_mesh
 
-from .grid import split_ok, valid_diagonals
+from .grid import check_grid_inputs, split_ok, valid_diagonals
 from .sampling import sample_surface
 from .segments import segment_intersections
 
@@ -73,15 +72,7 @@ def choose_diagonals(grid_uv, V, F, UV, edges, *, default: bool = True) -> np.nd
     diagonals : (res-1, res-1) bool
     """
     where = "choose_diagonals"
-    G = as_array(grid_uv, "grid_uv", shape=(None, None, 2), where=where)
-    res = G.shape[0]
-    if G.shape[1] != res or res < 2:
-        raise MeshError(f"{where}: grid_uv has shape {G.shape}; expected (res, res, 2) with res >= 2")
-    V, F = check_mesh(V, F, where=where)
-    UV = as_array(UV, "UV", shape=(len(V), 2), where=where)
-    edges = as_array(edges, "edges", shape=(None, 2), dtype=np.int64, where=where)
-    if edges.size and (edges.min() < 0 or edges.max() >= len(V)):
-        raise MeshError(f"{where}: edges hold vertex indices outside 0..{len(V) - 1}")
+    G, V, F, UV, edges = check_grid_inputs(grid_uv, V, F, UV, edges, where)
     diag = valid_diagonals(G, default)
     if len(edges) == 0:
         return diag

@@ -21,8 +21,9 @@ from geomlib.geometry import mesh_distance
 from geomlib.plot import (
     Figure,
     colorbar,
-    figures_or_placeholders,
+    lab_figures,
     lab_package,
+    lab_view,
     line_plot,
     panels,
     save_png,
@@ -351,24 +352,18 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         Every figure; one whose tasks are not implemented yet is a picture saying
         "Task N not implemented yet" (under the same file name).
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders(
-        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep), out, LAB, quick
+    return lab_figures(
+        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep), out_dir, LAB, quick
     )
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``vdm_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``vdm_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
-    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
-    returned figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders((_fig_view,), out, LAB, quick)[0]
+    return lab_view(_fig_view, out_dir, LAB, quick)

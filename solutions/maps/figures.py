@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, figures_or_placeholders, lab_package, panels, save_png
+from geomlib.plot import Figure, lab_figures, lab_package, lab_view, panels, save_png
 from geomlib.textures import triangle_atlas
 from geomlib.viewer import write_html
 
@@ -275,22 +275,16 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         Every figure; one whose tasks are not implemented yet is a picture saying
         "Task N not implemented yet" (under the same file name).
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), out, LAB, quick)
+    return lab_figures((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), out_dir, LAB, quick)
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``maps_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``maps_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
-    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
-    returned figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders((_fig_view,), out, LAB, quick)[0]
+    return lab_view(_fig_view, out_dir, LAB, quick)

@@ -15,9 +15,10 @@ import numpy as np
 from geomlib.plot import (
     Figure,
     colorbar,
-    figures_or_placeholders,
     heatmap_image,
+    lab_figures,
     lab_package,
+    lab_view,
     panels,
     save_png,
     with_colorbar,
@@ -328,28 +329,22 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         Every figure; one whose tasks are not implemented yet is a picture saying
         "Task N not implemented yet" (under the same file name).
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
     _CACHE.clear()
     try:
-        return figures_or_placeholders(
-            (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), out, LAB, quick
+        return lab_figures(
+            (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), out_dir, LAB, quick
         )
     finally:
         _CACHE.clear()
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``shadows_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``shadows_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
-    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
-    returned figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     global _L
     _L = lab_package(lab, __package__)
-    return figures_or_placeholders((fig_view,), out, LAB, quick)[0]
+    return lab_view(fig_view, out_dir, LAB, quick)

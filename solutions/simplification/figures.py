@@ -16,9 +16,10 @@ from geomlib.geometry import closest_points, mesh_distance
 from geomlib.plot import (
     Figure,
     colorbar,
-    figures_or_placeholders,
     heat_colors,
+    lab_figures,
     lab_package,
+    lab_view,
     line_plot,
     panels,
     save_png,
@@ -282,20 +283,14 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         Every figure; one whose tasks are not implemented yet is a picture saying
         "Task N not implemented yet" (under the same file name).
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders(
-        (fig_series, fig_error_curve, fig_pairs, fig_boundary), out, LAB, lab_package(lab, __package__), quick
+    return lab_figures(
+        (fig_series, fig_error_curve, fig_pairs, fig_boundary), out_dir, LAB, lab_package(lab, __package__), quick
     )
 
 
 def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``simplification_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
+    """Write ``simplification_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
 
-    Same arguments as :func:`make_figures`. Open the page in a browser and turn the result with the
-    mouse; ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the
-    returned figure is a "Task N not implemented yet" picture instead.
+    Same arguments as :func:`make_figures`.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders((fig_view,), out, LAB, lab_package(lab, __package__), quick)[0]
+    return lab_view(fig_view, out_dir, LAB, lab_package(lab, __package__), quick)

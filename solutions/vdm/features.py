@@ -26,9 +26,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from geomlib.geometry import dihedral_angles
-from geomlib.validate import MeshError, as_array, check_float, check_mesh
+from geomlib.validate import as_array, check_float, check_mesh
 
-from .grid import folded_cells
+from .grid import check_grid_inputs, check_vertex_indices, folded_cells
 from .segments import segment_intersections
 
 __all__ = ["sharp_features", "align_to_features", "grid_edges"]
@@ -156,20 +156,11 @@ def align_to_features(grid_uv, V, F, UV, edges, corners, *, return_moved: bool =
     before every pass because earlier moves bend the grid edges.
     """
     where = "align_to_features"
-    G = as_array(grid_uv, "grid_uv", shape=(None, None, 2), where=where).copy()
+    G, V, F, UV, edges = check_grid_inputs(grid_uv, V, F, UV, edges, where)
+    G = G.copy()
     res = G.shape[0]
-    if G.shape[1] != res or res < 2:
-        raise MeshError(f"{where}: grid_uv has shape {G.shape}; expected (res, res, 2) with res >= 2")
-    V, F = check_mesh(V, F, where=where)
-    UV = as_array(UV, "UV", shape=(len(V), 2), where=where)
-    edges = as_array(edges, "edges", shape=(None, 2), dtype=np.int64, where=where)
     corners = as_array(corners, "corners", shape=(None,), dtype=np.int64, where=where)
-    for name, idx in (("edges", edges), ("corners", corners)):
-        if idx.size and (idx.min() < 0 or idx.max() >= len(V)):
-            raise MeshError(
-                f"{where}: {name} holds vertex index {int(idx.max() if idx.max() >= len(V) else idx.min())}, "
-                f"valid indices are 0..{len(V) - 1}"
-            )
+    check_vertex_indices(corners, "corners", len(V), where)
     locked = np.zeros((res, res), bool)
     # BEGIN SOLUTION: Task 7b (alignment): snap corners, then the nearer end of each crossed grid edge; once per vertex, no folds
     colour = ((np.arange(res)[:, None] % 2) * 2 + np.arange(res)[None, :] % 2).ravel()

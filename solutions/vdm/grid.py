@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from geomlib.validate import MeshError, as_array, check_mesh
+
 __all__ = [
     "uniform_grid",
     "cell_areas",
@@ -98,3 +100,29 @@ def grid_faces(res: int, diagonals=None) -> np.ndarray:
     t1 = np.where(diag[:, None], np.stack([a, b, c], 1), np.stack([a, b, d], 1))
     t2 = np.where(diag[:, None], np.stack([a, c, d], 1), np.stack([b, c, d], 1))
     return np.stack([t1, t2], axis=1).reshape(-1, 3).astype(np.int64)
+
+
+def check_vertex_indices(idx: np.ndarray, name: str, n: int, where: str) -> None:
+    """Raise :class:`MeshError` unless every entry of ``idx`` is a vertex index ``0..n-1``."""
+    if idx.size and (idx.min() < 0 or idx.max() >= n):
+        bad = int(idx.max() if idx.max() >= n else idx.min())
+        raise MeshError(f"{where}: {name} holds vertex index {bad}, valid indices are 0..{n - 1}")
+
+
+def check_grid_inputs(grid_uv, V, F, UV, edges, where: str):
+    """Validate the inputs shared by the feature steps: a ``(res, res, 2)`` grid, a mesh, its UVs, sharp edges.
+
+    Returns
+    -------
+    G : (res, res, 2) float64
+    V, F, UV, edges
+        Checked arrays (``edges`` as ``(k, 2)`` int64 vertex indices).
+    """
+    G = as_array(grid_uv, "grid_uv", shape=(None, None, 2), where=where)
+    if G.shape[1] != G.shape[0] or G.shape[0] < 2:
+        raise MeshError(f"{where}: grid_uv has shape {G.shape}; expected (res, res, 2) with res >= 2")
+    V, F = check_mesh(V, F, where=where)
+    UV = as_array(UV, "UV", shape=(len(V), 2), where=where)
+    edges = as_array(edges, "edges", shape=(None, 2), dtype=np.int64, where=where)
+    check_vertex_indices(edges, "edges", len(V), where)
+    return G, V, F, UV, edges

@@ -219,3 +219,13 @@ def test_checks_refuse_nan_inf_complex_and_strings_where_the_reference_is_finite
         checks.ImageMatch()(img, {"image": np.full((4, 4, 3), np.nan)}, ctx)
     # NaN where the reference holds NaN too is not a problem of its own.
     checks.Allclose("x", atol=np.inf)({"x": np.array([np.nan, 0.0])}, {"x": np.array([np.nan, 0.0])}, ctx)
+
+
+def test_read_error_says_what_the_probe_cannot_read(tmp_path):
+    from geomlib.grading.zygote import _read_error
+
+    (tmp_path / "file").write_bytes(b"x")
+    assert _read_error(str(tmp_path / "file")) is None
+    assert _read_error(str(tmp_path)) is None  # a folder counts as readable when it can be listed
+    missing = _read_error(str(tmp_path / "missing"))
+    assert isinstance(missing, FileNotFoundError) and missing.strerror

@@ -449,6 +449,15 @@ def test_ply_header_and_ascii_errors(tmp_path):
         (ply_header("ascii", face) + b"3 0 1 2\n", "the file has no 'vertex' element"),
         (ply_header("ascii", face), "line 6: file ends after 0 of 1 'face' records"),
         (b"ply\nformat ascii 1.0\nelement vertex 1\n", "no 'end_header'"),
+        (
+            ply_header("ascii", vert, "element face 1\nproperty uchar n\n") + b"0 0 0\n1 0 0\n0 1 0\n3\n",
+            "the 'face' element has no list property 'vertex_indices' (or 'vertex_index')",
+        ),
+        (
+            ply_header("ascii", vert, "element tristrips 1\nproperty list int int corners\n")
+            + b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            "the 'tristrips' element has no list property 'vertex_indices' (or 'vertex_index')",
+        ),
     ]
     for content, message in cases:
         with pytest.raises(MeshError) as e:

@@ -40,6 +40,17 @@ TILTED_F = np.array([[0, 1, 2]])
 TILTED_P = np.array([1.0, 1.0, 1.0, -1.0]) / np.sqrt(3)  # unit normal, d = -n · v0
 
 
+def expect_tilted_face_quadric(lab) -> None:
+    """The area-weighted quadric of the tilted triangle: K = (√3 / 2) p pᵀ."""
+    K = lab.face_quadrics(TILTED_V, TILTED_F)
+    expect_close(
+        "face_quadrics on the tilted triangle",
+        np.asarray(K)[0],
+        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
+        name="K[0]",
+    )
+
+
 def expect_true(label: str, condition: bool, message: str) -> None:
     if not condition:
         raise Mismatch(f"{label}: {message}")
@@ -52,13 +63,7 @@ def expect_true(label: str, condition: bool, message: str) -> None:
 @graded(points=1, part="quadrics")
 def test_face_quadric_of_a_tilted_triangle(lab):
     """plane x + y + z = 1: p = (1, 1, 1, -1)/√3, K = area · p pᵀ with area √3/2"""
-    K = lab.face_quadrics(TILTED_V, TILTED_F)
-    expect_close(
-        "face_quadrics on the tilted triangle",
-        np.asarray(K)[0],
-        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
-        name="K[0]",
-    )
+    expect_tilted_face_quadric(lab)
     K = lab.face_quadrics(TILTED_V, TILTED_F, weighting="uniform")
     expect_close(
         'face_quadrics(weighting="uniform") on the tilted triangle',
@@ -107,13 +112,7 @@ def test_vertex_quadrics_vanish_at_their_vertex(lab):
 @graded(points=1, part="quadrics")
 def test_quadrics_reject_an_unknown_weighting(lab):
     """a correct result on valid input, then a MeshError naming the bad weighting"""
-    K = lab.face_quadrics(TILTED_V, TILTED_F)
-    expect_close(
-        "face_quadrics on the tilted triangle",
-        np.asarray(K)[0],
-        np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
-        name="K[0]",
-    )
+    expect_tilted_face_quadric(lab)
     expect_raises(lambda: lab.face_quadrics(TILTED_V, TILTED_F, weighting="volume"), "MeshError", match="weighting")
 
 
@@ -125,55 +124,42 @@ def planes(*ps) -> np.ndarray:
     return sum(np.outer(p, p) for p in np.asarray(ps, dtype=float))
 
 
+def expect_contraction(lab, label, Q, v1, v2, position, cost, *, atol, cost_atol=None, hint=None) -> None:
+    """``optimal_contraction(Q, v1, v2)`` gives ``position`` (within ``atol``) and ``cost``."""
+    pos, c = lab.optimal_contraction(Q, v1, v2)
+    expect_close(f"optimal_contraction, {label}", pos, position, atol=atol, name="position", hint=hint)
+    expect_close(f"optimal_contraction, {label}", c, cost, atol=atol if cost_atol is None else cost_atol, name="cost")
+
+
 @graded(points=1, part="placement")
 def test_placement_regular_system(lab):
     """planes x = 0, y = 0, z = 0 and x = 1: A = diag(2, 1, 1), b = (-1, 0, 0) → x = (1/2, 0, 0), cost 1/4 + 1/4"""
     Q = planes([1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [1, 0, 0, -1])
-    pos, cost = lab.optimal_contraction(Q, [5.0, 5, 5], [6.0, 6, 6])
-    expect_close("optimal_contraction, regular A", pos, [0.5, 0, 0], atol=1e-12, name="position")
-    expect_close("optimal_contraction, regular A", cost, 0.5, atol=1e-12, name="cost")
+    expect_contraction(lab, "regular A", Q, [5.0, 5, 5], [6.0, 6, 6], [0.5, 0, 0], 0.5, atol=1e-12)
 
 
 @graded(points=1, part="placement")
 def test_placement_flat_neighbourhood_takes_the_midpoint(lab):
     """all planes z = 0: A singular and the cost 0 along the whole segment → the midpoint"""
-    pos, cost = lab.optimal_contraction(planes([0, 0, 1, 0]), [0.0, 0, 0], [1.0, 2, 0])
-    expect_close(
-        "optimal_contraction, flat neighbourhood",
-        pos,
-        [0.5, 1, 0],
-        atol=1e-12,
-        name="position",
+    expect_contraction(
+        lab, "flat neighbourhood", planes([0, 0, 1, 0]), [0.0, 0, 0], [1.0, 2, 0], [0.5, 1, 0], 0.0, atol=1e-12,
         hint="A is singular and the cost is constant on the segment: ties go to the midpoint",
-    )
-    expect_close("optimal_contraction, flat neighbourhood", cost, 0.0, atol=1e-12, name="cost")
+    )  # fmt: skip
 
 
 @graded(points=1, part="placement")
 def test_placement_linear_neighbourhood_searches_the_segment(lab):
     """planes x = 0 and y = 0 (a line of minimisers): on v1 + t(v2 - v1) the cost is (4t - 1)² + 1/4 → t = 1/4"""
     Q = planes([1, 0, 0, 0], [0, 1, 0, 0])
-    pos, cost = lab.optimal_contraction(Q, [-1.0, 0.5, 0], [3.0, 0.5, 2])
-    expect_close(
-        "optimal_contraction, linear neighbourhood",
-        pos,
-        [0.0, 0.5, 0.5],
-        atol=1e-9,
-        name="position",
+    expect_contraction(
+        lab, "linear neighbourhood", Q, [-1.0, 0.5, 0], [3.0, 0.5, 2], [0.0, 0.5, 0.5], 0.25, atol=1e-9,
         hint="t* = -dᵀ(A v1 + b) / (dᵀ A d), clipped to [0, 1]",
-    )
-    expect_close("optimal_contraction, linear neighbourhood", cost, 0.25, atol=1e-9, name="cost")
+    )  # fmt: skip
     # t* = 5 for the line x = 5, y = 0 and the segment (0,0,0)-(1,0,0): clipped to t = 1, cost 16
-    pos, cost = lab.optimal_contraction(planes([1, 0, 0, -5], [0, 1, 0, 0]), [0.0, 0, 0], [1.0, 0, 0])
-    expect_close(
-        "optimal_contraction, minimiser beyond v2",
-        pos,
-        [1.0, 0, 0],
-        atol=1e-12,
-        name="position",
-        hint="clip t to [0, 1]",
-    )
-    expect_close("optimal_contraction, minimiser beyond v2", cost, 16.0, atol=1e-9, name="cost")
+    expect_contraction(
+        lab, "minimiser beyond v2", planes([1, 0, 0, -5], [0, 1, 0, 0]), [0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], 16.0,
+        atol=1e-12, cost_atol=1e-9, hint="clip t to [0, 1]",
+    )  # fmt: skip
 
 
 @graded(points=1, part="placement")
