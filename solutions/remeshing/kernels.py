@@ -25,6 +25,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from geomlib.jit import use_cache_folder
+
+# numba's cache refers to this module by its import name, and the grader imports the lab under
+# another name than your notebook does, from a read-only copy: one cache folder per import name,
+# in a private temporary folder when the lab folder is not writable (given; see geomlib.jit).
+use_cache_folder(__name__, __file__)
+
 #: Largest one-ring the kernels walk (a vertex with more faces is left alone).
 RING = 256
 
