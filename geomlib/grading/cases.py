@@ -55,7 +55,8 @@ class Case:
     params : dict
         JSON-able extra keyword arguments (recorded in the manifest).
     outputs : tuple of str
-        Names of the returned values (one name: the function returns a single value).
+        Names of the returned values (one name: the function returns a single value); for a
+        function that returns a dataclass, names of its fields.
     check : callable
         A comparison from :mod:`geomlib.grading.checks`.
     part : str
@@ -103,6 +104,10 @@ class Case:
         if len(self.outputs) == 1:
             return {self.outputs[0]: result}
         names = ", ".join(self.outputs)
+        fields = getattr(result, "__dict__", None)
+        if not isinstance(result, tuple | list) and isinstance(fields, dict) and all(n in fields for n in self.outputs):
+            # A returned dataclass (``ReturnedDataclass`` across the sandbox): the outputs name its fields.
+            return {n: fields[n] for n in self.outputs}
         if not isinstance(result, tuple | list):
             raise BadReturn(
                 f"{label}: should return {len(self.outputs)} values ({names}), got a single {type(result).__name__}"
