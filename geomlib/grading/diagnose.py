@@ -137,6 +137,8 @@ def _grid_image(ctx, expected, got):
 
     for name, e in expected.items():
         e = np.asarray(e)
+        if e.dtype.kind == "b" and e.ndim == 2 and min(e.shape) >= 2:
+            e = e.astype(float)  # a per-cell choice (diagonals): drawn as 0/1, the wrong cells lit
         try:
             g = np.asarray(got.get(name), dtype=float)
         except (TypeError, ValueError):
