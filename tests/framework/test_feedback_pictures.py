@@ -2,7 +2,8 @@
 lab's reference cases, and every failing case whose output is geometric gets a feedback picture.
 
 Geometric here: the case's inputs hold a mesh (``V`` and ``F``/``faces``), or an output is a grid or
-image (``(h, w, c)``, or ``(h, w)`` with both sides at least 8, booleans included: vdm's diagonals).
+image (``(h, w, c)``, or ``(h, w)`` with both sides at least 8, booleans included: vdm's diagonals),
+or points with no mesh (``(n, 2)`` or ``(n, 3)``: shadows' light-space ``(u, v, z)``).
 Not geometric, and so allowed without a picture: outputs on free-standing random vectors with no
 mesh or grid to draw them on (denoise's ``normal_offsets`` on random ``delta``/``N``: a list of
 scalars). Hand-written graded tests (``test_<lab>.py``) call ``expect_close`` without a feedback
@@ -44,6 +45,16 @@ PLANTS = {
         """,
         3,
     ),
+    "shadows": (
+        "lookup",
+        """
+        _true_light_uvz = light_uvz
+
+        def light_uvz(P, M):
+            return np.asarray(_true_light_uvz(P, M)) + [0.05, 0.0, 0.0]
+        """,
+        3,
+    ),
 }
 
 
@@ -59,6 +70,8 @@ def _geometric(case, expected: dict) -> bool:
             return True
         if e.ndim == 2 and min(e.shape) >= 8:
             return True
+        if e.dtype.kind == "f" and e.ndim == 2 and e.shape[1] in (2, 3) and len(e) >= 2:
+            return True  # free-standing points (light-space (u, v, z)): a scatter picture
     return False
 
 
