@@ -456,7 +456,7 @@ CASES = [
             TexelClose("grid_uv", atol=1e-6), TexelClose("displacement", atol=1e-6), checks.Equal("diagonals")
         ),
         part="whole bake",
-        points=1,
+        points=0,  # scores nothing of its own (Tasks 1-8 are graded); here to name the wrong task in a wrong bake
         hint="bake_vdm is given: it chains Tasks 1-8, so a wrong bake comes from one of them",
     ),
 ]
