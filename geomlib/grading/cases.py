@@ -298,10 +298,17 @@ def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Ca
     ``cases_hidden.py`` and the probe-only cases of ``diagnose.py``, which need references but are
     never graded)."""
     tests = str(_impl.tests_dir())
-    if tests not in sys.path:
+    if sys.path[:1] != [tests]:  # first, ahead of another course's tests folder imported in this process
+        if tests in sys.path:
+            sys.path.remove(tests)
         sys.path.insert(0, tests)
     cases: list[Case] = []
     folder = _impl.tests_dir() / "graded" / lab
+    loaded = sys.modules.get("graded")
+    if loaded is not None and str(folder.parent) not in [str(Path(p)) for p in getattr(loaded, "__path__", [])]:
+        # `graded` was imported from another course (a fixture course in the same process): forget it.
+        for name in [m for m in sys.modules if m == "graded" or m.startswith("graded.")]:
+            del sys.modules[name]
     for mod_name, is_hidden in (("cases", False), ("cases_hidden", True), ("diagnose", False)):
         if (is_hidden and not hidden) or (mod_name == "diagnose" and not probes):
             continue
