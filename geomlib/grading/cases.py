@@ -55,7 +55,8 @@ class Case:
     params : dict
         JSON-able extra keyword arguments (recorded in the manifest).
     outputs : tuple of str
-        Names of the returned values (one name: the function returns a single value).
+        Names of the returned values (one name: the function returns a single value); for a
+        function that returns a dataclass, names of its fields.
     check : callable
         A comparison from :mod:`geomlib.grading.checks`.
     part : str
@@ -103,6 +104,10 @@ class Case:
         if len(self.outputs) == 1:
             return {self.outputs[0]: result}
         names = ", ".join(self.outputs)
+        fields = getattr(result, "__dict__", None)
+        if not isinstance(result, tuple | list) and isinstance(fields, dict) and all(n in fields for n in self.outputs):
+            # A returned dataclass (``ReturnedDataclass`` across the sandbox): the outputs name its fields.
+            return {n: fields[n] for n in self.outputs}
         if not isinstance(result, tuple | list):
             raise BadReturn(
                 f"{label}: should return {len(self.outputs)} values ({names}), got a single {type(result).__name__}"
@@ -293,10 +298,17 @@ def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Ca
     ``cases_hidden.py`` and the probe-only cases of ``diagnose.py``, which need references but are
     never graded)."""
     tests = str(_impl.tests_dir())
-    if tests not in sys.path:
+    if sys.path[:1] != [tests]:  # first, ahead of another course's tests folder imported in this process
+        if tests in sys.path:
+            sys.path.remove(tests)
         sys.path.insert(0, tests)
     cases: list[Case] = []
     folder = _impl.tests_dir() / "graded" / lab
+    loaded = sys.modules.get("graded")
+    if loaded is not None and str(folder.parent) not in [str(Path(p)) for p in getattr(loaded, "__path__", [])]:
+        # `graded` was imported from another course (a fixture course in the same process): forget it.
+        for name in [m for m in sys.modules if m == "graded" or m.startswith("graded.")]:
+            del sys.modules[name]
     for mod_name, is_hidden in (("cases", False), ("cases_hidden", True), ("diagnose", False)):
         if (is_hidden and not hidden) or (mod_name == "diagnose" and not probes):
             continue

@@ -125,7 +125,34 @@ def _picture(mod, function, ctx, inputs, expected, got):
 
 def _default_picture(ctx, inputs, expected, got):
     """A picture for a wrong array: rows on the input mesh, or a grid output as an image."""
-    return _rows_on_mesh(ctx, inputs, expected, got) or _grid_image(ctx, expected, got)
+    return (
+        _rows_on_mesh(ctx, inputs, expected, got)
+        or _grid_image(ctx, expected, got)
+        or _free_points(ctx, inputs, expected, got)
+    )
+
+
+def _free_points(ctx, inputs, expected, got):
+    """Points with no mesh to draw them on (light-space (u, v, z), sample positions): a scatter of the
+    expected and submitted points, wrong ones joined to where they should be."""
+    import numpy as np
+
+    from geomlib.grading import feedback
+
+    if "V" in inputs:
+        return None  # on a mesh: _rows_on_mesh's business
+    for name, e in expected.items():
+        e = np.asarray(e)
+        try:
+            g = np.asarray(got.get(name), dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if e.dtype.kind != "f" or e.ndim != 2 or e.shape[1] not in (2, 3) or len(e) < 2 or g.shape != e.shape:
+            continue
+        if np.isclose(g, e, rtol=0.0, atol=1e-8).all():
+            continue
+        return feedback.points_picture(ctx, e, g, name)
+    return None
 
 
 def _grid_image(ctx, expected, got):
@@ -137,6 +164,8 @@ def _grid_image(ctx, expected, got):
 
     for name, e in expected.items():
         e = np.asarray(e)
+        if e.dtype.kind == "b" and e.ndim == 2 and min(e.shape) >= 2:
+            e = e.astype(float)  # a per-cell choice (diagonals): drawn as 0/1, the wrong cells lit
         try:
             g = np.asarray(got.get(name), dtype=float)
         except (TypeError, ValueError):

@@ -183,3 +183,48 @@ def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -
         plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
+
+
+def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: str) -> str | None:
+    """Expected and submitted ``(n, 2)`` or ``(n, 3)`` points with no mesh to draw them on (e.g. light-space
+    ``(u, v, z)``), seen from above: the first two coordinates, each wrong row joined to where it should be,
+    coloured by its error."""
+    path = ctx.feedback_path()
+    if path is None:
+        return None
+
+    def draw():
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from matplotlib.collections import LineCollection
+
+        e, g = np.asarray(expected, float), np.asarray(got, float)
+        err = np.linalg.norm(np.nan_to_num(g - e, nan=np.inf, posinf=np.inf, neginf=np.inf), axis=1)
+        bad = ~(err <= 1e-8)
+        fig, ax = plt.subplots(figsize=(6.4, 5.6), dpi=100)
+        ax.scatter(e[:, 0], e[:, 1], s=10, c="#1f77b4", label="expected", zorder=2)
+        gf = np.isfinite(g[:, :2]).all(axis=1)
+        ax.scatter(g[gf, 0], g[gf, 1], s=14, c="#d62728", marker="x", label="submitted", zorder=3)
+        both = bad & gf
+        if both.any():
+            shown = np.where(np.isfinite(err[both]), err[both], np.nan)
+            vmax = max(float(np.nanmax(shown)) if np.isfinite(shown).any() else 1.0, 1e-12)
+            lines = LineCollection(
+                np.stack([e[both, :2], g[both, :2]], axis=1), cmap="inferno", linewidths=1.5, zorder=1
+            )
+            lines.set_array(np.nan_to_num(shown, nan=vmax))
+            lines.set_clim(0.0, vmax)
+            ax.add_collection(lines)
+            fig.colorbar(lines, ax=ax, label=f"|{name} error|")
+        ax.set_xlabel(f"{name}[:, 0]")
+        ax.set_ylabel(f"{name}[:, 1]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.legend(loc="best", fontsize=8)
+        ax.set_title(f"{ctx.label}\n{int(bad.sum())} of {len(e)} rows of {name} are wrong", fontsize=9)
+        fig.tight_layout()
+        fig.savefig(path)
+        plt.close(fig)
+
+    return _drawn_in_time(path, draw)

@@ -132,6 +132,33 @@ PLANTS = {
         "naive-box-12",
         ["naive_vdm is off because sample_surface (Task 2:"],
     ),
+    "vdm-bake-sampling": (
+        "vdm",
+        "sampling",
+        """
+        _true_sample_surface = sample_surface
+
+        def sample_surface(V, F, UV, uv_points):
+            return 1.01 * _true_sample_surface(V, F, UV, uv_points)
+        """,
+        "bake-box-6-12",
+        ["bake_vdm is off because sample_surface (Task 2:"],
+    ),
+    "vdm-bake-transport": (
+        "vdm",
+        "transport",
+        """
+        _true_transport_grid = transport_grid
+
+        def transport_grid(field, res, *, boundary="fixed", iterations=20, smoothing=1.0, return_info=False):
+            return _true_transport_grid(
+                field, res, boundary=boundary, iterations=max(1, iterations // 4), smoothing=smoothing,
+                return_info=return_info,
+            )
+        """,
+        "bake-box-6-12",
+        ["bake_vdm is off because transport_grid (Task 6:"],
+    ),
 }
 
 

@@ -445,4 +445,18 @@ CASES = [
         points=1,
         hint="cells no sharp edge crosses keep `default` (unless only the other split has two positive triangles)",
     ),
+    # ----------------------------------------------------------------------- the whole bake (given code)
+    Case(
+        id="bake-box-6-12",
+        function="bake_vdm",
+        inputs=lambda: dict(zip(("V", "F"), open_box(6), strict=True)),
+        params={"res": 12},
+        outputs=("displacement", "grid_uv", "diagonals"),  # fields of the returned VDM
+        check=checks.All(
+            TexelClose("grid_uv", atol=1e-6), TexelClose("displacement", atol=1e-6), checks.Equal("diagonals")
+        ),
+        part="whole bake",
+        points=0,  # scores nothing of its own (Tasks 1-8 are graded); here to name the wrong task in a wrong bake
+        hint="bake_vdm is given: it chains Tasks 1-8, so a wrong bake comes from one of them",
+    ),
 ]
