@@ -23,6 +23,7 @@ from geomlib.viewer import write_html
 
 from .bump import bump_normal
 from .heights import bricks, bumps
+from .inputs import height_at
 from .parallax import parallax_uv
 from .relief import REFINEMENTS, relief_uv
 from .shadow import relief_shadow
@@ -120,10 +121,8 @@ def _method_panels(H, kind, size):
 
     add(f"POM ({'binary' if kind == 'bricks' else 'secant'}) + self-shadow, uv outside [0, 1] discarded", pom_shadow)
     truth, _ = exact_uv(H, uv, view, scale=SCALE, samples=1024)
-    imgs.append(shifted(truth))
-    caps.append("exact ray / height-field hit")
-    imgs.append(_displaced(H, kind, size))
-    caps.append("true displaced geometry (rasterized grid)")
+    add("exact ray / height-field hit", lambda: shifted(truth))
+    add("true displaced geometry (rasterized grid)", lambda: _displaced(H, kind, size))
     return imgs, caps
 
 
@@ -287,6 +286,104 @@ def _fig_steps(out: Path, quick: bool) -> Figure:
     )
 
 
+# The curved mesh of the silhouette figure: half a cylinder of radius R around the y axis, length W,
+# textured once. u runs around the arc (u = 0 at -x, 1/2 on top, 1 at +x), v along the axis; the
+# frame (dP/du, dP/dv, outward normal) is right-handed like the quad's (x, y, z).
+_ARC_R, _ARC_W, _ARC_DEPTH = 0.5, 1.6, 0.08
+_ARC_EYE = np.array([3.0, -1.2, 1.2])
+_ARC_LIGHT = np.array([0.7, -0.5, 0.6]) / np.linalg.norm([0.7, -0.5, 0.6])
+
+
+def _arc(uv, depth=None):
+    """Positions, unit tangent, bitangent and normal (each (..., 3)) of the half cylinder at ``uv``,
+    the positions moved ``depth`` (...) inward along the normal."""
+    t = np.pi * (1.0 - uv[..., 0])
+    zero, one = np.zeros_like(t), np.ones_like(t)
+    N = np.stack([np.cos(t), zero, np.sin(t)], axis=-1)
+    T = np.stack([np.sin(t), zero, -np.cos(t)], axis=-1)  # dP/du / (pi R)
+    B = np.stack([zero, one, zero], axis=-1)  # dP/dv / W
+    P = np.stack([_ARC_R * np.cos(t), _ARC_W * (uv[..., 1] - 0.5), _ARC_R * np.sin(t)], axis=-1)
+    if depth is not None:
+        P = P - depth[..., None] * N
+    return P, T, B, N
+
+
+def _arc_render(H, size, cells, depth=None):
+    """Rasterize the half cylinder (displaced by ``depth(uv)`` when given) from ``_ARC_EYE``: mask and uv."""
+    Vg, F = datasets.grid_patch(cells)
+    uv = Vg[:, :2]
+    P, *_ = _arc(uv, None if depth is None else depth(uv))
+    M = camera.perspective(30, 1.0, 0.1, 10.0) @ camera.look_at(_ARC_EYE, (0.0, 0.0, 0.3), (0, 0, 1))
+    g = rasterize(P, F, M, size, size, attributes={"uv": uv})
+    return g.mask, g.attributes["uv"]
+
+
+def _arc_shade(H, mask, uv, normal_ts, kind="bumps"):
+    """Lambert + ambient with tangent-space normals turned into world space on the cylinder."""
+    _, T, B, N = _arc(uv)
+    n = T * normal_ts[..., :1] + B * normal_ts[..., 1:2] + N * normal_ts[..., 2:]
+    n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
+    img = albedo(H, uv, kind) * (0.25 + 0.75 * np.clip(n @ _ARC_LIGHT, 0, None)[..., None])
+    img[~mask] = BACKGROUND
+    return np.clip(img, 0, 1)
+
+
+def _fig_silhouette(out: Path, quick: bool) -> Figure:
+    size = 160 if quick else 300
+    H = bumps(128 if quick else 256)
+    mask, uv = _arc_render(H, size, 64)
+    P, T, B, N = _arc(uv)
+    v = _ARC_EYE - P
+    # The tangent-space view in uv units: a step of 1 in u is pi R long on the surface, in v it is W
+    # long; the depth stays in world units, so relief_uv's shift scale * d * view_xy / view_z is in uv.
+    view = np.stack(
+        [(T * v).sum(-1) / (np.pi * _ARC_R), (B * v).sum(-1) / _ARC_W, np.maximum((N * v).sum(-1), 1e-4)], axis=-1
+    )
+    view /= np.linalg.norm(view, axis=-1, keepdims=True)
+    view[~mask] = (0.0, 0.0, 1.0)
+    strength = _ARC_DEPTH / (np.pi * _ARC_R)  # the bump's slope per unit of u, in world units (u is pi R long)
+
+    def pom():
+        hit, _, _ = relief_uv(H, uv, view, scale=_ARC_DEPTH, refine="secant")
+        keep = mask & inside_texture(hit)
+        return _arc_shade(H, keep, hit, bump_normal(H, hit, strength=strength)), keep
+
+    made, note = _try(pom, size)
+    pom_img, pom_mask = made if made is not None else (_missing(size), mask)
+    true_mask, true_uv = _arc_render(H, size, 96 if quick else 200, depth=lambda q: _ARC_DEPTH * (1 - height_at(H, q[:, 0], q[:, 1])))
+    up = np.zeros(true_uv.shape[:2] + (3,))
+    up[..., 2] = 1.0
+    bumped, _ = _try(lambda: bump_normal(H, true_uv, strength=strength), size)
+    true_img = _arc_shade(H, true_mask, true_uv, up if bumped is None else bumped)
+    # Outline comparison: grey where both cover the pixel, red where only POM does (the notches the
+    # real relief cuts into the outline), blue where only the displaced mesh does.
+    cmp = np.full((size, size, 3), BACKGROUND)
+    cmp[pom_mask & true_mask] = (0.62, 0.62, 0.62)
+    cmp[pom_mask & ~true_mask] = (0.85, 0.12, 0.10)
+    cmp[~pom_mask & true_mask] = (0.15, 0.35, 0.85)
+    only_pom = int((pom_mask & ~true_mask).sum())
+    only_true = int((~pom_mask & true_mask).sum())
+    img = panels(
+        [pom_img, true_img, cmp],
+        [
+            "POM (secant) + discard, on the smooth half cylinder" + (note or ""),
+            "true geometry: the cylinder displaced by the bumps",
+            f"outlines: both (grey), POM only (red, {only_pom} px), displaced only (blue, {only_true} px)",
+        ],
+        title="Silhouette on a curved mesh: relief mapping cannot change the outline",
+    )
+    return Figure(
+        save_png(out / "silhouette.png", img),
+        "Smooth bumps, up to 0.08 deep, on a half cylinder of radius 0.5 seen from the side: the far top edge is "
+        "the silhouette. Relief mapping only moves the texture inside the triangles that are drawn, so its "
+        "outline stays the straight top line of the cylinder, while the truly displaced surface dips between the "
+        "bumps and its outline is wavy (red: pixels POM draws that are empty in reality). Discarding uv outside "
+        "[0, 1] carves only at the patch's ends (blue: the displaced surface is there, POM discarded the pixels). "
+        "Shell mapping would give the relief a volume.",
+        LAB,
+    )
+
+
 def _named_missing(build, out: Path, quick: bool) -> list[Figure]:
     """Draw one figure builder; where panels had to be left out, each caption starts with the missing task."""
     _MISSING.clear()
@@ -315,8 +412,8 @@ def make_figures(out_dir: Path, lab=None, quick: bool = False) -> list[Figure]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs: list[Figure] = []
-    names = {_fig_methods: "methods_bumps", _fig_errors: "uv_error", _fig_error_vs_angle: "error_vs_angle"}
-    for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps):
+    names = {_fig_methods: "methods_bumps", _fig_errors: "uv_error", _fig_error_vs_angle: "error_vs_angle", _fig_silhouette: "silhouette"}
+    for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps, _fig_silhouette):
 
         def draw(o, q, b=build):
             return _named_missing(b, o, q)
