@@ -350,7 +350,9 @@ def _fig_silhouette(out: Path, quick: bool) -> Figure:
 
     made, note = _try(pom, size)
     pom_img, pom_mask = made if made is not None else (_missing(size), mask)
-    true_mask, true_uv = _arc_render(H, size, 96 if quick else 200, depth=lambda q: _ARC_DEPTH * (1 - height_at(H, q[:, 0], q[:, 1])))
+    true_mask, true_uv = _arc_render(
+        H, size, 96 if quick else 200, depth=lambda q: _ARC_DEPTH * (1 - height_at(H, q[:, 0], q[:, 1]))
+    )
     up = np.zeros(true_uv.shape[:2] + (3,))
     up[..., 2] = 1.0
     bumped, _ = _try(lambda: bump_normal(H, true_uv, strength=strength), size)
@@ -412,7 +414,12 @@ def make_figures(out_dir: Path, lab=None, quick: bool = False) -> list[Figure]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs: list[Figure] = []
-    names = {_fig_methods: "methods_bumps", _fig_errors: "uv_error", _fig_error_vs_angle: "error_vs_angle", _fig_silhouette: "silhouette"}
+    names = {
+        _fig_methods: "methods_bumps",
+        _fig_errors: "uv_error",
+        _fig_error_vs_angle: "error_vs_angle",
+        _fig_silhouette: "silhouette",
+    }
     for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps, _fig_silhouette):
 
         def draw(o, q, b=build):
