@@ -69,9 +69,13 @@ SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
 cd "$SRC"
 export DEBIAN_FRONTEND=noninteractive
 
-# System packages, only the missing ones: headless OpenGL for pyrender, a Python, pip.
+# System packages, only the missing ones: headless OpenGL (OSMesa for pyrender and the GLSL
+# harness; EGL with Mesa's software driver as the fallback platform), a Python, pip.
 need=()
 ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so' || need+=(libosmesa6)
+ldconfig -p 2>/dev/null | grep -q 'libEGL\.so' || need+=(libegl1)
+ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so' || need+=(libegl-mesa0)
+compgen -G "${GEOMLIB_DRI_DIR:-/usr/lib/*/dri}/swrast_dri.so" >/dev/null || need+=(libgl1-mesa-dri)
 command -v python3 >/dev/null 2>&1 || need+=(python3 python3-venv python3-pip)
 if ! command -v uv >/dev/null 2>&1 && ! python3 -m pip --version >/dev/null 2>&1; then need+=(python3-pip); fi
 if [ ${#need[@]} -gt 0 ]; then

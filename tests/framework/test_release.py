@@ -190,3 +190,35 @@ def test_run_autograder_copies_the_submission_without_following_links(release, s
     assert sorted(skipped) == ["notes.txt (symbolic link)", "outside (symbolic link)"]
     assert not (tmp_path / "copy" / "notes.txt").exists() and not (tmp_path / "copy" / "outside").exists()
     assert (tmp_path / "copy" / "ops.py").read_text() == (lab / "ops.py").read_text()
+
+
+def _setup_packages(tmp_path: Path, libraries: str, dri: bool) -> list[str]:
+    """Run the system-package block of the released setup.sh with a fake ``ldconfig`` (listing
+    ``libraries``) and a fake ``apt-get`` that records what it is asked to install."""
+    from geomlib.grading.release import SETUP_SH
+
+    block = "need=()" + SETUP_SH.split("\nneed=()", 1)[1].split("\nfi\n", 1)[0] + "\nfi\n"
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir(parents=True)
+    (bin_dir / "ldconfig").write_text(f"#!/bin/sh\nprintf '%s\\n' {libraries!r}\n")
+    log = tmp_path / "apt.log"
+    (bin_dir / "apt-get").write_text(f'#!/bin/sh\necho "$@" >> {log}\n')
+    for f in bin_dir.iterdir():
+        f.chmod(0o755)
+    dri_dir = tmp_path / "dri"
+    dri_dir.mkdir()
+    if dri:
+        (dri_dir / "swrast_dri.so").write_text("")
+    env = {**os.environ, "PATH": f"{bin_dir}:{os.environ['PATH']}", "GEOMLIB_DRI_DIR": str(dri_dir)}
+    p = subprocess.run(["bash", "-c", "set -euo pipefail\n" + block], env=env, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    lines = log.read_text().splitlines() if log.exists() else []
+    return [w for line in lines if line.startswith("install") for w in line.split() if not w.startswith("-")][1:]
+
+
+def test_setup_installs_what_osmesa_and_egl_need_only_when_missing(tmp_path):
+    everything = "libOSMesa.so.8 libEGL.so.1 libEGL_mesa.so.0"
+    assert _setup_packages(tmp_path / "a", everything, dri=True) == []
+    wanted = _setup_packages(tmp_path / "b", "libc.so.6", dri=False)
+    assert {"libosmesa6", "libegl1", "libegl-mesa0", "libgl1-mesa-dri"} <= set(wanted)
+    assert _setup_packages(tmp_path / "c", "libOSMesa.so.8 libEGL.so.1", dri=True) == ["libegl-mesa0"]
