@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import gl
-from geomlib.validate import MeshError, as_array, check_choice, check_float
+from geomlib.validate import MeshError, as_array, check_float
 
-from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points
+from .inputs import check_directions, check_height, check_layers, check_march, check_scale, check_uv_points
 from .relief import REFINEMENTS
 
 __all__ = ["SHADERS", "shader_path", "glsl_parallax_uv", "glsl_relief_uv", "glsl_relief_shadow"]
@@ -84,12 +84,7 @@ def glsl_relief_uv(
     uv = _grid(uv, where)
     V = check_directions(view, uv.shape[:-1], where)
     scale = check_scale(scale, where)
-    lo = check_layers(min_layers, "min_layers", where)
-    hi = check_layers(max_layers, "max_layers", where)
-    if hi < lo:
-        raise MeshError(f"{where}: max_layers ({hi}) must be >= min_layers ({lo})")
-    check_choice(refine, "refine", REFINEMENTS, where=where)
-    steps = check_layers(refine_steps, "refine_steps", where, minimum=0)
+    lo, hi, steps = check_march(min_layers, max_layers, refine, refine_steps, REFINEMENTS, where)
     out = _run(
         "relief",
         (uv.shape[1], uv.shape[0]),

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.tangent_space import as_height_map
-from geomlib.validate import MeshError, as_array, check_float, check_int
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int
 from geomlib.vectors import normalize_rows
 
 __all__ = ["as_height_map", "check_height", "check_uv_points", "check_directions", "height_at", "normalize_rows"]
@@ -78,6 +78,17 @@ def check_scale(scale, where: str) -> float:
 
 def check_layers(n, name: str, where: str, minimum: int = 1) -> int:
     return check_int(n, name, minimum=minimum, maximum=4096, where=where)
+
+
+def check_march(min_layers, max_layers, refine, refine_steps, refinements, where: str) -> tuple[int, int, int]:
+    """The ray march's settings (shared by :func:`relief_uv` and its GLSL twin): layer bounds with
+    ``1 <= min_layers <= max_layers <= 4096``, ``refine`` one of ``refinements``, ``refine_steps >= 0``."""
+    lo = check_layers(min_layers, "min_layers", where)
+    hi = check_layers(max_layers, "max_layers", where)
+    if hi < lo:
+        raise MeshError(f"{where}: max_layers ({hi}) must be >= min_layers ({lo})")
+    check_choice(refine, "refine", refinements, where=where)
+    return lo, hi, check_layers(refine_steps, "refine_steps", where, minimum=0)
 
 
 def height_at(H: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, check_choice
-
-from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points, height_at
+from .inputs import check_directions, check_height, check_march, check_scale, check_uv_points, height_at
 
 __all__ = ["relief_uv", "layer_count", "REFINEMENTS"]
 
@@ -88,12 +86,7 @@ def relief_uv(
     uv = check_uv_points(uv, where)
     V = check_directions(view, uv.shape[:-1], where)
     scale = check_scale(scale, where)
-    lo_n = check_layers(min_layers, "min_layers", where)
-    hi_n = check_layers(max_layers, "max_layers", where)
-    if hi_n < lo_n:
-        raise MeshError(f"{where}: max_layers ({hi_n}) must be >= min_layers ({lo_n})")
-    check_choice(refine, "refine", REFINEMENTS, where=where)
-    steps_n = check_layers(refine_steps, "refine_steps", where, minimum=0)
+    lo_n, hi_n, steps_n = check_march(min_layers, max_layers, refine, refine_steps, REFINEMENTS, where)
 
     shape = uv.shape[:-1]
     u0, v0 = uv[..., 0].ravel(), uv[..., 1].ravel()
