@@ -327,8 +327,9 @@ def fig_features(out: Path, lab, quick: bool) -> Figure:
         f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
         f"({its} iterations) with feature_angle = {angle:.0f} and without: each face is coloured by the distance of "
         "its centroid from the input surface, in % of the bounding-box diagonal (one scale for both, the bar on "
-        "the right). With the features kept, the edges and corners stay in place and what is left is the sag of "
-        "flat faces under the curved top; without, the faces cut across the sharp edges and round the corners.",
+        "the right). With the features kept, the corners stay put and the vertices of the sharp edges on the "
+        "input's edges, so what is left is the sag of flat faces under the curved top; without, the faces cut "
+        "across the sharp edges and round the corners.",
         LAB,
     )
 
