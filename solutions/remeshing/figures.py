@@ -217,6 +217,27 @@ def _blank(size) -> np.ndarray:
     return np.full((size[1], size[0], 3), 255, np.uint8)
 
 
+def _attempt(missing: list, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``, or None when it needs a task not implemented yet (noted in ``missing``)."""
+    try:
+        return fn(*args, **kwargs)
+    except NotImplementedError as err:
+        missing.append(err)
+        return None
+
+
+def _todo(missing: list) -> str:
+    """Caption prefix of a figure drawn in part: which task is missing (empty when none is)."""
+    if not missing:
+        return ""
+    first = re.search(r"Task \d+[a-z]?", str(missing[0]))
+    return f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: "
+
+
+def _mesh(result):
+    return None if result is None else (np.asarray(result[0], dtype=np.float64), np.asarray(result[1]))
+
+
 # --------------------------------------------------------------------------------------------
 # the figures
 
@@ -229,27 +250,28 @@ def fig_before_after(out: Path, lab, quick: bool) -> Figure:
     its = 5 if quick else 10
     size = (260, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True, zoom=0.95)
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
     imgs, caps = [], []
     for name, (V, F) in (("bunny (marching cubes)", bunny), ("bunny decimated by QEM", decimated)):
-        U, G = R.isotropic_remesh(V, F, L, iterations=its)
-        U, G = np.asarray(U, dtype=np.float64), np.asarray(G)
-        for title, (X, T) in ((name, (V, F)), (f"remeshed, L = {L}", (U, G))):
-            imgs.append(render(X, T, colors=valence_colors(X, T), **kw))
-            caps.append(f"{title}: {_summary(quality(X, T))}")
-        imgs.append(
-            _histogram(
-                ((V, F), (U, G)),
-                ["input", "remeshed"],
-                (max(size[0] + 40, 360), max(size[1], 280)),
-                "angles (60° = equilateral)",
-            )
-        )
+        imgs.append(render(V, F, colors=valence_colors(V, F), **kw))
+        caps.append(f"{name}: {_summary(quality(V, F))}")
+        result = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its))
+        if result is None:
+            imgs.append(_blank(size))
+            caps.append("isotropic_remesh: not implemented yet")
+        else:
+            imgs.append(render(*result, colors=valence_colors(*result), **kw))
+            caps.append(f"remeshed, L = {L}: {_summary(quality(*result))}")
+        meshes = [(V, F)] + ([result] if result is not None else [])
+        hist_size = (max(size[0] + 40, 360), max(size[1], 280))
+        imgs.append(_histogram(meshes, ["input", "remeshed"][: len(meshes)], hist_size, "angles (60° = equilateral)"))
         caps.append(f"corner angles of the {name.split(' (')[0]}")
     img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {VALENCE_TITLE}")
     path = save_png(out / "before_after.png", img)
     return Figure(
         path,
-        f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
+        _todo(missing)
+        + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
         f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
         f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
         "Vertices are coloured by valence (blue below 6, grey 6, red above); the captions give the faces, the "
@@ -301,29 +323,41 @@ def fig_features(out: Path, lab, quick: bool) -> Figure:
     size = (280, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True)
     diag = bbox_diagonal(V)
-    sharp = np.asarray(R.sharp_edges(V, F, angle))
-    results, errs = [], []
-    for fa in (angle, None):
-        U, G = R.isotropic_remesh(V, F, L, iterations=its, feature_angle=fa)
-        U, G = np.asarray(U, dtype=np.float64), np.asarray(G)
-        # how far each face leaves the input: the distance of its centroid, in % of the diagonal
-        errs.append(100 * np.sqrt(closest_points(V, F, U[G].mean(axis=1))[0]) / diag)
-        results.append((U, G))
-    vmax = max(float(max(e.max() for e in errs)), 1e-3)
-    imgs = [render(V, F, highlight_points=np.unique(sharp), **kw)]
-    caps = [f"input: {len(F)} faces; the {len(sharp)} edges sharper than {angle:.0f}° marked at their ends"]
-    for (U, G), e, what in zip(results, errs, (f"feature_angle={angle:.0f}", "feature_angle=None"), strict=True):
-        imgs.append(render(U, G, face_colors=heat_colors(e, 0, vmax, CMAP), **kw))
-        q = quality(U, G)
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    sharp = _attempt(missing, R.sharp_edges, V, F, angle)
+    results = [
+        _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, feature_angle=fa)) for fa in (angle, None)
+    ]
+    # how far each face leaves the input: the distance of its centroid, in % of the diagonal
+    errs = [
+        None if r is None else 100 * np.sqrt(closest_points(V, F, r[0][r[1]].mean(axis=1))[0]) / diag for r in results
+    ]
+    vmax = max([float(e.max()) for e in errs if e is not None] + [1e-3])
+    if sharp is None:
+        imgs, caps = [render(V, F, **kw)], [f"input: {len(F)} faces; sharp_edges: not implemented yet"]
+    else:
+        sharp = np.asarray(sharp)
+        imgs = [render(V, F, highlight_points=np.unique(sharp), **kw)]
+        caps = [f"input: {len(F)} faces; the {len(sharp)} edges sharper than {angle:.0f}° marked at their ends"]
+    for r, e, what in zip(results, errs, (f"feature_angle={angle:.0f}", "feature_angle=None"), strict=True):
+        if r is None:
+            imgs.append(_blank(size))
+            caps.append(f"{what}: not implemented yet")
+            continue
+        imgs.append(render(*r, face_colors=heat_colors(e, 0, vmax, CMAP), **kw))
         caps.append(
-            f"{what}: {len(G)} faces, min angle {q['min_angle']:.1f}°; faces off the input by up to {e.max():.2f}%"
+            f"{what}: {len(r[1])} faces, min angle {quality(*r)['min_angle']:.1f}°; "
+            f"faces off the input by up to {e.max():.2f}%"
         )
     grid = panels(imgs, caps, ncols=3, title=f"Sharp edges kept (feature_angle = {angle:.0f}°) or not, L = {L}")
-    bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
-    path = save_png(out / "features.png", _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3)))
+    if any(e is not None for e in errs):  # the bar of the heat maps, when there are any
+        bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
+        grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
+    path = save_png(out / "features.png", grid)
     return Figure(
         path,
-        "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
+        _todo(missing)
+        + "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
         f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
         f"({its} iterations) with feature_angle = {angle:.0f} and without: each face is coloured by the distance of "
         "its centroid from the input surface, in % of the bounding-box diagonal (one scale for both, the bar on "
@@ -359,30 +393,33 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     length = float(np.linalg.norm(B - A, axis=1).sum())
     imgs = [render(V, F, colors=valence_colors(V, F), highlight_points=np.unique(E), **kw)]
     caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (dots), boundary length {length:.2f}"]
-    offsets = []
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
     for keep in (True, False):
-        U, G = R.isotropic_remesh(V, F, L, iterations=its, preserve_boundary=keep)
-        U, G = np.asarray(U, dtype=np.float64), np.asarray(G)
-        nb, off, ln = _boundary_offset(U, G, A, B)
-        offsets.append(100 * off / diag)
-        dots = np.unique(topology.boundary_edges(G))
-        imgs.append(render(U, G, colors=valence_colors(U, G), highlight_points=dots, **kw))
+        r = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
+        if r is None:
+            imgs.append(_blank(size))
+            caps.append(f"preserve_boundary={keep}: not implemented yet")
+            continue
+        nb, off, ln = _boundary_offset(*r, A, B)
+        dots = np.unique(topology.boundary_edges(r[1]))
+        imgs.append(render(*r, colors=valence_colors(*r), highlight_points=dots, **kw))
         caps.append(
-            f"preserve_boundary={keep}: {len(G)} faces, {nb} boundary vertices up to {offsets[-1]:.2f}% of the "
-            f"diagonal off the input boundary, length {ln:.2f}"
+            f"preserve_boundary={keep}: {len(r[1])} faces, {nb} boundary vertices, at most {100 * off / diag:.2f}% "
+            f"of the diagonal from the input boundary; length {ln:.2f}"
         )
     title = f"An open surface remeshed to L = {L}; valence: blue below the target (6, on the boundary 4), grey at it, red above"
     img = panels(imgs, caps, ncols=3, title=title)
     path = save_png(out / "boundary.png", img)
     return Figure(
         path,
-        "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
+        _todo(missing)
+        + "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
         f"jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
         "iterations) with preserve_boundary True and False. Boundary vertices are dotted, every vertex coloured "
-        "by valence against its target (6 inside, 4 on the boundary). With the boundary preserved, its vertices "
-        f"stay on the input's boundary line (at most {offsets[0]:.2g}% of the diagonal away) and are only "
-        "respaced; without, the boundary is relaxed like the interior and leaves that line (up to "
-        f"{offsets[1]:.2g}%). The captions also give each boundary's length.",
+        "by valence against its target (6 inside, 4 on the boundary). The captions give how far the boundary "
+        "vertices are from the input's boundary line and the boundary's length: preserved, the boundary stays on "
+        "that line and is only respaced; not preserved, it is relaxed like the interior, leaves the line and "
+        "the opening shrinks.",
         LAB,
     )
 
@@ -412,36 +449,30 @@ def fig_operations(out: Path, lab, quick: bool) -> Figure:
         ("collapse_edge", R.collapse_edge, "merged vertex marked"),
         ("flip_edge", R.flip_edge, "new edge marked"),
     ):
-        try:
-            U, H2 = op(V, H, e)
-            U, G = np.asarray(U, dtype=np.float64), np.asarray(H2.idx).reshape(-1, 3)
-            if name == "flip_edge":
-                dots = _new_edge_ends(G, F)
-            else:
-                dots = [int(np.argmin(np.linalg.norm(U - mid, axis=1)))]
-            imgs.append(render(U, G, highlight_points=dots, **kw))
-            caps.append(f"{name}: {len(G)} faces, {mark}")
-        except NotImplementedError as err:
-            missing.append(err)
+        r = _attempt(missing, op, V, H, e)
+        if r is None:
             imgs.append(_blank(size))
             caps.append(f"{name}: not implemented yet")
+            continue
+        U, G = np.asarray(r[0], dtype=np.float64), np.asarray(r[1].idx).reshape(-1, 3)
+        if name == "flip_edge":
+            dots = _new_edge_ends(G, F)
+        else:
+            dots = [int(np.argmin(np.linalg.norm(U - mid, axis=1)))]
+        imgs.append(render(U, G, highlight_points=dots, **kw))
+        caps.append(f"{name}: {len(G)} faces, {mark}")
     J = V + 0.08 * np.random.default_rng(1).normal(size=V.shape) * [1, 1, 0] * ~H.boundary_vertex[:, None]
     imgs.append(render(J, F, **kw))
     caps.append("interior vertices jittered")
-    try:
-        imgs.append(render(np.asarray(R.tangential_relaxation(J, F)), F, **kw))
-        caps.append("after tangential_relaxation")
-    except NotImplementedError as err:
-        missing.append(err)
-        imgs.append(_blank(size))
-        caps.append("tangential_relaxation: not implemented yet")
+    W = _attempt(missing, R.tangential_relaxation, J, F)
+    imgs.append(_blank(size) if W is None else render(np.asarray(W), F, **kw))
+    caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
     path = save_png(out / "operations.png", img)
-    first = re.search(r"Task \d+[a-z]?", str(missing[0])) if missing else None
-    todo = f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: " if missing else ""
     return Figure(
         path,
-        todo + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
+        _todo(missing)
+        + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
         "(both ends meet at the midpoint) and flipped to the other diagonal; a patch with jittered interior "
         "vertices before and after one tangential relaxation step (damping 0.5).",
         LAB,
