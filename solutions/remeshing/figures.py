@@ -2,42 +2,161 @@
 
 ``make_figures(out_dir, lab=None, quick=False)`` writes the PNGs and returns
 :class:`geomlib.plot.Figure` records; in ``labs/remeshing/`` it renders *your* results.
+
+The issue's meshes (the Stanford bunny, the fandisk, the camel head) are not part of the course,
+so the figures use built-in stand-ins made here: a bunny of metaballs extracted by marching cubes
+(:func:`metaball_bunny`; like a scan, it has slivers and irregular valences), the same bunny
+decimated by QEM (:func:`decimated_bunny`), a block with a curved top and sharp edges
+(:func:`curved_block`) and the bunny's head cut off at the neck, an open surface with one
+boundary loop (:func:`bunny_head`).
 """
 
 from __future__ import annotations
 
-import importlib
 import re
 from pathlib import Path
 
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.plot import Figure, figures_or_placeholders, line_plot, panels, save_png
+from geomlib.geometry import bbox_diagonal, closest_points
+from geomlib.plot import (
+    Figure,
+    colorbar,
+    heat_colors,
+    lab_figures,
+    lab_package,
+    lab_view,
+    line_plot,
+    panels,
+    save_png,
+)
 from geomlib.render import render
 from geomlib.viewer import write_html
 
-__all__ = ["make_figures", "make_view"]
+__all__ = [
+    "make_figures",
+    "make_view",
+    "metaball_bunny",
+    "decimated_bunny",
+    "curved_block",
+    "bunny_head",
+    "quality",
+    "valence_colors",
+]
 
 LAB = "remeshing"
-#: valence colours: blue below 6, grey at 6, red above (4 on the boundary counts as regular)
+#: valence colours: blue below the target, grey at it, red above (target 6 inside, 4 on the boundary)
 LOW, SIX, HIGH = np.array([0.25, 0.45, 0.95]), np.array([0.82, 0.82, 0.82]), np.array([0.95, 0.3, 0.25])
+VALENCE_TITLE = "vertices coloured by valence: blue below 6, grey 6, red above"
+CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error vanishes
 
 
 def _lab(lab):
-    if lab is not None:
-        return lab
-    return importlib.import_module(__package__)  # this package: the solution, or your lab in labs/
+    return lab_package(lab, __package__)  # this package: the solution, or your lab in labs/
 
 
-def valence_colors(V, F) -> np.ndarray:
-    H = topology.halfedge_mesh(np.asarray(F), len(V))
-    target = np.where(H.boundary_vertex, 4, 6)
-    d = H.valence - target
-    return np.where(d[:, None] < 0, LOW, np.where(d[:, None] > 0, HIGH, SIX))
+def _ss(quick: bool) -> int:
+    return 1 if quick else 2
+
+
+# --------------------------------------------------------------------------------------------
+# the meshes
+
+
+#: metaballs of the bunny: (centre, radii) of Gaussian ellipsoids; it faces +x, z up
+_BUNNY_BALLS = (
+    ((0.0, 0.0, 0.0), (0.55, 0.42, 0.42)),  # body
+    ((0.35, 0.0, 0.22), (0.35, 0.32, 0.32)),  # chest
+    ((0.62, 0.0, 0.48), (0.26, 0.22, 0.22)),  # head
+    ((0.82, 0.0, 0.42), (0.12, 0.11, 0.11)),  # snout
+    ((0.55, 0.11, 0.90), (0.09, 0.065, 0.30)),  # ears
+    ((0.52, -0.11, 0.88), (0.09, 0.065, 0.30)),
+    ((-0.55, 0.0, 0.1), (0.13, 0.13, 0.13)),  # tail
+    ((0.25, 0.22, -0.35), (0.22, 0.1, 0.1)),  # fore paws
+    ((0.25, -0.22, -0.35), (0.22, 0.1, 0.1)),
+    ((-0.2, 0.3, -0.3), (0.3, 0.12, 0.16)),  # haunches
+    ((-0.2, -0.3, -0.3), (0.3, 0.12, 0.16)),
+)
+
+
+def metaball_bunny(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """A bunny of metaballs: the 0.5 level set of a sum of Gaussian ellipsoids, by marching cubes.
+
+    Stands in for the Stanford bunny: a closed genus-0 surface about 2.2 units long (facing +x,
+    z up) whose marching-cubes triangles have the flaws of a scan (slivers, valences from 3 to 9).
+
+    Parameters
+    ----------
+    n : int
+        Grid samples per axis (the mesh has about ``1.5 n**2`` faces).
+
+    Returns
+    -------
+    V : (k, 3) float64
+    F : (m, 3) int64
+    """
+    import pyvista as pv  # slow import: only when asked for
+
+    g = np.linspace(-1.2, 1.4, n)
+    X, Y, Z = np.meshgrid(g, g, g, indexing="ij")
+    f = np.zeros_like(X)
+    for c, r in _BUNNY_BALLS:
+        f += np.exp(-(((X - c[0]) / r[0]) ** 2) - ((Y - c[1]) / r[1]) ** 2 - ((Z - c[2]) / r[2]) ** 2)
+    grid = pv.ImageData(dimensions=(n, n, n), spacing=(g[1] - g[0],) * 3, origin=(g[0],) * 3)
+    grid.point_data["f"] = f.ravel(order="F")
+    mesh = grid.contour([0.5], scalars="f", method="marching_cubes").triangulate().clean()
+    F = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64)
+    return np.asarray(mesh.points, dtype=np.float64), F
+
+
+def decimated_bunny(faces: int = 1200, n: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`metaball_bunny` decimated by QEM (fast-simplification) to about ``faces`` faces.
+
+    The irregular input of the issue's second case: long thin triangles where the surface is flat
+    in one direction, valences far from 6.
+    """
+    import fast_simplification
+
+    V, F = metaball_bunny(n)
+    U, G = fast_simplification.simplify(V.astype(np.float32), F.astype(np.int32), target_count=faces)
+    return np.asarray(U, dtype=np.float64), np.asarray(G, dtype=np.int64)
+
+
+def curved_block(n: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """A block with a curved top and waist: :func:`geomlib.datasets.sharp_box` 1.6 x 1 x 0.8, bent.
+
+    Stands in for the fandisk: smooth curved parts (the top) meeting flat ones along sharp edges
+    (dihedral angles of 60-90 degrees) with corners where three of them meet.
+    """
+    V, F = datasets.sharp_box((1.6, 1.0, 0.8), n)
+    bump = np.cos(np.pi * V[:, 0] / 1.6)  # 1 in the middle, 0 at the ends
+    V[:, 2] = -0.4 + (V[:, 2] + 0.4) * (1.0 + 0.6 * bump)
+    V[:, 1] *= 1.0 - 0.3 * bump  # a waist: the front and back are curved too
+    return V, F
+
+
+def bunny_head(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
+    """The head and ears of :func:`metaball_bunny`, cut off at the neck (the faces with ``x + z > 0.9`` at every vertex).
+
+    Stands in for the camel head: an open surface with one jagged boundary loop.
+    """
+    V, F = metaball_bunny(n)
+    F = F[(V[F, 0] + V[F, 2] > 0.9).all(axis=1)]
+    _, label = topology.connected_components_faces(F)
+    F = F[label == np.argmax(np.bincount(label))]
+    used = np.unique(F)
+    new = np.full(len(V), -1, np.int64)
+    new[used] = np.arange(len(used))
+    return V[used], new[F]
+
+
+# --------------------------------------------------------------------------------------------
+# measures
 
 
 def angles(V, F) -> np.ndarray:
+    """Every corner angle of every face, in degrees, ``(3 m,)``."""
     out = []
     for k in range(3):
         a, b = V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]
@@ -46,102 +165,325 @@ def angles(V, F) -> np.ndarray:
     return np.concatenate(out)
 
 
-def irregular_sphere():
-    """A noisy icosphere made irregular by random vertex jitter in the tangent plane."""
-    V, F = datasets.icosphere(3)
-    rng = np.random.default_rng(0)
-    V = V + 0.04 * rng.normal(size=V.shape)
-    return V / np.linalg.norm(V, axis=1, keepdims=True), F
+def quality(V, F) -> dict:
+    """The issue's quality measures (those the graded tests use, without the distance to the input).
+
+    Returns
+    -------
+    dict
+        ``faces``; ``min_angle`` (degrees); ``below_30`` (share of angles below 30 degrees);
+        ``edge_cv`` (edge-length std / mean); ``valence6`` (share of interior vertices of valence 6).
+    """
+    V, F = np.asarray(V, dtype=np.float64), np.asarray(F)
+    H = topology.halfedge_mesh(F, len(V), manifold=True)
+    a = angles(V, F)
+    e = np.linalg.norm(V[H.E[:, 0]] - V[H.E[:, 1]], axis=1)
+    inner = ~H.boundary_vertex
+    return {
+        "faces": len(F),
+        "min_angle": float(a.min()),
+        "below_30": float(np.mean(a < 30)),
+        "edge_cv": float(e.std() / e.mean()),
+        "valence6": float(np.mean(H.valence[inner] == 6)) if inner.any() else 1.0,
+    }
+
+
+def _summary(q: dict) -> str:
+    return (
+        f"{q['faces']} faces, min angle {q['min_angle']:.1f}°, {q['below_30']:.2%} of angles < 30°, "
+        f"valence 6: {q['valence6']:.0%}"
+    )
+
+
+def valence_colors(V, F) -> np.ndarray:
+    """Per-vertex colours: :data:`LOW` below the target valence, :data:`SIX` at it, :data:`HIGH` above."""
+    H = topology.halfedge_mesh(np.asarray(F), len(V))
+    d = H.valence - np.where(H.boundary_vertex, 4, 6)
+    return np.where(d[:, None] < 0, LOW, np.where(d[:, None] > 0, HIGH, SIX))
+
+
+def _histogram(meshes, labels, size, title) -> np.ndarray:
+    xs, ys = [], []
+    for V, F in meshes:
+        counts, edges = np.histogram(angles(V, F), bins=36, range=(0, 180))
+        xs.append(0.5 * (edges[1:] + edges[:-1]))
+        ys.append(counts / counts.sum())
+    return line_plot(
+        xs, ys, labels, xlabel="corner angle (degrees)", ylabel="share of angles", title=title, size=size, markers=False
+    )
+
+
+def _blank(size) -> np.ndarray:
+    return np.full((size[1], size[0], 3), 255, np.uint8)
+
+
+def _attempt(missing: list, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``, or None when it needs a task not implemented yet (noted in ``missing``)."""
+    try:
+        return fn(*args, **kwargs)
+    except NotImplementedError as err:
+        missing.append(err)
+        return None
+
+
+def _todo(missing: list) -> str:
+    """Caption prefix of a figure drawn in part: which task is missing (empty when none is)."""
+    if not missing:
+        return ""
+    first = re.search(r"Task \d+[a-z]?", str(missing[0]))
+    return f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: "
+
+
+def _mesh(result):
+    return None if result is None else (np.asarray(result[0], dtype=np.float64), np.asarray(result[1]))
+
+
+# --------------------------------------------------------------------------------------------
+# the figures
 
 
 def fig_before_after(out: Path, lab, quick: bool) -> Figure:
     R = _lab(lab)
-    V, F = irregular_sphere()
-    L = 0.12
-    U, G = R.isotropic_remesh(V, F, L, iterations=5 if quick else 10)
-    U, G = np.asarray(U), np.asarray(G)
-    size = (260, 220) if quick else (360, 300)
-    kw = dict(camera="three_quarter", size=size, supersample=1 if quick else 2, wireframe=True, flat=True)
+    n = 48 if quick else 64
+    bunny, decimated = metaball_bunny(n), decimated_bunny(800 if quick else 1200, n)
+    L = 0.08 if quick else 0.06
+    its = 5 if quick else 10
+    size = (260, 220) if quick else (380, 300)
+    kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True, zoom=0.95)
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
     imgs, caps = [], []
-    hx, hy, labels = [], [], []
-    for title, (X, T) in (("input", (V, F)), (f"remeshed, L = {L}", (U, G))):
-        a = angles(X, T)
-        h = np.mean(valence_colors(X, T) == SIX, axis=1).mean()
-        imgs.append(render(X, T, colors=valence_colors(X, T), **kw))
-        caps.append(f"{title}: {len(T)} faces, min angle {a.min():.1f}°, valence 6: {h:.0%}")
-        counts, edges = np.histogram(a, bins=36, range=(0, 180))
-        hx.append(0.5 * (edges[1:] + edges[:-1]))
-        hy.append(counts / counts.sum())
-        labels.append(title)
-    imgs.append(
-        line_plot(
-            hx,
-            hy,
-            labels,
-            xlabel="corner angle (degrees)",
-            ylabel="share of angles",
-            title="angle histograms (60° = equilateral)",
-            size=(size[0] + 80, size[1]),
-            markers=False,
-        )
-    )
-    caps.append("angles cluster at 60° after remeshing")
-    img = panels(imgs, caps, title="Isotropic remeshing: valence blue < 6, grey = 6, red > 6")
+    for name, (V, F) in (("bunny (marching cubes)", bunny), ("bunny decimated by QEM", decimated)):
+        imgs.append(render(V, F, colors=valence_colors(V, F), **kw))
+        caps.append(f"{name}: {_summary(quality(V, F))}")
+        result = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its))
+        if result is None:
+            imgs.append(_blank(size))
+            caps.append("isotropic_remesh: not implemented yet")
+        else:
+            imgs.append(render(*result, colors=valence_colors(*result), **kw))
+            caps.append(f"remeshed, L = {L}: {_summary(quality(*result))}")
+        meshes = [(V, F)] + ([result] if result is not None else [])
+        hist_size = (max(size[0] + 40, 360), max(size[1], 280))
+        imgs.append(_histogram(meshes, ["input", "remeshed"][: len(meshes)], hist_size, "angles (60° = equilateral)"))
+        caps.append(f"corner angles of the {name.split(' (')[0]}")
+    img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {VALENCE_TITLE}")
     path = save_png(out / "before_after.png", img)
     return Figure(
         path,
-        "An irregular sphere before and after isotropic_remesh, vertices coloured by valence (blue below 6, grey 6, "
-        "red above); the captions print the minimum angle and the valence-6 share, the plot the angle histograms.",
+        _todo(missing)
+        + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
+        f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
+        f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
+        "Vertices are coloured by valence (blue below 6, grey 6, red above); the captions give the faces, the "
+        "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6; the "
+        "plots the distribution of the corner angles, which remeshing gathers around 60°.",
         LAB,
     )
+
+
+def fig_iterations(out: Path, lab, quick: bool) -> Figure:
+    R = _lab(lab)
+    n = 48 if quick else 64
+    V, F = decimated_bunny(800 if quick else 1200, n)
+    L = 0.08 if quick else 0.06
+    size = (240, 200) if quick else (340, 270)
+    kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True, zoom=0.95)
+    imgs, caps = [], []
+    for its in range(6):
+        U, G = R.isotropic_remesh(V, F, L, iterations=its)
+        U, G = np.asarray(U, dtype=np.float64), np.asarray(G)
+        imgs.append(render(U, G, colors=valence_colors(U, G), **kw))
+        caps.append(f"{its} iteration{'' if its == 1 else 's'}: {_summary(quality(U, G))}")
+    img = panels(imgs, caps, ncols=3, title=f"The decimated bunny after 0 to 5 iterations (L = {L}); {VALENCE_TITLE}")
+    path = save_png(out / "iterations.png", img)
+    return Figure(
+        path,
+        f"isotropic_remesh(V, F, {L}, iterations=k) of the QEM-decimated bunny for k = 0 (the input) to 5, "
+        "vertices coloured by valence (blue below 6, grey 6, red above); each caption gives the faces, the "
+        "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6.",
+        LAB,
+    )
+
+
+def _bar_beside_row(grid: np.ndarray, bar: np.ndarray, row: np.ndarray, pad: int = 12) -> np.ndarray:
+    """Put ``bar`` right of the one-row panel page ``grid``, level with its pictures.
+
+    ``row`` is the same row laid out without the title, to find where the pictures start.
+    """
+    top = grid.shape[0] - row.shape[0] + pad
+    bar = np.pad(bar, ((top, grid.shape[0] - top - bar.shape[0]), (0, pad), (0, 0)), constant_values=255)
+    return np.concatenate([grid, bar], axis=1)
+
+
+def fig_features(out: Path, lab, quick: bool) -> Figure:
+    R = _lab(lab)
+    V, F = curved_block(4)
+    L, angle = (0.14, 45.0) if quick else (0.1, 45.0)
+    its = 5 if quick else 10
+    size = (280, 220) if quick else (380, 300)
+    kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True)
+    diag = bbox_diagonal(V)
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    sharp = _attempt(missing, R.sharp_edges, V, F, angle)
+    results = [
+        _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, feature_angle=fa)) for fa in (angle, None)
+    ]
+    # how far each face leaves the input: the distance of its centroid, in % of the diagonal
+    errs = [
+        None if r is None else 100 * np.sqrt(closest_points(V, F, r[0][r[1]].mean(axis=1))[0]) / diag for r in results
+    ]
+    vmax = max([float(e.max()) for e in errs if e is not None] + [1e-3])
+    if sharp is None:
+        imgs, caps = [render(V, F, **kw)], [f"input: {len(F)} faces; sharp_edges: not implemented yet"]
+    else:
+        sharp = np.asarray(sharp)
+        imgs = [render(V, F, highlight_points=np.unique(sharp), **kw)]
+        caps = [f"input: {len(F)} faces; the {len(sharp)} edges sharper than {angle:.0f}° marked at their ends"]
+    for r, e, what in zip(results, errs, (f"feature_angle={angle:.0f}", "feature_angle=None"), strict=True):
+        if r is None:
+            imgs.append(_blank(size))
+            caps.append(f"{what}: not implemented yet")
+            continue
+        imgs.append(render(*r, face_colors=heat_colors(e, 0, vmax, CMAP), **kw))
+        caps.append(
+            f"{what}: {len(r[1])} faces, min angle {quality(*r)['min_angle']:.1f}°; "
+            f"faces off the input by up to {e.max():.2f}%"
+        )
+    grid = panels(imgs, caps, ncols=3, title=f"Sharp edges kept (feature_angle = {angle:.0f}°) or not, L = {L}")
+    if any(e is not None for e in errs):  # the bar of the heat maps, when there are any
+        bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
+        grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
+    path = save_png(out / "features.png", grid)
+    return Figure(
+        path,
+        _todo(missing)
+        + "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
+        f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
+        f"({its} iterations) with feature_angle = {angle:.0f} and without: each face is coloured by the distance of "
+        "its centroid from the input surface, in % of the bounding-box diagonal (one scale for both, the bar on "
+        "the right). With the features kept, the corners stay put and the vertices of the sharp edges on the "
+        "input's edges, so what is left is the sag of flat faces under the curved top; without, the faces cut "
+        "across the sharp edges and round the corners.",
+        LAB,
+    )
+
+
+def _boundary_offset(U, G, A, B) -> tuple[int, float, float]:
+    """Boundary of ``(U, G)``: vertex count, largest distance of a vertex to the segments ``A[i]B[i]``, length."""
+    E = topology.boundary_edges(G)
+    P = U[np.unique(E)]
+    AB = B - A
+    t = np.clip(np.einsum("pij,ij->pi", P[:, None] - A[None], AB) / np.einsum("ij,ij->i", AB, AB), 0, 1)
+    d = np.linalg.norm(A[None] + t[:, :, None] * AB[None] - P[:, None], axis=2).min(axis=1)
+    return len(P), float(d.max()), float(np.linalg.norm(U[E[:, 1]] - U[E[:, 0]], axis=1).sum())
+
+
+def fig_boundary(out: Path, lab, quick: bool) -> Figure:
+    R = _lab(lab)
+    V, F = bunny_head(48 if quick else 64)
+    L = 0.06 if quick else 0.045
+    its = 5 if quick else 10
+    size = (260, 260) if quick else (360, 340)
+    c = V.mean(axis=0)
+    view = c + 1.9 * np.array([-0.61, -0.73, -0.3])  # from behind, left and below: into the opening
+    kw = dict(camera=(view, c, (0.0, 0.0, 1.0)), size=size, supersample=_ss(quick), wireframe=True)
+    diag = bbox_diagonal(V)
+    E = topology.boundary_edges(F)
+    A, B = V[E[:, 0]], V[E[:, 1]]
+    length = float(np.linalg.norm(B - A, axis=1).sum())
+    imgs = [render(V, F, colors=valence_colors(V, F), highlight_points=np.unique(E), **kw)]
+    caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (dots), boundary length {length:.2f}"]
+    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    for keep in (True, False):
+        r = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
+        if r is None:
+            imgs.append(_blank(size))
+            caps.append(f"preserve_boundary={keep}: not implemented yet")
+            continue
+        nb, off, ln = _boundary_offset(*r, A, B)
+        dots = np.unique(topology.boundary_edges(r[1]))
+        imgs.append(render(*r, colors=valence_colors(*r), highlight_points=dots, **kw))
+        caps.append(
+            f"preserve_boundary={keep}: {len(r[1])} faces, {nb} boundary vertices, at most {100 * off / diag:.2f}% "
+            f"of the diagonal from the input boundary; length {ln:.2f}"
+        )
+    title = f"An open surface remeshed to L = {L}; valence: blue below the target (6, on the boundary 4), grey at it, red above"
+    img = panels(imgs, caps, ncols=3, title=title)
+    path = save_png(out / "boundary.png", img)
+    return Figure(
+        path,
+        _todo(missing)
+        + "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
+        f"jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
+        "iterations) with preserve_boundary True and False. Boundary vertices are dotted, every vertex coloured "
+        "by valence against its target (6 inside, 4 on the boundary). The captions give how far the boundary "
+        "vertices are from the input's boundary line and the boundary's length: preserved, the boundary stays on "
+        "that line and is only respaced; not preserved, it is relaxed like the interior, leaves the line and "
+        "the opening shrinks.",
+        LAB,
+    )
+
+
+def _new_edge_ends(G, F) -> np.ndarray:
+    """Vertices of the edges of ``G`` that ``F`` does not have (the flipped edge)."""
+    old = {tuple(e) for e in topology.unique_edges(F).tolist()}
+    return np.unique([e for e in topology.unique_edges(G).tolist() if tuple(e) not in old])
 
 
 def fig_operations(out: Path, lab, quick: bool) -> Figure:
     R = _lab(lab)
     V, F = datasets.grid_patch(3)
     H = topology.halfedge_mesh(F, len(V), manifold=True)
-    inner = np.flatnonzero(~H.boundary_edge)
-    e = int(inner[len(inner) // 2])
+    # the diagonal of the middle cell: both ends inside the patch
+    inside = (~H.boundary_vertex[H.E]).all(axis=1)
+    diagonal = (V[H.E[:, 0], :2] != V[H.E[:, 1], :2]).all(axis=1)
+    e = int(np.flatnonzero(inside & diagonal)[0])
+    a, b = (int(i) for i in H.E[e])
+    mid = 0.5 * (V[a] + V[b])
     size = (200, 200) if quick else (260, 260)
-    kw = dict(camera="top", size=size, supersample=1 if quick else 2, wireframe=True, flat=True)
+    kw = dict(camera="top", size=size, supersample=_ss(quick), wireframe=True, flat=True)
     missing: list[NotImplementedError] = []  # tasks whose panels are left blank
-    imgs, caps = (
-        [render(V, F, highlight_points=H.E[e], **kw)],
-        [f"patch, edge ({int(H.E[e, 0])}, {int(H.E[e, 1])}) marked"],
-    )
-    for name, op in (("split_edge", R.split_edge), ("collapse_edge", R.collapse_edge), ("flip_edge", R.flip_edge)):
-        try:
-            U, H2 = op(V, H, e)
-            G = np.asarray(H2.idx).reshape(-1, 3)
-            imgs.append(render(np.asarray(U), G, **kw))
-            caps.append(f"{name}: {len(G)} faces")
-        except NotImplementedError as err:
-            missing.append(err)
-            imgs.append(np.full((size[1], size[0], 3), 255, np.uint8))
+    imgs, caps = [render(V, F, highlight_points=[a, b], **kw)], [f"patch, edge ({a}, {b}) marked"]
+    for name, op, mark in (
+        ("split_edge", R.split_edge, "new vertex marked"),
+        ("collapse_edge", R.collapse_edge, "merged vertex marked"),
+        ("flip_edge", R.flip_edge, "new edge marked"),
+    ):
+        r = _attempt(missing, op, V, H, e)
+        if r is None:
+            imgs.append(_blank(size))
             caps.append(f"{name}: not implemented yet")
-    try:
-        J = V + 0.08 * np.random.default_rng(1).normal(size=V.shape) * [1, 1, 0] * ~H.boundary_vertex[:, None]
-        W = np.asarray(R.tangential_relaxation(J, F))
-        imgs[-1:-1] = []
-        imgs.append(render(J, F, **kw))
-        caps.append("interior vertices jittered")
-        imgs.append(render(W, F, **kw))
-        caps.append("after tangential_relaxation")
-    except NotImplementedError as err:
-        missing.append(err)
-        imgs.append(np.full((size[1], size[0], 3), 255, np.uint8))
-        caps.append("tangential_relaxation: not implemented yet")
+            continue
+        U, G = np.asarray(r[0], dtype=np.float64), np.asarray(r[1].idx).reshape(-1, 3)
+        if name == "flip_edge":
+            dots = _new_edge_ends(G, F)
+        else:
+            dots = [int(np.argmin(np.linalg.norm(U - mid, axis=1)))]
+        imgs.append(render(U, G, highlight_points=dots, **kw))
+        caps.append(f"{name}: {len(G)} faces, {mark}")
+    J = V + 0.08 * np.random.default_rng(1).normal(size=V.shape) * [1, 1, 0] * ~H.boundary_vertex[:, None]
+    imgs.append(render(J, F, **kw))
+    caps.append("interior vertices jittered")
+    W = _attempt(missing, R.tangential_relaxation, J, F)
+    imgs.append(_blank(size) if W is None else render(np.asarray(W), F, **kw))
+    caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
     path = save_png(out / "operations.png", img)
-    first = re.search(r"Task \d+[a-z]?", str(missing[0])) if missing else None
-    todo = f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: " if missing else ""
     return Figure(
         path,
-        todo
-        + "One interior edge of a grid patch (marked) split, collapsed and flipped; a patch with jittered interior "
+        _todo(missing)
+        + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
+        "(both ends meet at the midpoint) and flipped to the other diagonal; a patch with jittered interior "
         "vertices before and after one tangential relaxation step (damping 0.5).",
         LAB,
     )
+
+
+fig_before_after.figure_name = "before_after"
+fig_iterations.figure_name = "iterations"
+fig_features.figure_name = "features"
+fig_boundary.figure_name = "boundary"
+fig_operations.figure_name = "operations"
 
 
 def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
@@ -149,32 +491,30 @@ def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
 
     A figure whose task is not implemented yet becomes a "Task N not implemented yet" picture.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders((fig_before_after, fig_operations), out, LAB, lab, quick)
+    builders = (fig_before_after, fig_operations, fig_iterations, fig_features, fig_boundary)
+    return lab_figures(builders, out_dir, LAB, lab, quick)
 
 
 def fig_view(out: Path, lab, quick: bool) -> Figure:
     R = _lab(lab)
-    V, F = irregular_sphere()
-    U, G = R.isotropic_remesh(V, F, 0.12, iterations=5 if quick else 10)
+    V, F = metaball_bunny(48 if quick else 64)
+    L = 0.08 if quick else 0.06
+    U, G = R.isotropic_remesh(V, F, L, iterations=5 if quick else 10)
     U, G = np.asarray(U, float), np.asarray(G)
     H = topology.halfedge_mesh(G, len(U))
     dev = np.abs(H.valence - np.where(H.boundary_vertex, 4, 6)).astype(float)
     path = write_html(
-        out / "remeshing_3d.html", U, G, dev, title="Remeshed sphere (L = 0.12)",
+        out / "remeshing_3d.html", U, G, dev, title=f"Remeshed bunny (L = {L})",
         cmap="viridis", scalar_name="|valence - 6|",
     )  # fmt: skip
     return Figure(
         path,
-        "Turn it: the jittered sphere after isotropic remeshing to L = 0.12, each vertex coloured by how far its "
+        f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far its "
         "valence is from 6 (0: regular).",
         LAB,
     )
 
 
-fig_before_after.figure_name = "before_after"
-fig_operations.figure_name = "operations"
 fig_view.figure_name = "remeshing_3d"
 
 
@@ -184,6 +524,4 @@ def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
     Same arguments as :func:`make_figures`; before the loop (Task 10) is implemented, the returned
     figure is a "Task N not implemented yet" picture instead.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders((fig_view,), out, LAB, lab, quick)[0]
+    return lab_view(fig_view, out_dir, LAB, lab, quick)
