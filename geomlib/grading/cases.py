@@ -263,8 +263,9 @@ def expect_close(
 
     A failure in a graded test comes with a feedback picture
     (:func:`geomlib.grading.feedback.failure_picture`): with ``mesh=(V, F)``, the mesh with the wrong
-    rows marked (one row per vertex, or points near the mesh); without, grids as images and
-    ``(n, 2)``/``(n, 3)`` arrays as points.
+    rows marked (one row per vertex, or points near the mesh; ``mesh=(V, F, rows)`` when the rows
+    are those of the vertices ``rows`` only); without, grids as images and ``(n, 2)``/``(n, 3)``
+    arrays as points.
     """
     ctx = Context(label=label, hint=hint)
     e = np.asarray(expected, dtype=np.float64)

@@ -419,9 +419,10 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
         The comparison as the message names it (the picture's title).
     got, expected : array_like
         Submitted and expected values of the output ``name``.
-    mesh : (V, F), optional
-        The mesh the rows of the output belong to (one row per vertex, or points near it): the wrong
-        rows are marked on it. Without a mesh, grids and images are drawn as images, ``(n, 2)`` and
+    mesh : (V, F) or (V, F, rows), optional
+        The mesh the rows of the output belong to (one row per vertex, or points near it, or a
+        single point of shape (3,)): the wrong rows are marked on it. ``rows`` (indices or a mask)
+        names the vertices of the rows when the output covers only some of them. Without a mesh, grids and images are drawn as images, ``(n, 2)`` and
         ``(n, 3)`` arrays as points.
     atol, rtol : float
         The comparison's tolerance: rows within it are not marked.
@@ -430,10 +431,20 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
     if ctx is None:
         return None
     try:
+        e, g = np.asarray(expected, float), _as_float(got)
         inputs = {} if mesh is None else {"V": mesh[0], "F": mesh[1]}
-        return default_picture(
-            ctx, inputs, {name: np.asarray(expected, float)}, {name: got}, atol=max(atol, 1e-12), rtol=rtol
-        )
+        if mesh is not None and len(mesh) == 3 and g is not None and g.shape == e.shape:
+            # rows of some vertices only (the interior ones, say): spread onto all vertices, the others right
+            rows = np.asarray(mesh[2])
+            rows = np.flatnonzero(rows) if rows.dtype == bool else rows.astype(np.int64)
+            if len(rows) == len(e):
+                full_e = np.zeros((len(mesh[0]), *e.shape[1:]))
+                full_g = full_e.copy()
+                full_e[rows], full_g[rows] = e, g
+                e, g = full_e, full_g
+        if mesh is not None and e.shape == (3,) and len(mesh[0]) != 3 and g is not None and g.shape == (3,):
+            e, g = e[None], g[None]  # one point (a vertex, an edge point): marked where it should be
+        return default_picture(ctx, inputs, {name: e}, {name: g}, atol=max(atol, 1e-12), rtol=rtol)
     except Exception:  # noqa: BLE001 - a picture is a help: the message stands alone
         return None
 

@@ -299,12 +299,7 @@ def test_cube_by_hand(lab):
     EP = np.asarray(lab.cc_edge_points(V, Q, centroids(V, Q)))
     i = int(np.flatnonzero((E == [0, 1]).all(axis=1))[0])
     expect_close(
-        "cc_edge_points(cube), edge (0, 1)",
-        EP[i : i + 1],
-        [[0, -3 / 8, -3 / 8]],
-        atol=1e-12,
-        name="edge point",
-        mesh=(V, Q),
+        "cc_edge_points(cube), edge (0, 1)", EP[i], [0, -3 / 8, -3 / 8], atol=1e-12, name="edge point", mesh=(V, Q)
     )
     # Corner -1/2 (1,1,1), valence 3: Q = mean face centre = -1/6 (1,1,1), R = mean edge midpoint
     # = -1/3 (1,1,1); (Q + 2R + 0 P) / 3 = -5/18 (1,1,1). All corners by symmetry: 5/9 of P.
