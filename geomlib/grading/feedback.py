@@ -165,6 +165,7 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
         idx = np.arange(len(V), len(W))
         size = (480, 400)
         # A flat mesh is best seen from above; on a closed one, marks on the far side show from behind.
+        # Zoomed out a little: a mark on the outline is not cut in half by the frame.
         extent = np.ptp(V, axis=0) if len(V) else np.zeros(3)
         second = (
             ("top", "seen from above")
@@ -172,7 +173,9 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
             else ("three_quarter_back", "seen from behind")
         )
         views = [
-            _draw(W, F, wireframe=len(F) < 5000, highlight_points=idx, point_radius=5.0, size=size, camera=cam)
+            _draw(
+                W, F, wireframe=len(F) < 5000, highlight_points=idx, point_radius=5.0, size=size, camera=cam, zoom=0.92
+            )
             for cam in ("three_quarter", second[0])
         ]
         img = plot.panels(views, [caption, second[1]], title=ctx.label)
