@@ -425,8 +425,8 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
     mesh : (V, F) or (V, F, rows), optional
         The mesh the rows of the output belong to (one row per vertex, or points near it, or a
         single point of shape (3,)): the wrong rows are marked on it. ``rows`` (indices or a mask)
-        names the vertices of the rows when the output covers only some of them. Without a mesh, grids and images are drawn as images, ``(n, 2)`` and
-        ``(n, 3)`` arrays as points.
+        names the vertices of the rows when the output covers only some of them. Without a mesh,
+        grids and images are drawn as images, ``(n, 2)`` and ``(n, 3)`` arrays as points.
     atol, rtol : float
         The comparison's tolerance: rows within it are not marked.
     """
