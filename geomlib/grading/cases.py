@@ -257,19 +257,33 @@ def expect_close(
     rtol: float = 0.0,
     name: str = "output",
     hint: str | None = None,
+    mesh=None,
 ) -> None:
-    """Fail with a student-readable message unless ``got`` matches ``expected`` (same shape, within tolerance)."""
+    """Fail with a student-readable message unless ``got`` matches ``expected`` (same shape, within tolerance).
+
+    A failure in a graded test comes with a feedback picture
+    (:func:`geomlib.grading.feedback.failure_picture`): with ``mesh=(V, F)``, the mesh with the wrong
+    rows marked (one row per vertex, or points near the mesh; ``mesh=(V, F, rows)`` when the rows
+    are those of the vertices ``rows`` only); without, grids as images and ``(n, 2)``/``(n, 3)``
+    arrays as points.
+    """
     ctx = Context(label=label, hint=hint)
     e = np.asarray(expected, dtype=np.float64)
     try:
         g = np.asarray(got)
         problem = nonfinite_problem(name, e, g) if g.dtype != object else None
-        if problem:
-            raise Mismatch(f"{label}: {problem}" + (f" — {hint}" if hint else ""))
-        g = g.astype(np.float64)
+        g = g if problem else g.astype(np.float64)
     except (TypeError, ValueError):
         raise BadReturn(f"{label}: {name} is not a numeric array (got {type(got).__name__})") from None
-    compare_arrays(name, np.atleast_1d(e), np.atleast_1d(g), ctx, atol=atol, rtol=rtol)
+    try:
+        if problem:
+            raise Mismatch(f"{label}: {problem}" + (f" — {hint}" if hint else ""))
+        compare_arrays(name, np.atleast_1d(e), np.atleast_1d(g), ctx, atol=atol, rtol=rtol)
+    except Mismatch as err:
+        from geomlib.grading import feedback
+
+        picture = feedback.failure_picture(label, g, e, name=name, mesh=mesh, atol=atol, rtol=rtol)
+        raise Mismatch(err.message, picture) from None
 
 
 def expect_raises(

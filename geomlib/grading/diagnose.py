@@ -116,132 +116,13 @@ def _run_probe(lab, probe, mod, feedback_dir):
 def _picture(mod, function, ctx, inputs, expected, got):
     if ctx.feedback_dir is None:
         return None
-    fn = getattr(mod, "PICTURES", {}).get(function, _default_picture)
+    from geomlib.grading import feedback
+
+    fn = getattr(mod, "PICTURES", {}).get(function, feedback.default_picture)
     try:
         return fn(ctx, inputs, expected, got)
     except Exception:
         return None
-
-
-def _default_picture(ctx, inputs, expected, got):
-    """A picture for a wrong array: rows on the input mesh, or a grid output as an image."""
-    return (
-        _rows_on_mesh(ctx, inputs, expected, got)
-        or _grid_image(ctx, expected, got)
-        or _free_points(ctx, inputs, expected, got)
-    )
-
-
-def _free_points(ctx, inputs, expected, got):
-    """Points with no mesh to draw them on (light-space (u, v, z), sample positions): a scatter of the
-    expected and submitted points, wrong ones joined to where they should be."""
-    import numpy as np
-
-    from geomlib.grading import feedback
-
-    if "V" in inputs:
-        return None  # on a mesh: _rows_on_mesh's business
-    for name, e in expected.items():
-        e = np.asarray(e)
-        try:
-            g = np.asarray(got.get(name), dtype=float)
-        except (TypeError, ValueError):
-            continue
-        if e.dtype.kind != "f" or e.ndim != 2 or e.shape[1] not in (2, 3) or len(e) < 2 or g.shape != e.shape:
-            continue
-        if np.isclose(g, e, rtol=0.0, atol=1e-8).all():
-            continue
-        return feedback.points_picture(ctx, e, g, name)
-    return None
-
-
-def _grid_image(ctx, expected, got):
-    """Expected and submitted (h, w, c) grids (displacements, positions, maps) as images, with the
-    per-texel error as a heat map; channels are scaled by the expected values' range."""
-    import numpy as np
-
-    from geomlib.grading import feedback
-
-    for name, e in expected.items():
-        e = np.asarray(e)
-        if e.dtype.kind == "b" and e.ndim == 2 and min(e.shape) >= 2:
-            e = e.astype(float)  # a per-cell choice (diagonals): drawn as 0/1, the wrong cells lit
-        try:
-            g = np.asarray(got.get(name), dtype=float)
-        except (TypeError, ValueError):
-            continue
-        # (h, w, c) grids, or (h, w) scalar images; an (n, 3) list of points is not an image.
-        if (
-            e.dtype.kind != "f"
-            or e.ndim not in (2, 3)
-            or g.shape != e.shape
-            or min(e.shape[:2]) < (2 if e.ndim == 3 else 8)
-        ):
-            continue
-        if e.ndim == 3 and e.shape[2] not in (1, 2, 3, 4):
-            continue
-        e3 = e if e.ndim == 3 else e[..., None]
-        g3 = g if g.ndim == 3 else g[..., None]
-        err = np.abs(g3 - e3).max(axis=2)
-        if not (err > 1e-12).any():
-            continue
-        lo = e3.min(axis=(0, 1))
-        span = np.maximum(e3.max(axis=(0, 1)) - lo, 1e-12)
-
-        def show(x, lo=lo, span=span):
-            x = np.clip((x - lo) / span, 0, 1)
-            if x.shape[2] == 2:
-                x = np.concatenate([x, np.zeros_like(x[..., :1])], axis=2)
-            return x[..., :3] if x.shape[2] >= 3 else x[..., 0]
-
-        k = max(1, 256 // max(e.shape[:2]))  # small grids: one block of k x k pixels per texel
-
-        def up(x, k=k):
-            return np.repeat(np.repeat(x, k, axis=0), k, axis=1)
-
-        return feedback.image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))))
-    return None
-
-
-def _rows_on_mesh(ctx, inputs, expected, got):
-    """Default picture for a wrong array of points or per-vertex values on an input mesh: the mesh
-    with the wrong rows marked (at the vertex for per-vertex rows, else where the point should be)."""
-    import numpy as np
-
-    from geomlib.grading import feedback
-
-    V = inputs.get("V")
-    F = next((inputs[k] for k in ("F", "faces", "Q") if k in inputs), None)
-    if V is None or F is None:
-        return None
-    V = np.asarray(V, float)
-    if V.ndim != 2 or V.shape[1] != 3:
-        return None
-    for name, e in expected.items():
-        e = np.asarray(e)
-        try:
-            g = np.asarray(got.get(name), dtype=float)
-        except (TypeError, ValueError):
-            continue
-        if e.dtype.kind != "f" or e.ndim != 2 or g.shape != e.shape:
-            continue
-        bad = ~np.isclose(g, e, rtol=0.0, atol=1e-8).all(axis=1)
-        if not bad.any():
-            continue
-        if len(e) == len(V) and bad.sum() > 20:
-            err = np.linalg.norm(np.nan_to_num(g - e, nan=np.inf), axis=1)
-            err[~np.isfinite(err)] = np.nan
-            return feedback.heat_on_mesh_picture(
-                ctx, V, F, err, f"{int(bad.sum())} of {len(e)} rows of {name} are wrong", f"|{name} error|"
-            )
-        if len(e) == len(V):
-            points, what = V[bad], f"{int(bad.sum())} vertices where {name} is wrong"
-        elif e.shape[1] == 3:
-            points, what = e[bad], f"where the {int(bad.sum())} wrong rows of {name} should be"
-        else:
-            continue
-        return feedback.highlight_picture(ctx, V, F, points, what)
-    return None
 
 
 def explain(lab, case, *, feedback_dir=None) -> str | None:

@@ -4,6 +4,7 @@ Loaded by ``tests/conftest.py``. A graded test lives in ``tests/graded/<lab>/`` 
 ``graded`` marker (points, part, visibility). The plugin
 
 - hands each test the lab under test as a sandboxed :class:`~geomlib.grading.sandbox.LabProxy`;
+- tells :mod:`~geomlib.grading.feedback` where the running graded test's failure pictures go;
 - replaces the traceback of an expected failure (:class:`~geomlib.grading.errors.GradingFailure`)
   by its one- or two-sentence message;
 - records every graded outcome, prints a per-lab, per-part score table, and leaves the records in
@@ -77,6 +78,24 @@ def _lab_of(path: Path) -> str | None:
 def feedback_dir(request) -> Path | None:
     d = request.config.getoption("--feedback-dir")
     return Path(d) if d else None
+
+
+@pytest.fixture(autouse=True)
+def _feedback_pictures_of_this_test(request):
+    """Tell :mod:`geomlib.grading.feedback` where a graded test's failure pictures go, so
+    ``expect_close`` and a lab's own comparisons draw them (``feedback/<lab>/<test>-<output>.png``)."""
+    from geomlib.grading import feedback
+
+    name = _lab_of(request.path)
+    folder = request.config.getoption("--feedback-dir", None)
+    if name is None or not folder:
+        yield
+        return
+    feedback.begin_test(Path(folder), name, request.node.name)
+    try:
+        yield
+    finally:
+        feedback.end_test()
 
 
 @pytest.fixture

@@ -17,6 +17,7 @@ from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import failure_picture
 from geomlib.textures import rasterize_uv
 
 from .cases import CASES
@@ -61,7 +62,7 @@ def test_pyramid_uniform_offsets(lab):
     expected = [[0, 0, 1], [1, 0, -1 / 3], [0, 1, -1 / 3], [-1, 0, -1 / 3], [0, -1, -1 / 3]]
     expect_close(
         "laplacian_offsets on the pyramid", d, expected, atol=1e-12, name="delta",
-        hint="each neighbour counts once, even when two triangles share the edge",
+        hint="each neighbour counts once, even when two triangles share the edge", mesh=(PYRAMID_V, PYRAMID_F),
     )  # fmt: skip
 
 
@@ -75,6 +76,7 @@ def test_right_triangle_cotan_offsets(lab):
     expect_close(
         "laplacian_offsets(weights='cotan') on a right triangle", d, expected, atol=1e-12, name="delta",
         hint="w_ij = (cot alpha + cot beta)/2 with the angles OPPOSITE the edge ij; one angle on a boundary edge",
+        mesh=(RIGHT_V, RIGHT_F),
     )  # fmt: skip
 
 
@@ -85,7 +87,12 @@ def test_regular_tetrahedron_cotan_equals_uniform(lab):
         d = lab.laplacian_offsets(REG_TET_V, REG_TET_F, w, weld=False)
         # the vertices sum to 0, so the mean of the other three is -p_i / 3
         expect_close(
-            f"laplacian_offsets(weights={w!r}) on a regular tetrahedron", d, 4 / 3 * REG_TET_V, atol=1e-12, name="delta"
+            f"laplacian_offsets(weights={w!r}) on a regular tetrahedron",
+            d,
+            4 / 3 * REG_TET_V,
+            atol=1e-12,
+            name="delta",
+            mesh=(REG_TET_V, REG_TET_F),
         )
 
 
@@ -97,7 +104,11 @@ def test_flat_meshes_have_zero_interior_offsets(lab):
     interior[topology.boundary_edges(F).ravel()] = False
     d = np.asarray(lab.laplacian_offsets(V, F, "uniform", weld=False))
     expect_close(
-        "laplacian_offsets on a regular flat grid (interior vertices)", d[interior], 0 * V[interior], atol=1e-12
+        "laplacian_offsets on a regular flat grid (interior vertices)",
+        d[interior],
+        0 * V[interior],
+        atol=1e-12,
+        mesh=(V, F, interior),
     )
     Vj = V.copy()
     Vj[interior, :2] += np.random.default_rng(3).uniform(-0.03, 0.03, size=(interior.sum(), 2))
@@ -105,6 +116,7 @@ def test_flat_meshes_have_zero_interior_offsets(lab):
     expect_close(
         "laplacian_offsets(weights='cotan') on a jittered flat grid (interior vertices)", d[interior], 0 * V[interior],
         atol=1e-10, hint="cotangent weights reproduce linear functions exactly: on a plane the weighted mean is the vertex",
+        mesh=(Vj, F, interior),
     )  # fmt: skip
 
 
@@ -133,7 +145,13 @@ def test_pyramid_denoise_by_hand(lab):
     # s = (1, -1/3, -1/3, -1/3, -1/3) (z of the uniform offsets); p' = p - 0.5 s (0,0,1)
     expected = PYRAMID_V + np.outer([-0.5, 1 / 6, 1 / 6, 1 / 6, 1 / 6], UP)
     expect_close(
-        "denoise_vertices on the pyramid, lam=0.5", X, expected, atol=1e-12, name="V'", hint="p' = p - lam s n"
+        "denoise_vertices on the pyramid, lam=0.5",
+        X,
+        expected,
+        atol=1e-12,
+        name="V'",
+        hint="p' = p - lam s n",
+        mesh=(PYRAMID_V, PYRAMID_F),
     )
 
 
@@ -142,7 +160,14 @@ def test_lambda_zero_changes_nothing(lab):
     """lambda = 0 returns the input positions"""
     V, F = datasets.icosphere(2)
     Vn, N = noisy(V, F, 0.3, 1)
-    expect_close("denoise_vertices(lam=0)", lab.denoise_vertices(Vn, F, N, 0.0, weld=False), Vn, atol=0.0, name="V'")
+    expect_close(
+        "denoise_vertices(lam=0)",
+        lab.denoise_vertices(Vn, F, N, 0.0, weld=False),
+        Vn,
+        atol=0.0,
+        name="V'",
+        mesh=(Vn, F),
+    )
 
 
 @graded(points=1, part="direct denoising")
@@ -153,7 +178,7 @@ def test_vertices_move_along_their_normals(lab):
     D = np.asarray(lab.denoise_vertices(Vn, F, N, 0.7, weights="cotan", weld=False)) - Vn
     expect_close(
         "cross(V' - V, N) after denoise_vertices", np.cross(D, N), 0 * D, atol=1e-12,
-        hint="move by s_i n_i, not by delta_i",
+        hint="move by s_i n_i, not by delta_i", mesh=(Vn, F),
     )  # fmt: skip
 
 
@@ -165,7 +190,7 @@ def test_iterations_repeat_the_pass(lab):
     twice = lab.denoise_vertices(lab.denoise_vertices(Vn, F, N, 0.3, weld=False), F, N, 0.3, weld=False)
     expect_close(
         "denoise_vertices(iterations=2)", lab.denoise_vertices(Vn, F, N, 0.3, iterations=2, weld=False), twice, atol=1e-12,
-        hint="recompute delta from the moved vertices in every iteration, with the same normals",
+        hint="recompute delta from the moved vertices in every iteration, with the same normals", mesh=(Vn, F),
     )  # fmt: skip
 
 
@@ -279,6 +304,7 @@ def test_map_lookup_by_hand(lab):
     expect_close(
         "denoise_with_map on a 2x2 map (z of the result)", np.asarray(X)[:, 2], [-1.5, 0.0, -2.0, -3.0, -1.0], atol=1e-12,
         name="z", hint="bilinear lookup with geomlib.textures.sample_bilinear (row 0 = v near 1); p' = p - lam s n",
+        mesh=(V, F),
     )  # fmt: skip
 
 
@@ -289,7 +315,12 @@ def test_integer_maps_are_decoded(lab):
     N = np.tile(UP, (5, 1))
     X8 = lab.denoise_with_map(V, F, UV, N, np.full((4, 4), 255, np.uint8), 0.1, 0.2, 1.0, weld=False)
     expect_close(
-        "denoise_with_map with a uint8 map of 255", np.asarray(X8)[:, 2], np.full(5, -0.3), atol=1e-12, name="z"
+        "denoise_with_map with a uint8 map of 255",
+        np.asarray(X8)[:, 2],
+        np.full(5, -0.3),
+        atol=1e-12,
+        name="z",
+        mesh=(V, F),
     )
     X16 = lab.denoise_with_map(V, F, UV, N, np.full((4, 4), 32768, np.uint16), 0.0, 1.0, 0.5, weld=False)
     expect_close(
@@ -298,6 +329,7 @@ def test_integer_maps_are_decoded(lab):
         np.full(5, -0.5 * 32768 / 65535),
         atol=1e-12,
         name="z",
+        mesh=(V, F),
     )
 
 
@@ -312,7 +344,9 @@ def test_linear_map_is_read_exactly_inside(lab):
     UV = 0.05 + 0.9 * UV  # stay inside the outermost texel centres
     X = lab.denoise_with_map(V, F, UV, np.tile(UP, (len(V), 1)), image, bias, scale, 1.0, weld=False)
     expected = -(0.25 + 0.5 * UV[:, 0] + 0.25 * UV[:, 1])
-    expect_close("denoise_with_map on a linear map", np.asarray(X)[:, 2], expected, atol=scale / 65535, name="z")
+    expect_close(
+        "denoise_with_map on a linear map", np.asarray(X)[:, 2], expected, atol=scale / 65535, name="z", mesh=(V, F)
+    )
 
 
 @graded(points=1, part="denoising through the map")
@@ -326,11 +360,15 @@ def test_map_route_matches_direct_route(lab):
     Xd = np.asarray(lab.denoise_vertices(Vn, F, N, 0.7, weld=False))
     gap = float(np.linalg.norm(Xm - Xd, axis=1).max())
     # a texel holds s up to the slope of s times a texel diagonal; the reference solution reaches 0.028 scale here
-    expect(
-        "denoise_with_map after bake_offset_map(size=512)", gap <= 0.7 * 0.05 * float(scale),
-        f"the map route differs from denoise_vertices by up to {gap:.3g} (scale {float(scale):.3g}); check that the "
-        "bake and the lookup use the same texel convention (row 0 = v near 1, texel centres at (col + 1/2) / size)",
-    )  # fmt: skip
+    label = "denoise_with_map after bake_offset_map(size=512)"
+    if not gap <= 0.7 * 0.05 * float(scale):
+        raise Mismatch(
+            f"{label}: the map route differs from denoise_vertices by up to {gap:.3g} (scale {float(scale):.3g}); check "
+            "that the bake and the lookup use the same texel convention (row 0 = v near 1, texel centres at (col + 1/2) / size)",
+            failure_picture(
+                label, Xm, Xd, name="map route - direct route", mesh=(Vn, F), atol=0.7 * 0.05 * float(scale)
+            ),
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -392,6 +430,7 @@ def test_welded_offsets_match_the_seamless_torus(lab):
     expect_close(
         "laplacian_offsets(weld=True) on the cut torus", d_cut, d_ref, atol=1e-10, name="delta",
         hint="compute the offsets on the welded mesh (weld_seams) and give every copy its group's offset",
+        mesh=(Vn[idx], Fu),
     )  # fmt: skip
 
 

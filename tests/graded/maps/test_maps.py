@@ -12,6 +12,7 @@ from geomlib import datasets
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import failure_picture, marked_picture
 
 from .cases import CASES, LIGHT, quad_gbuffer, texel_uv, unit_vectors, wave
 
@@ -40,7 +41,8 @@ def expect_map_close(label: str, got, expected, atol: float, hint: str | None = 
         r, c = (int(i) for i in np.argwhere(bad)[0])
         raise Mismatch(
             f"{label}: [{r}, {c}] expected {format_vec(e[r, c])}, got {format_vec(g[r, c])}; {int(bad.sum())} of "
-            f"{bad.size} texels differ by more than {atol:g}" + (f" — {hint}" if hint else "")
+            f"{bad.size} texels differ by more than {atol:g}" + (f" — {hint}" if hint else ""),
+            failure_picture(label, g, e, name="map", atol=atol),
         )
 
 
@@ -52,11 +54,14 @@ def test_one_triangle_by_hand(lab):
     """one triangle: T along +u, B along +v, w = +1"""
     # P1 - P0 = (2, 0, 0) with du = 1, P2 - P0 = (0, 1, 0) with dv = 1: dP/du = (2, 0, 0), dP/dv = (0, 1, 0).
     V = np.array([[0, 0, 0], [2, 0, 0], [0, 1, 0.0]])
-    T, B, N, w = lab.tangent_frames(V, [[0, 1, 2]], [[0, 0], [1, 0], [0, 1]])
-    expect_close("tangent_frames T on one triangle", T, np.tile([1.0, 0, 0], (3, 1)), atol=1e-12)
-    expect_close("tangent_frames B on one triangle", B, np.tile([0.0, 1, 0], (3, 1)), atol=1e-12)
-    expect_close("tangent_frames N on one triangle", N, np.tile([0.0, 0, 1], (3, 1)), atol=1e-12)
-    expect_close("tangent_frames w on one triangle", w, np.ones(3), atol=0, hint="w = sign((N x T) . B_sum)")
+    F = [[0, 1, 2]]
+    T, B, N, w = lab.tangent_frames(V, F, [[0, 0], [1, 0], [0, 1]])
+    expect_close("tangent_frames T on one triangle", T, np.tile([1.0, 0, 0], (3, 1)), atol=1e-12, mesh=(V, F))
+    expect_close("tangent_frames B on one triangle", B, np.tile([0.0, 1, 0], (3, 1)), atol=1e-12, mesh=(V, F))
+    expect_close("tangent_frames N on one triangle", N, np.tile([0.0, 0, 1], (3, 1)), atol=1e-12, mesh=(V, F))
+    expect_close(
+        "tangent_frames w on one triangle", w, np.ones(3), atol=0, hint="w = sign((N x T) . B_sum)", mesh=(V, F)
+    )
 
 
 @graded(points=1, part="tangent frames")
@@ -72,10 +77,16 @@ def test_mirrored_uvs_flip_w(lab):
         -np.ones(len(V)),
         atol=0,
         hint="the UV triangles run clockwise: det < 0",
+        mesh=(V, F),
     )
-    expect_close("tangent_frames T with mirrored UVs", T, np.tile([-1.0, 0, 0], (len(V), 1)), atol=1e-12)
+    expect_close("tangent_frames T with mirrored UVs", T, np.tile([-1.0, 0, 0], (len(V), 1)), atol=1e-12, mesh=(V, F))
     expect_close(
-        "tangent_frames B with mirrored UVs", B, np.tile([0.0, 1, 0], (len(V), 1)), atol=1e-12, hint="B = w (N x T)"
+        "tangent_frames B with mirrored UVs",
+        B,
+        np.tile([0.0, 1, 0], (len(V), 1)),
+        atol=1e-12,
+        hint="B = w (N x T)",
+        mesh=(V, F),
     )
 
 
@@ -91,11 +102,18 @@ def test_frames_are_orthonormal_without_nan(lab):
         "tangent_frames returned NaN or inf (degenerate UV triangles must be skipped)",
     )
     for name, X in (("T", T), ("B", B), ("N", N)):
-        expect_close(f"tangent_frames |{name}|", np.linalg.norm(X, axis=1), np.ones(len(V)), atol=1e-9)
+        expect_close(f"tangent_frames |{name}|", np.linalg.norm(X, axis=1), np.ones(len(V)), atol=1e-9, mesh=(V, F))
     expect_close(
-        "tangent_frames T . N", np.sum(T * N, axis=1), np.zeros(len(V)), atol=1e-9, hint="Gram-Schmidt: T - (N . T) N"
+        "tangent_frames T . N",
+        np.sum(T * N, axis=1),
+        np.zeros(len(V)),
+        atol=1e-9,
+        hint="Gram-Schmidt: T - (N . T) N",
+        mesh=(V, F),
     )
-    expect_close("tangent_frames B - w N x T", B - w[:, None] * np.cross(N, T), np.zeros_like(B), atol=1e-9)
+    expect_close(
+        "tangent_frames B - w N x T", B - w[:, None] * np.cross(N, T), np.zeros_like(B), atol=1e-9, mesh=(V, F)
+    )
 
 
 # ------------------------------------------------------------------------------ encode / decode
@@ -135,12 +153,13 @@ def test_round_trip_within_one_code(lab):
     n = unit_vectors((96, 96), 4)
     back = np.asarray(lab.decode_normal_map(lab.encode_normal_map(n)), float)
     err = np.abs(back - n).max()
-    expect(
-        err <= 1.0 / 255.0,
-        f"decode(encode(n)) is off by up to {err * 255:.3f}/255 in a component, allowed 1/255 — plain rounding gets "
-        f"about 1.3/255 after renormalising: try the 8 floor/ceil codes around 255 (n + 1) / 2 and keep the one "
-        f"that decodes closest to n",
-    )
+    if not err <= 1.0 / 255.0:
+        raise Mismatch(
+            f"decode(encode(n)) is off by up to {err * 255:.3f}/255 in a component, allowed 1/255 — plain rounding gets "
+            f"about 1.3/255 after renormalising: try the 8 floor/ceil codes around 255 (n + 1) / 2 and keep the one "
+            f"that decodes closest to n",
+            failure_picture("decode(encode(n)) vs n", back, n, name="normals", atol=1.0 / 255.0),
+        )
 
 
 # ------------------------------------------------------------------------------ height -> normals
@@ -247,7 +266,11 @@ def test_constant_map_by_hand(lab):
     V, F, UV = datasets.uv_sphere(8, 16)
     Vd = np.asarray(lab.displace(V, F, UV, V, np.full((4, 4), 0.75), lam=0.1, bias=-1.0, scale=2.0), float)
     expect_close(
-        "displace: radius after a constant offset", np.linalg.norm(Vd, axis=1), np.full(len(V), 1.05), atol=1e-12
+        "displace: radius after a constant offset",
+        np.linalg.norm(Vd, axis=1),
+        np.full(len(V), 1.05),
+        atol=1e-12,
+        mesh=(V, F),
     )
 
 
@@ -259,11 +282,13 @@ def test_seam_copies_move_together(lab):
     Vd = np.asarray(lab.displace(V, F, UV, None, H, lam=0.2), float)
     key = np.round(V, 9)
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    gap = np.linalg.norm(Vd - Vd[first][inv.ravel()], axis=1).max()
-    expect(
-        gap < 1e-12,
-        f"displace: copies of a seam vertex end up {gap:.3g} apart (the seam cracks open); average their offsets and normals when weld_seams=True",
-    )
+    gaps = np.linalg.norm(Vd - Vd[first][inv.ravel()], axis=1)
+    if not gaps.max() < 1e-12:
+        raise Mismatch(
+            f"displace: copies of a seam vertex end up {gaps.max():.3g} apart (the seam cracks open); average their "
+            "offsets and normals when weld_seams=True",
+            marked_picture("displace: seam copies", V, F, V[~(gaps < 1e-12)], "seam vertices whose copies split"),
+        )
 
 
 # ------------------------------------------------------------------------------ baking
@@ -282,10 +307,11 @@ def test_baked_height_field_matches_exact_normals(lab):
     hv = -np.pi * np.sin(2 * np.pi * u) * np.sin(2 * np.pi * v)
     exact = unit(np.stack([-k * hu, -k * hv, np.ones_like(u)], axis=-1))
     ang = np.degrees(np.arccos(np.clip(np.sum(unit(n) * exact, axis=-1), -1, 1)))
-    expect(
-        ang.max() < 1.0,
-        f"bake_normal_map: baked normals are up to {ang.max():.2f} degrees off the exact ones (allowed 1)",
-    )
+    if not ang.max() < 1.0:
+        raise Mismatch(
+            f"bake_normal_map: baked normals are up to {ang.max():.2f} degrees off the exact ones (allowed 1)",
+            failure_picture("bake_normal_map vs exact normals", n, exact, name="normals"),
+        )
 
 
 # ------------------------------------------------------------------------------ bad input (given validation)

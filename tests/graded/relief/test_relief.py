@@ -11,6 +11,7 @@ import numpy as np
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.cases import load_reference
 from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import failure_picture
 
 from .cases import CASES, SCALE, direction, pixel_uv, texel_uv
 
@@ -37,7 +38,8 @@ def expect_glsl_matches(label: str, got, expected, *, atol: float, unit: str = "
         raise Mismatch(
             f"{label}: pixel [{r}, {c}] differs from the NumPy reference by {per[r, c]:.3g}{unit}; "
             f"{int(bad.sum())} of {bad.size} pixels differ by more than {atol:g}{unit} "
-            f"(at most {100 * (1 - GLSL_FRACTION):.2g}% may)"
+            f"(at most {100 * (1 - GLSL_FRACTION):.2g}% may)",
+            failure_picture(label, g, e, name="shader output", atol=atol / scale_to),
         )
 
 

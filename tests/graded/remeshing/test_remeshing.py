@@ -55,7 +55,9 @@ def test_split_the_diagonal_of_a_square(lab):
     H = halfedges(SQUARE_V, SQUARE_F)
     V, H2 = lab.split_edge(SQUARE_V, H, edge_index(H, 0, 2))
     expect_valid("split_edge on the square", V, H2)
-    expect_close("split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.5, 0.0], name="V[4]")
+    expect_close(
+        "split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.5, 0.0], name="V[4]", mesh=(SQUARE_V, SQUARE_F)
+    )
     expect_true(
         "split_edge on the square",
         faces_as_sets(H2) == [(0, 1, 4), (0, 3, 4), (1, 2, 4), (2, 3, 4)],
@@ -69,7 +71,9 @@ def test_split_a_boundary_edge(lab):
     H = halfedges(SQUARE_V, SQUARE_F)
     V, H2 = lab.split_edge(SQUARE_V, H, edge_index(H, 0, 1))
     expect_valid("split_edge on a boundary edge", V, H2)
-    expect_close("split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.0, 0.0], name="V[4]")
+    expect_close(
+        "split_edge: the new vertex", np.asarray(V)[4], [0.5, 0.0, 0.0], name="V[4]", mesh=(SQUARE_V, SQUARE_F)
+    )
     expect_true(
         "split_edge on a boundary edge",
         rebuilt(H2).n_faces == 3 and int(rebuilt(H2).boundary_edge.sum()) == 5,

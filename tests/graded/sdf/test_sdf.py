@@ -31,6 +31,7 @@ def test_seven_regions_by_hand(lab):
         [[0.5, 0.5, 0], [0, 0, 0], [2, 0, 0], [0, 2, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]],
         atol=1e-12,
         name="closest",
+        mesh=(TRI[0], [[0, 1, 2]]),
     )
 
 

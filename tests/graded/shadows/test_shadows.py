@@ -12,6 +12,7 @@ from geomlib import datasets
 from geomlib.geometry import ray_cast
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import marked_picture
 
 from .cases import CASES
 from .support import CAMERA, SCENE_BOUNDS, ortho_light, scene_meshes, small_scene
@@ -32,8 +33,8 @@ def corners(B) -> np.ndarray:
     return np.array(np.meshgrid(*B.T, indexing="ij")).reshape(3, -1).T
 
 
-def fail(msg: str):
-    raise Mismatch(msg)
+def fail(msg: str, picture: str | None = None):
+    raise Mismatch(msg, picture)
 
 
 # ------------------------------------------------------------------------------------------ Task 1
@@ -188,7 +189,8 @@ def test_no_acne_with_default_bias(lab):
         fail("without bias about half of the slanted square should shadow itself (acne); check compare_depth")
     if (vis < 0.5).any():
         fail(f"with the default bias {int((vis < 0.5).sum())} of 500 points on a lit plane are shadowed (acne); "
-             "the slope term must cover half a texel in u and in v: b = bias + slope_bias (|g_u| + |g_v|) / 2")  # fmt: skip
+             "the slope term must cover half a texel in u and in v: b = bias + slope_bias (|g_u| + |g_v|) / 2",
+             marked_picture("shadow_visibility on a lit plane", V, SQUARE_F, P[vis < 0.5], "points shadowed (acne)"))  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ Task 5
@@ -338,8 +340,10 @@ def test_agrees_with_ray_casting(lab):
     agree = np.mean((vis >= 0.5) == truth)
     acne = np.mean(vis[truth] < 0.5)
     if agree < 0.99 or acne > 0.005:
+        wrong = P[(vis >= 0.5) != truth]
         fail(f"shadow_visibility agrees with ray casting on {100 * agree:.2f}% of {len(P)} points (need >= 99%) "
-             f"and shades {100 * acne:.2f}% of truly lit points dark (acne, allowed 0.5%)")  # fmt: skip
+             f"and shades {100 * acne:.2f}% of truly lit points dark (acne, allowed 0.5%)",
+             marked_picture("shadow_visibility vs ray casting", V, F, wrong, "points where the two disagree"))  # fmt: skip
 
 
 @graded(points=1, part="all together")

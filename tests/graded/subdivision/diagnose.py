@@ -26,7 +26,7 @@ from .cases import (
     torus,
     with_face_points,
 )
-from .support import as_dense, faces_check, matrix_check
+from .support import faces_check, matrix_check, matrix_picture, wrong_rows
 
 TASKS = {
     "loop_odd_matrix": (1, 4),
@@ -172,14 +172,6 @@ PROBES = {
 }
 
 
-def _bad_rows(expected, got, name):
-    E = as_dense(expected[name], name)
-    G = as_dense(got[name], name)
-    if G.shape != E.shape:
-        return None
-    return np.flatnonzero((np.abs(G - E) > 1e-12).any(axis=1))
-
-
 def _kinds(labels) -> str:
     kinds = sorted(set(labels), key=lambda s: (not s.startswith("valence"), s))
     if len(kinds) > 3:
@@ -188,7 +180,7 @@ def _kinds(labels) -> str:
 
 
 def _where_even(inputs, expected, got) -> str:
-    rows = _bad_rows(expected, got, "S_even")
+    rows = wrong_rows(expected["S_even"], got["S_even"], "S_even")
     if rows is None or not len(rows):
         return ""
     F = np.asarray(inputs["F"])
@@ -200,7 +192,7 @@ def _where_even(inputs, expected, got) -> str:
 
 
 def _where_odd(inputs, expected, got) -> str:
-    rows = _bad_rows(expected, got, "S_odd")
+    rows = wrong_rows(expected["S_odd"], got["S_odd"], "S_odd")
     if rows is None or not len(rows):
         return ""
     F = np.asarray(inputs["F"])
@@ -213,27 +205,11 @@ def _where_odd(inputs, expected, got) -> str:
 WHERE = {"loop_even_matrix": _where_even, "loop_odd_matrix": _where_odd}
 
 
-def _picture_even(ctx, inputs, expected, got):
-    from geomlib.grading import feedback
+def _picture(name):
+    def picture(ctx, inputs, expected, got):
+        return matrix_picture(ctx, inputs["V"], inputs["F"], expected[name], got[name], name)
 
-    rows = _bad_rows(expected, got, "S_even")
-    if rows is None or not len(rows):
-        return None
-    V = np.asarray(inputs["V"], float)
-    return feedback.highlight_picture(ctx, V, inputs["F"], V[rows], f"{len(rows)} vertices whose S_even rows are wrong")
+    return picture
 
 
-def _picture_odd(ctx, inputs, expected, got):
-    from geomlib.grading import feedback
-
-    rows = _bad_rows(expected, got, "S_odd")
-    if rows is None or not len(rows):
-        return None
-    V = np.asarray(inputs["V"], float)
-    E = topology.unique_edges(np.asarray(inputs["F"]))
-    rows = rows[rows < len(E)]
-    mid = (V[E[rows, 0]] + V[E[rows, 1]]) / 2
-    return feedback.highlight_picture(ctx, V, inputs["F"], mid, f"{len(rows)} edges whose S_odd rows are wrong")
-
-
-PICTURES = {"loop_even_matrix": _picture_even, "loop_odd_matrix": _picture_odd}
+PICTURES = {"loop_even_matrix": _picture("S_even"), "loop_odd_matrix": _picture("S_odd")}

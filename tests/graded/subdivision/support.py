@@ -113,6 +113,39 @@ def matrix_mismatch(name: str, expected, got, *, atol: float = tol.EXACT, what_r
     return msg
 
 
+def wrong_rows(expected, got, name: str = "S", atol: float = tol.EXACT) -> np.ndarray | None:
+    """Indices of the rows of a returned matrix that differ from the expected one (None: shapes differ)."""
+    E = as_dense(expected, name)
+    G = as_dense(got, name)
+    if G.shape != E.shape:
+        return None
+    return np.flatnonzero(~(np.abs(G - E) <= atol).all(axis=1))  # NaN counts as wrong
+
+
+def matrix_picture(ctx, V, F, expected, got, name: str) -> str | None:
+    """The mesh with the places whose rows of a subdivision matrix are wrong marked in red: edge
+    midpoints for ``S_odd`` (one row per edge, in :func:`geomlib.topology.unique_edges` order),
+    vertices for ``S_even`` and the other matrices (one row per vertex)."""
+    from geomlib import topology
+    from geomlib.grading import feedback
+
+    if ctx is None:
+        return None
+    rows = wrong_rows(expected, got, name)
+    if rows is None or not len(rows):
+        return None
+    V = np.asarray(V, float)
+    if name == "S_odd":
+        E = topology.unique_edges(np.asarray(F))
+        rows = rows[rows < len(E)]
+        points = (V[E[rows, 0]] + V[E[rows, 1]]) / 2
+        what = f"{feedback.count(len(rows), 'edge', 'edges')} whose {name} row is wrong"
+    else:
+        rows = rows[rows < len(V)]
+        points, what = V[rows], f"{feedback.count(len(rows), 'vertex', 'vertices')} whose {name} row is wrong"
+    return feedback.highlight_picture(ctx, V, F, points, what)
+
+
 def matrix_check(name: str, *, atol: float = tol.EXACT, what_row: str = "row"):
     """A ``checks.Custom`` comparison for a matrix output stored dense in the reference."""
     from geomlib.grading import checks

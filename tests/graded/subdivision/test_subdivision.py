@@ -13,6 +13,7 @@ import numpy as np
 from geomlib import datasets, topology
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import marked_picture, picture_context
 
 from .cases import CASES
 from .support import (
@@ -32,15 +33,18 @@ from .support import (
     centroids,
     faces_mismatch,
     matrix_mismatch,
+    matrix_picture,
 )
 
 test_references = reference_tests(CASES)
 
 
-def expect_matrix(label: str, got, expected, name: str = "S") -> None:
+def expect_matrix(label: str, got, expected, name: str = "S", mesh=None) -> None:
+    """Compare a subdivision matrix; on failure, the rows that are wrong are marked on ``mesh = (V, F)``."""
     msg = matrix_mismatch(name, np.asarray(expected, float), got)
     if msg:
-        raise Mismatch(f"{label}: {msg}")
+        picture = matrix_picture(picture_context(label, name), *mesh, expected, got, name) if mesh else None
+        raise Mismatch(f"{label}: {msg}", picture)
 
 
 def expect_faces(label: str, got, expected, name: str = "F") -> None:
@@ -63,7 +67,7 @@ def test_tetrahedron_odd_rows(lab):
     expected = np.full((6, 4), 1 / 8)
     for i, (a, b) in enumerate(E):
         expected[i, [a, b]] = 3 / 8
-    expect_matrix("loop_odd_matrix on the tetrahedron", S, expected, "S_odd")
+    expect_matrix("loop_odd_matrix on the tetrahedron", S, expected, "S_odd", mesh=(TET_V, TET_F))
 
 
 @graded(points=1, part="odd vertices")
@@ -74,7 +78,9 @@ def test_octahedron_odd_positions(lab):
     # Every edge joins two unit vectors on different axes; its opposite vertices are the two
     # antipodes on the third axis, which cancel: odd = 3/8 (a + b).
     expected = 3 / 8 * (OCTA_V[E[:, 0]] + OCTA_V[E[:, 1]])
-    expect_close("loop_odd_matrix(octahedron) @ V", S @ OCTA_V, expected, atol=1e-12, name="odd vertices")
+    expect_close(
+        "loop_odd_matrix(octahedron) @ V", S @ OCTA_V, expected, atol=1e-12, name="odd vertices", mesh=(OCTA_V, OCTA_F)
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -98,7 +104,9 @@ def test_octahedron_even_rows(lab):
         for k in range(3):
             expected[2 * k, 2 * k + 1] = expected[2 * k + 1, 2 * k] = 0.0  # antipodes are not neighbours
         S = lab.loop_even_matrix(OCTA_V, OCTA_F, weights)
-        expect_matrix(f"loop_even_matrix(octahedron, weights={weights!r})", S, expected, "S_even")
+        expect_matrix(
+            f"loop_even_matrix(octahedron, weights={weights!r})", S, expected, "S_even", mesh=(OCTA_V, OCTA_F)
+        )
 
 
 @graded(points=1, part="even vertices")
@@ -112,6 +120,7 @@ def test_tetrahedron_even_rows(lab):
             lab.loop_even_matrix(TET_V, TET_F, weights),
             expected,
             "S_even",
+            mesh=(TET_V, TET_F),
         )
 
 
@@ -154,11 +163,16 @@ def test_one_triangle_boundary_rows(lab):
         lab.loop_odd_matrix(TRIANGLE_V, TRIANGLE_F),
         [[0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]],  # edges (0,1), (0,2), (1,2)
         "S_odd",
+        mesh=(TRIANGLE_V, TRIANGLE_F),
     )
     expected = np.full((3, 3), 1 / 8)
     np.fill_diagonal(expected, 3 / 4)
     expect_matrix(
-        "loop_even_matrix on one triangle", lab.loop_even_matrix(TRIANGLE_V, TRIANGLE_F, "loop"), expected, "S_even"
+        "loop_even_matrix on one triangle",
+        lab.loop_even_matrix(TRIANGLE_V, TRIANGLE_F, "loop"),
+        expected,
+        "S_even",
+        mesh=(TRIANGLE_V, TRIANGLE_F),
     )
 
 
@@ -167,13 +181,16 @@ def test_square_interior_edge_between_boundary_vertices(lab):
     """square split along 0-2: the interior edge keeps the 3/8-1/8 rule; vertex 0 ignores its interior neighbour 2"""
     # Edges (0,1), (0,2), (0,3), (1,2), (2,3). Only (0,2) is interior (opposite vertices 1 and 3).
     odd = [[0.5, 0.5, 0, 0], [3 / 8, 1 / 8, 3 / 8, 1 / 8], [0.5, 0, 0, 0.5], [0, 0.5, 0.5, 0], [0, 0, 0.5, 0.5]]
-    expect_matrix("loop_odd_matrix on the split square", lab.loop_odd_matrix(SQUARE_V, SQUARE_F), odd, "S_odd")
+    S = lab.loop_odd_matrix(SQUARE_V, SQUARE_F)
+    expect_matrix("loop_odd_matrix on the split square", S, odd, "S_odd", mesh=(SQUARE_V, SQUARE_F))
     # Every vertex is on the boundary: 3/4 on itself, 1/8 on its two boundary neighbours only.
     # Vertex 0's boundary neighbours are 1 and 3; vertex 2 is a neighbour too, but across the interior edge.
     even = [[3 / 4, 1 / 8, 0, 1 / 8], [1 / 8, 3 / 4, 1 / 8, 0], [0, 1 / 8, 3 / 4, 1 / 8], [1 / 8, 0, 1 / 8, 3 / 4]]
     for weights in ("warren", "loop"):
         S = lab.loop_even_matrix(SQUARE_V, SQUARE_F, weights)
-        expect_matrix(f"loop_even_matrix on the split square ({weights!r})", S, even, "S_even")
+        expect_matrix(
+            f"loop_even_matrix on the split square ({weights!r})", S, even, "S_even", mesh=(SQUARE_V, SQUARE_F)
+        )
 
 
 @graded(points=1, part="boundary rules")
@@ -183,7 +200,12 @@ def test_one_quad_boundary_points(lab):
     EP = lab.cc_edge_points(QUAD_V, QUAD_F, fp)
     # edges (0,1), (0,3), (1,2), (2,3)
     expect_close(
-        "cc_edge_points on one quad", EP, [[1, 0, 0], [0, 1, 0], [2, 1, 0], [1, 2, 0]], atol=1e-12, name="edge points"
+        "cc_edge_points on one quad",
+        EP,
+        [[1, 0, 0], [0, 1, 0], [2, 1, 0], [1, 2, 0]],
+        atol=1e-12,
+        name="edge points",
+        mesh=(QUAD_V, QUAD_F),
     )
     VP = lab.cc_vertex_points(QUAD_V, QUAD_F, fp)
     # vertex 0 = (0,0): 1/8 ((2,0) + (0,2)) = (0.25, 0.25); the others by symmetry
@@ -193,6 +215,7 @@ def test_one_quad_boundary_points(lab):
         [[0.25, 0.25, 0], [1.75, 0.25, 0], [1.75, 1.75, 0], [0.25, 1.75, 0]],
         atol=1e-12,
         name="vertex points",
+        mesh=(QUAD_V, QUAD_F),
     )
 
 
@@ -205,7 +228,7 @@ def test_levels_zero_is_identity(lab):
     """levels=0 returns the input mesh unchanged"""
     V, F = datasets.icosphere(1)
     V0, F0 = lab.loop_subdivide(V, F, 0)
-    expect_close("loop_subdivide(levels=0) vertices", V0, V, atol=0.0, name="V")
+    expect_close("loop_subdivide(levels=0) vertices", V0, V, atol=0.0, name="V", mesh=(V, F))
     expect_close("loop_subdivide(levels=0) faces", F0, F, atol=0.0, name="F")
 
 
@@ -224,8 +247,8 @@ def test_subdivision_matrix_identity(lab):
     S = as_dense(S, "S")
     if S.shape != (n2, len(V)):
         raise Mismatch(f"loop_subdivide(..., return_matrix=True): S has shape {S.shape}, expected ({n2}, {len(V)})")
-    expect_close("S @ V (return_matrix=True)", S @ V, V2, atol=1e-10, name="S @ V")
-    expect_close("row sums of S", S.sum(axis=1), np.ones(n2), atol=1e-10, name="row sums")
+    expect_close("S @ V (return_matrix=True)", S @ V, V2, atol=1e-10, name="S @ V", mesh=(V2, F2))
+    expect_close("row sums of S", S.sum(axis=1), np.ones(n2), atol=1e-10, name="row sums", mesh=(V2, F2))
 
 
 @graded(points=1, part="several levels")
@@ -240,6 +263,7 @@ def test_planar_mesh_stays_planar(lab):
             np.zeros(len(V3)),
             atol=1e-12,
             name="z",
+            mesh=(V3, F3),
         )
 
 
@@ -268,17 +292,19 @@ def test_cube_by_hand(lab):
     """unit cube [-1/2, 1/2]^3: face points = face centres, edge points at 3/8, corner vertex points at 5/18"""
     V, Q = datasets.quad_cube()
     FP = lab.cc_face_points(V, Q)
-    expect_close("cc_face_points(cube)", FP, centroids(V, Q), atol=1e-12, name="face points")
+    expect_close("cc_face_points(cube)", FP, centroids(V, Q), atol=1e-12, name="face points", mesh=(V, Q))
     # Edge (0, 1) runs along x at y = z = -1/2 between the faces y = -1/2 and z = -1/2:
     # ((-1/2,-1/2,-1/2) + (1/2,-1/2,-1/2) + (0,-1/2,0) + (0,0,-1/2)) / 4 = (0, -3/8, -3/8).
     E = topology.unique_edges(Q)
     EP = np.asarray(lab.cc_edge_points(V, Q, centroids(V, Q)))
     i = int(np.flatnonzero((E == [0, 1]).all(axis=1))[0])
-    expect_close("cc_edge_points(cube), edge (0, 1)", EP[i], [0, -3 / 8, -3 / 8], atol=1e-12, name="edge point")
+    expect_close(
+        "cc_edge_points(cube), edge (0, 1)", EP[i], [0, -3 / 8, -3 / 8], atol=1e-12, name="edge point", mesh=(V, Q)
+    )
     # Corner -1/2 (1,1,1), valence 3: Q = mean face centre = -1/6 (1,1,1), R = mean edge midpoint
     # = -1/3 (1,1,1); (Q + 2R + 0 P) / 3 = -5/18 (1,1,1). All corners by symmetry: 5/9 of P.
     VP = lab.cc_vertex_points(V, Q, centroids(V, Q))
-    expect_close("cc_vertex_points(cube)", VP, V * (5 / 9), atol=1e-12, name="vertex points")
+    expect_close("cc_vertex_points(cube)", VP, V * (5 / 9), atol=1e-12, name="vertex points", mesh=(V, Q))
 
 
 @graded(points=2, part="catmull-clark points")
@@ -305,9 +331,11 @@ def test_regular_torus_is_bicubic_bspline(lab):
 
     d, _ = cKDTree(V1).query(expected)
     if d.max() > 1e-10:
+        missing = expected[d > 1e-10]
         raise Mismatch(
-            f"catmull_clark(quad torus): {int((d > 1e-10).sum())} of {len(expected)} B-spline points have no matching "
-            f"vertex (worst off by {d.max():.3g}) — check the edge and vertex point rules on regular quads"
+            f"catmull_clark(quad torus): {len(missing)} of {len(expected)} B-spline points have no matching "
+            f"vertex (worst off by {d.max():.3g}) — check the edge and vertex point rules on regular quads",
+            marked_picture("catmull_clark(quad torus)", V1, Q1, missing, "B-spline points with no matching vertex"),
         )
 
 
@@ -335,7 +363,10 @@ def test_regular_tetrahedron_by_hand(lab):
     if d.max() > 1e-12:
         i = int(np.argmax(d))
         raise Mismatch(
-            f"catmull_clark(tetrahedron): expected a vertex at {np.round(expected[i], 6).tolist()}, nearest is {np.round(V1[j[i]], 6).tolist()}"
+            f"catmull_clark(tetrahedron): expected a vertex at {np.round(expected[i], 6).tolist()}, nearest is {np.round(V1[j[i]], 6).tolist()}",
+            marked_picture(
+                "catmull_clark(tetrahedron)", V1, Q1, expected[d > 1e-12], "expected vertices with no match"
+            ),
         )
     Q1 = np.asarray(Q1)
     if Q1.shape != (12, 4):

@@ -105,7 +105,7 @@ def test_flat_square_maps_to_itself(lab):
     for method in ("harmonic", "tutte"):
         UV = lab.parameterize_square(V, F, method=method)
         # The identity is harmonic for any weights and matches the arc-length boundary.
-        expect_close(f"parameterize_square({method}) on a flat unit square", UV, V[:, :2], atol=1e-10)
+        expect_close(f"parameterize_square({method}) on a flat unit square", UV, V[:, :2], atol=1e-10, mesh=(V, F))
 
 
 @graded(points=1, part="parameterization")
@@ -164,9 +164,17 @@ def test_sampling_a_tilted_plane(lab):
         np.c_[X, 0.3 * X[:, 0] - 0.2 * X[:, 1]],
         atol=1e-12,
         hint="P = sum of barycentric weights times the 3-D corners of the uv triangle that contains the point",
+        mesh=(V, F),
     )
     P = lab.sample_surface(V, F, V[:, :2], V[:, :2])
-    expect_close("sample_surface at the vertices' own uv", P, V, atol=1e-12, hint="a vertex's uv must give the vertex")
+    expect_close(
+        "sample_surface at the vertices' own uv",
+        P,
+        V,
+        atol=1e-12,
+        hint="a vertex's uv must give the vertex",
+        mesh=(V, F),
+    )
 
 
 @graded(points=1, part="sampling")
@@ -224,23 +232,20 @@ def test_naive_vdm_of_a_flat_square_is_zero(lab):
 def test_importance_by_hand(lab):
     """a 90 degree fold gives 0.5 on the fold vertices, a 180 degree fold 1, flat 0"""
     V = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]
+    F = [[0, 1, 2], [1, 0, 3]]
     # faces (0,1,2) and (1,0,3): unit normals (0,0,1) and (0,1,0), n1.n2 = 0: 0.5 - 0.5 * 0 = 0.5.
     expect_close(
-        "vertex_importance of a 90 degree fold",
-        lab.vertex_importance(V, [[0, 1, 2], [1, 0, 3]]),
-        [0.5, 0.5, 0, 0],
-        atol=1e-12,
+        "vertex_importance of a 90 degree fold", lab.vertex_importance(V, F), [0.5, 0.5, 0, 0], atol=1e-12, mesh=(V, F)
     )
     V2 = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.5, 1, 0]]
     # (0,1,2) and (1,0,3) lie in one plane with opposite normals: 0.5 - 0.5 * (-1) = 1.
     expect_close(
-        "vertex_importance of a folded-over pair",
-        lab.vertex_importance(V2, [[0, 1, 2], [1, 0, 3]]),
-        [1, 1, 0, 0],
-        atol=1e-12,
+        "vertex_importance of a folded-over pair", lab.vertex_importance(V2, F), [1, 1, 0, 0], atol=1e-12, mesh=(V2, F)
     )
     Vg, Fg = datasets.grid_patch(3)
-    expect_close("vertex_importance of a flat grid", lab.vertex_importance(Vg, Fg), np.zeros(len(Vg)), atol=1e-12)
+    expect_close(
+        "vertex_importance of a flat grid", lab.vertex_importance(Vg, Fg), np.zeros(len(Vg)), atol=1e-12, mesh=(Vg, Fg)
+    )
 
 
 @graded(points=1, part="importance")
@@ -256,6 +261,7 @@ def test_importance_of_the_box(lab):
         imp[on_crease | foot],
         np.full((on_crease | foot).sum(), 0.5),
         atol=1e-12,
+        mesh=(V, F, on_crease | foot),
     )
     expect_close(
         "vertex_importance on flat parts",
@@ -263,6 +269,7 @@ def test_importance_of_the_box(lab):
         np.zeros((~(on_crease | foot)).sum()),
         atol=1e-12,
         hint="boundary edges have only one face and do not count",
+        mesh=(V, F, ~(on_crease | foot)),
     )
 
 
