@@ -31,6 +31,21 @@ def _relpath(p) -> str:
         return str(p)
 
 
+#: Pictures drawn so far in this process (see :func:`_picture_allowed`).
+_DRAWN = [0]
+
+
+def _picture_allowed() -> bool:
+    """False when pictures are switched off (``GEOMLIB_NO_FEEDBACK_PICTURES`` set) or when this run has
+    drawn ``GEOMLIB_MAX_FEEDBACK_PICTURES`` already. The autograder sets a cap: a student needs a picture
+    of the first failures of each task, and every picture costs seconds of the run and ~0.2 MB of
+    results.json."""
+    if os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        return False
+    cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
+    return not cap.isdigit() or _DRAWN[0] < int(cap)
+
+
 def _drawn_in_time(path, draw) -> str | None:
     """Run ``draw()`` (which writes ``path``) in a forked child, stopped after
     :data:`~geomlib.grading.tolerances.PICTURE_TIME_S` or the rest of the run's time budget."""
@@ -38,6 +53,8 @@ def _drawn_in_time(path, draw) -> str | None:
 
     from geomlib.grading import sandbox, tolerances
 
+    if not _picture_allowed():
+        return None
     limit = tolerances.PICTURE_TIME_S
     left = sandbox.remaining_time()
     if left is not None:
@@ -56,7 +73,10 @@ def _drawn_in_time(path, draw) -> str | None:
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
         if done:
-            return _relpath(path) if os.waitstatus_to_exitcode(status) == 0 and os.path.exists(path) else None
+            if os.waitstatus_to_exitcode(status) != 0 or not os.path.exists(path):
+                return None
+            _DRAWN[0] += 1
+            return _relpath(path)
         if time.monotonic() > deadline:
             os.kill(pid, 9)
             os.waitpid(pid, 0)

@@ -82,3 +82,27 @@ def test_a_missing_or_huge_picture_is_not_embedded(tmp_path):
     noise = np.random.default_rng(0).integers(0, 256, (900, 900, 3), dtype=np.uint8)  # incompressible
     Image.fromarray(noise).save(tmp_path / "noise.png")
     assert results.embedded_picture(tmp_path / "noise.png") is None
+
+
+def test_the_picture_cap_stops_drawing_after_n_pictures(tmp_path, monkeypatch):
+    """The autograder caps pictures per run (GEOMLIB_MAX_FEEDBACK_PICTURES): the first failures get one, the
+    rest keep their message without one; GEOMLIB_NO_FEEDBACK_PICTURES switches every kind off."""
+    from geomlib.grading import feedback
+
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.setenv("GEOMLIB_MAX_FEEDBACK_PICTURES", "2")
+    monkeypatch.setattr(feedback, "_DRAWN", [0])
+    expected = np.zeros((16, 16, 3))
+    got = expected + 0.5
+
+    def draw(i):
+        ctx = checks.Context(label="shade", lab="maps", case_id=f"quad{i}", feedback_dir=tmp_path)
+        return feedback.image_picture(ctx, expected, got, np.full((16, 16), 0.5))
+
+    drawn = [draw(i) for i in range(3)]
+    assert drawn[0] and drawn[1] and drawn[2] is None
+    assert sorted(p.name for p in (tmp_path / "maps").glob("*.png")) == ["quad0.png", "quad1.png"]
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES")
+    assert draw(3) is not None
+    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
+    assert draw(4) is None

@@ -148,6 +148,28 @@ def test_solutions_score_every_point(autograder, points):
     assert any(t["visibility"] == "hidden" for t in r["tests"])
 
 
+def test_a_wrong_weight_gets_feedback_pictures_inlined_up_to_the_cap(autograder, points):
+    """A wrong odd-vertex weight (Task 1): the failing tests name it, the first few carry their feedback
+    picture inside results.json (Gradescope serves no files), and the cap keeps the file small."""
+
+    def fill(sub):
+        lab = sub / "labs" / LAB
+        shutil.copytree(ROOT / "solutions" / LAB, lab)
+        src = (lab / "loop.py").read_text()
+        wrong = src.replace("np.tile([3 / 8, 3 / 8, 1 / 8, 1 / 8]", "np.tile([3 / 8, 3 / 8, 1 / 7, 1 / 8]")
+        assert wrong != src, "the planted line is gone from the solution: update this test"
+        (lab / "loop.py").write_text(wrong)
+
+    r, _ = _run(autograder, fill)
+    failed = [t for t in r["tests"] if t["status"] == "failed"]
+    assert failed and r["score"] < sum(p + h for p, h in points.values())
+    pictured = [t for t in failed if t.get("output_format") == "html"]
+    assert 1 <= len(pictured) <= 8, len(pictured)  # run_autograder's GEOMLIB_MAX_FEEDBACK_PICTURES
+    assert all("data:image/png;base64," in t["output"] for t in pictured)
+    size = (autograder / "results" / "results.json").stat().st_size
+    assert size < 8 * 450_000, size
+
+
 def test_stubs_score_zero(autograder):
     # Submitted as the bare lab folder (no labs/ around it): both layouts are accepted.
     r, _ = _run(autograder, lambda sub: shutil.copytree(ROOT / "labs" / LAB, sub / LAB))
