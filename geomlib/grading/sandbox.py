@@ -16,7 +16,7 @@ Protection levels (reported by :func:`status`):
 
 - root with ``GEOMLIB_SANDBOX_USER`` (Gradescope): student code runs as that user; hidden cases and
   references are made readable by root only; with Landlock also nothing outside Python, geomlib,
-  the stubs and its own lab is readable and nothing but a scratch folder writable;
+  the stubs and its own lab is readable and nothing but a scratch folder and the run's numba cache writable;
 - any user with Landlock (``geomlib grade`` / ``grade-all`` by an instructor): the same file-system
   confinement, no TCP, no signals to the grader;
 - neither: only the process isolation (fresh zygote, closed descriptors, limits, killed
@@ -212,13 +212,20 @@ class _Zygote:
             self.user = None  # only root can switch users; say so in status()
         self.scratch_root = Path(tempfile.mkdtemp(prefix="geomlib-sandbox-"))
         self.scratch_root.chmod(0o711)
+        # One numba cache for every worker of this run (NUMBA_CACHE_DIR in the worker, see
+        # geomlib.jit): the first call compiles a lab's kernels, later calls load them. Each call's
+        # own scratch folder would make every call compile again (seconds per call). Workers run
+        # the same submission, so what one writes there can only change that submission's calls.
+        self.jit_cache = self.scratch_root / "numba-cache"
+        self.jit_cache.mkdir(mode=0o700)
         self.snapshots: dict[str, Path] = {}
         self.problems: list[str] = []
         if self.user:
             try:
                 import pwd
 
-                pwd.getpwnam(self.user)
+                pw = pwd.getpwnam(self.user)
+                os.chown(self.jit_cache, pw.pw_uid, pw.pw_gid)
             except KeyError:
                 self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
             _protect_hidden()
@@ -299,7 +306,8 @@ class _Zygote:
         out_fd, out_path = tempfile.mkstemp(prefix="geomlib-out-", dir=self.scratch_root)
         scratch = tempfile.mkdtemp(prefix="call-", dir=self.scratch_root)
         os.chmod(scratch, 0o700)
-        req = {**req, "scratch": scratch, "write": [scratch, os.devnull]}
+        jit = str(self.jit_cache)
+        req = {**req, "scratch": scratch, "jit_cache": jit, "write": [scratch, jit, os.devnull]}
         pid = None
         try:
             try:

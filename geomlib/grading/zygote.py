@@ -13,7 +13,7 @@ For each request the zygote forks a worker that
    number of processes;
 3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``);
 4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
-   and its own lab, write only a private scratch folder, and neither open TCP connections nor signal
+   and its own lab, write only a private scratch folder (and the run's shared numba cache), and neither open TCP connections nor signal
    processes outside its sandbox.
 
 The zygote is a child subreaper: anything the student's code started and detached is re-parented
@@ -194,6 +194,8 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
         resource.setrlimit(resource.RLIMIT_NPROC, (n, n))
     if scratch:
         os.environ["TMPDIR"] = scratch
+    if req.get("jit_cache"):
+        os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the run's workers (geomlib.jit)
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
     os.chdir(req.get("cwd") or "/")

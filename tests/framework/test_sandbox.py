@@ -229,3 +229,37 @@ def test_read_error_says_what_the_probe_cannot_read(tmp_path):
     assert _read_error(str(tmp_path)) is None  # a folder counts as readable when it can be listed
     missing = _read_error(str(tmp_path / "missing"))
     assert isinstance(missing, FileNotFoundError) and missing.strerror
+
+
+KERNELS = """
+from numba import njit
+
+from geomlib.jit import use_cache_folder
+
+use_cache_folder(__name__, __file__)
+
+
+@njit(cache=True)
+def _double(x):
+    return 2.0 * x
+
+
+def double(x):
+    y = _double(x)
+    return y, sum(_double.stats.cache_hits.values()), sum(_double.stats.cache_misses.values())
+"""
+
+
+def test_compiled_kernels_are_compiled_by_the_first_worker_only(tmp_path):
+    """Every call runs in a fresh worker that may not write its lab folder: the run's workers share one
+    numba cache, so only the first call compiles and the next ones load the machine code."""
+    d = tmp_path / "jitlab"
+    d.mkdir()
+    (d / "__init__.py").write_text("from .kernels import double\n")
+    (d / "kernels.py").write_text(KERNELS)
+    lab = LabProxy("jitlab", d, timeout=120)
+    y, hits, misses = lab.double(1.5)
+    assert y == 3.0 and (hits, misses) == (0, 1)
+    for _ in range(2):
+        y, hits, misses = lab.double(2.5)
+        assert y == 5.0 and (hits, misses) == (1, 0), "a later worker compiled the kernel again"
