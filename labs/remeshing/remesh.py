@@ -11,6 +11,7 @@ M. Botsch, L. Kobbelt, "A remeshing approach to multiresolution modeling", SGP 2
 
 from __future__ import annotations
 
+import igl
 import numpy as np
 
 from geomlib import topology
@@ -83,6 +84,10 @@ class RemeshState:
         self.VH = np.r_[self.VH, np.full(nv, -1, np.int64)]
         self.val = np.r_[self.val, np.zeros(nv, np.int64)]
         self.cls = np.r_[self.cls, np.zeros(nv, np.int64)]
+
+    def compact(self):
+        """Drop dead faces and vertices from the rows the passes visit (:func:`.kernels.compact`)."""
+        K.compact(*_args(self))
 
     def faces(self) -> np.ndarray:
         """Live faces (vertex indices of the state, removed vertices unused)."""
@@ -413,6 +418,25 @@ def _closest_on_segments(P, A, B, chunk=2048):
     return out
 
 
+class SurfaceProjector:
+    """Closest points on a fixed surface ``(V0, F0)``, its AABB tree built once (given).
+
+    :func:`geomlib.geometry.closest_points` builds libigl's tree at every call; the loop projects
+    onto the same input tens of times, and building the tree costs about four queries.
+    """
+
+    def __init__(self, V0, F0):
+        self.V0 = np.ascontiguousarray(V0, np.float64)
+        self.F0 = np.ascontiguousarray(F0, np.int64)
+        self.tree = igl.AABB()
+        self.tree.init(self.V0, self.F0)
+
+    def __call__(self, P) -> np.ndarray:
+        if len(P) == 0:
+            return np.zeros((0, 3))
+        return np.asarray(self.tree.squared_distance(self.V0, self.F0, np.ascontiguousarray(P, np.float64))[2])
+
+
 def project_to_surface(P, V0, F0):
     """Closest point of every row of ``P`` on the input surface ``(V0, F0)`` (stage 5).
 
@@ -430,13 +454,15 @@ def project_to_surface(P, V0, F0):
 # the loop
 
 
-def isotropic_remesh(V, F, target_length, *, iterations=10, feature_angle=None, preserve_boundary=True, damping=0.5):
+def isotropic_remesh(
+    V, F, target_length, *, iterations=10, feature_angle=None, preserve_boundary=True, damping=0.5, relax_steps=3
+):
     """Remesh a triangle mesh toward equilateral triangles with edges of about ``target_length``.
 
     Each iteration: split edges longer than ``4/3 L``; collapse edges shorter than ``4/5 L``;
-    flip edges to bring valences toward 6 (4 on the boundary); tangential relaxation; projection
-    of the vertices back onto the input (feature-line and boundary vertices onto the input's
-    lines, the others onto its surface).
+    flip edges to bring valences toward 6 (4 on the boundary); ``relax_steps`` steps of tangential
+    relaxation; projection of the vertices back onto the input (feature-line and boundary vertices
+    onto the input's lines, the others onto its surface).
 
     Parameters
     ----------
@@ -450,6 +476,12 @@ def isotropic_remesh(V, F, target_length, *, iterations=10, feature_angle=None, 
         Edges whose dihedral angle exceeds it (degrees) are kept as feature lines.
     preserve_boundary : bool
         Keep the boundary on the input boundary (boundary vertices slide along it).
+    damping : float
+        ``λ`` of the relaxation, in [0, 1].
+    relax_steps : int
+        Relaxation steps per iteration. One damped step does not undo the distortion that the
+        iteration's splits, collapses and flips leave (the last iteration's would stay in the
+        result); three do, at the cost of two more relaxations (the projection runs once).
 
     Returns
     -------
@@ -460,5 +492,6 @@ def isotropic_remesh(V, F, target_length, *, iterations=10, feature_angle=None, 
     L = _positive(target_length, "target_length", where)
     its = check_int(iterations, "iterations", where=where, minimum=0)
     lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
+    steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
     raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat')
