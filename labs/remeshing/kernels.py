@@ -141,7 +141,7 @@ def length(V, F, h):
 
 
 @njit(cache=True)
-def compact(V, F, T, VH, val, cls, feat, falive, cnt):
+def compact(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
     """Move the live faces and used vertices to the front, in order, and renumber (given).
 
     Collapses only mark faces and vertices dead; the passes visit every row, so the loop compacts
@@ -178,6 +178,8 @@ def compact(V, F, T, VH, val, cls, feat, falive, cnt):
         VH[w] = 3 * fmap[h // 3] + h % 3
         val[w] = val[v]
         cls[w] = cls[v]
+        high[w] = high[v]
+        low[w] = low[v]
     falive[:k] = True
     falive[k:nf] = False
     T[3 * k : 3 * nf] = -1
@@ -230,8 +232,12 @@ def flip(V, F, T, VH, val, feat, h):
 
 
 @njit(cache=True)
-def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
-    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low, start, stop):
+    """Split at its midpoint every edge longer than its bound among half-edges ``start..stop-1``.
+
+    ``high``, ``low`` (one per vertex row) are the split and collapse bounds of every vertex; an
+    edge's bound is the smaller of its two ends' (a uniform target length fills them with one
+    value). The new vertex takes the mean of its ends' bounds.
 
     Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
     same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
@@ -241,8 +247,12 @@ def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
 
 
 @njit(cache=True)
-def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
-    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Collapse edges shorter than their bound unless that breaks a rule; returns the number of collapses.
+
+    ``high``, ``low`` as in :func:`split_pass`: an edge is short below the smaller ``low`` of its
+    ends, and the collapse may not create an edge longer than the smaller ``high`` of its ends.
+    """
     raise NotImplementedError('Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint (else an end) otherwise')
 
 

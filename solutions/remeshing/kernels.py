@@ -141,7 +141,7 @@ def length(V, F, h):
 
 
 @njit(cache=True)
-def compact(V, F, T, VH, val, cls, feat, falive, cnt):
+def compact(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
     """Move the live faces and used vertices to the front, in order, and renumber (given).
 
     Collapses only mark faces and vertices dead; the passes visit every row, so the loop compacts
@@ -178,6 +178,8 @@ def compact(V, F, T, VH, val, cls, feat, falive, cnt):
         VH[w] = 3 * fmap[h // 3] + h % 3
         val[w] = val[v]
         cls[w] = cls[v]
+        high[w] = high[v]
+        low[w] = low[v]
     falive[:k] = True
     falive[k:nf] = False
     T[3 * k : 3 * nf] = -1
@@ -428,8 +430,12 @@ def flip(V, F, T, VH, val, feat, h):
 
 
 @njit(cache=True)
-def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
-    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low, start, stop):
+    """Split at its midpoint every edge longer than its bound among half-edges ``start..stop-1``.
+
+    ``high``, ``low`` (one per vertex row) are the split and collapse bounds of every vertex; an
+    edge's bound is the smaller of its two ends' (a uniform target length fills them with one
+    value). The new vertex takes the mean of its ends' bounds.
 
     Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
     same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
@@ -438,30 +444,43 @@ def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
     # BEGIN SOLUTION: Task 4 (split long edges): every edge with |e| > 4/3 L at its midpoint, one pass over the edges present at the start
     done = 0
     for h in range(start, stop):
-        if falive[h // 3] and (T[h] < 0 or h < T[h]) and length(V, F, h) > high:
-            p = 0.5 * (V[org(F, h)] + V[dst(F, h)])
+        if not falive[h // 3] or (T[h] >= 0 and h > T[h]):
+            continue
+        a, b = org(F, h), dst(F, h)
+        if length(V, F, h) > min(high[a], high[b]):
+            p = 0.5 * (V[a] + V[b])
             if split(V, F, T, VH, val, cls, feat, falive, cnt, h, p) == FULL:
                 return done, h
+            m = cnt[0] - 1
+            high[m] = 0.5 * (high[a] + high[b])
+            low[m] = 0.5 * (low[a] + low[b])
             done += 1
     return done, stop
     # END SOLUTION
 
 
 @njit(cache=True)
-def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
-    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Collapse edges shorter than their bound unless that breaks a rule; returns the number of collapses.
+
+    ``high``, ``low`` as in :func:`split_pass`: an edge is short below the smaller ``low`` of its
+    ends, and the collapse may not create an edge longer than the smaller ``high`` of its ends.
+    """
     # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint (else an end) otherwise
     hes = np.empty(RING, np.int64)
     nb1 = np.empty(RING, np.int64)
     nb2 = np.empty(RING, np.int64)
     done = 0
     for h in range(3 * cnt[1]):
-        if not falive[h // 3] or length(V, F, h) >= low:
+        if not falive[h // 3]:
+            continue
+        a, b = org(F, h), dst(F, h)
+        lo, hi = min(low[a], low[b]), min(high[a], high[b])
+        if length(V, F, h) >= lo:
             continue
         t = T[h]
         if t >= 0 and t < h and falive[t // 3]:
             continue  # each edge once (from its lower half-edge)
-        a, b = org(F, h), dst(F, h)
         hh = h
         if cls[b] > cls[a]:  # keep the more constrained end
             if t < 0:
@@ -475,13 +494,13 @@ def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
         # two free ends meet at the midpoint; a very short edge (a needle, seen on thin ridges), when
         # the midpoint is refused, at one of its ends; a constrained end stays
         free = cls[a] == 0 and cls[b] == 0
-        tries = 3 if free and length(V, F, h) < 0.625 * low else 1
+        tries = 3 if free and length(V, F, h) < 0.625 * lo else 1
         for k in range(tries):
             if free and k == 0:
                 p = 0.5 * (V[a] + V[b])
             else:
                 p = (V[b] if k == 2 else V[a]).copy()
-            if collapse_check(V, F, T, VH, val, cls, feat, hh, p, high, hes, nb1, nb2) == OK:
+            if collapse_check(V, F, T, VH, val, cls, feat, hh, p, hi, hes, nb1, nb2) == OK:
                 collapse(V, F, T, VH, val, cls, feat, falive, hh, p, hes)
                 done += 1
                 break
