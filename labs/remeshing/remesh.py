@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import igl
 import numpy as np
+from scipy.spatial import cKDTree
 
 from geomlib import topology
 from geomlib.errors import MeshError
@@ -385,7 +386,10 @@ def _line_tangents(V, E_feat, n):
     outer = d[:, :, None] * d[:, None, :]
     np.add.at(M, E_feat[:, 0], outer)
     np.add.at(M, E_feat[:, 1], outer)
-    return np.linalg.eigh(M)[1][:, :, 2]
+    t = np.zeros((n, 3))
+    on = np.unique(E_feat)  # only the line's vertices have a direction
+    t[on] = np.linalg.eigh(M[on])[1][:, :, 2]
+    return t
 
 
 def _relax(V, F, cls, E_feat, damping):
@@ -413,18 +417,38 @@ def tangential_relaxation(V, F, *, damping=0.5, feature_edges=None, preserve_bou
     return _relax(V, F, S.cls[: len(V)], _state_feature_edges(S), lam)
 
 
-def _closest_on_segments(P, A, B, chunk=2048):
-    """Closest point of every row of ``P`` on the segments ``A[i]B[i]`` (brute force in chunks)."""
+def _closest_on_segments(P, A, B, k=8, chunk=2048):
+    """Closest point of every row of ``P`` on the segments ``A[i]B[i]``.
+
+    The ``k`` segments with the nearest midpoints (a k-d tree) are measured exactly; the answer is
+    certain when the ``k``-th nearest midpoint is farther than the best distance plus the longest
+    half segment (no other segment can come closer). The other rows are measured against every
+    segment, in chunks.
+    """
     out = np.empty_like(P)
+    if len(P) == 0:
+        return out
     AB = B - A
     L2 = np.maximum(np.einsum("ij,ij->i", AB, AB), 1e-300)
-    step = max(1, chunk * 256 // max(len(A), 1))
-    for s in range(0, len(P), step):
-        Q = P[s : s + step]
-        t = np.clip(np.einsum("qij,ij->qi", Q[:, None, :] - A[None], AB) / L2, 0.0, 1.0)
-        X = A[None] + t[:, :, None] * AB[None]
+
+    def nearest_of(Q, S):  # S (q, s) candidate segments per row
+        t = np.clip(np.einsum("qsj,qsj->qs", Q[:, None, :] - A[S], AB[S]) / L2[S], 0.0, 1.0)
+        X = A[S] + t[:, :, None] * AB[S]
         d = ((X - Q[:, None, :]) ** 2).sum(axis=2)
-        out[s : s + step] = X[np.arange(len(Q)), d.argmin(axis=1)]
+        j = d.argmin(axis=1)
+        r = np.arange(len(Q))
+        return X[r, j], np.sqrt(d[r, j])
+
+    k = min(k, len(A))
+    dmid, S = cKDTree(0.5 * (A + B)).query(P, k)
+    S, dmid = S.reshape(len(P), k), dmid.reshape(len(P), k)
+    out[:], best = nearest_of(P, S)
+    unsure = np.flatnonzero(dmid[:, -1] <= best + 0.5 * np.sqrt(L2.max())) if k < len(A) else []
+    step = max(1, chunk * 256 // len(A))
+    everything = np.arange(len(A))
+    for s in range(0, len(unsure), step):
+        rows = unsure[s : s + step]
+        out[rows] = nearest_of(P[rows], np.broadcast_to(everything, (len(rows), len(A))))[0]
     return out
 
 
