@@ -563,12 +563,11 @@ def max_curvature(V, F):
     theta = np.empty(F.shape)
     cot = np.empty(F.shape)
     for k in range(3):  # corner k of every face: angle between its two edges
-        a = V[F[:, (k + 1) % 3]] - V[F[:, k]]
-        b = V[F[:, (k + 2) % 3]] - V[F[:, k]]
-        cos = np.einsum("ij,ij->i", a, b)
-        sin = np.linalg.norm(np.cross(a, b), axis=1)
-        theta[:, k] = np.arctan2(sin, cos)
-        cot[:, k] = cos / np.maximum(sin, 1e-300)
+        u, w = V[np.roll(F, -1, axis=1)[:, k]] - V[F[:, k]], V[np.roll(F, -2, axis=1)[:, k]] - V[F[:, k]]
+        cos_k = (u * w).sum(axis=1)
+        sin_k = np.linalg.norm(np.cross(u, w), axis=1)
+        theta[:, k] = np.arctan2(sin_k, cos_k)
+        cot[:, k] = cos_k / np.maximum(sin_k, 1e-300)
     area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
     A = np.maximum(np.bincount(F.ravel(), np.repeat(area / 3.0, 3), minlength=n), 1e-300)
     lap = np.zeros((n, 3))
@@ -628,9 +627,9 @@ def adaptive_target_length(V, F, target_length, *, error=None, min_length=None, 
     # BEGIN SOLUTION: Task 11 (adaptive target length): smooth κ over 1-rings, h = sqrt(6 ε r − 3 ε²) with r = 1/κ, clamp
     kappa = max_curvature(V, F)
     n = len(V)
-    E = topology.unique_edges(F)
-    rows = np.r_[E[:, 0], E[:, 1], np.arange(n)]
-    cols = np.r_[E[:, 1], E[:, 0], np.arange(n)]
+    ij = topology.unique_edges(F)
+    rows = np.r_[ij[:, 0], ij[:, 1], np.arange(n)]  # closed 1-ring: both directions and the vertex itself
+    cols = np.r_[ij[:, 1], ij[:, 0], np.arange(n)]
     for _ in range(steps):  # mean over the closed 1-ring, known values only
         known = np.isfinite(kappa)
         k0 = np.where(known, kappa, 0.0)

@@ -150,9 +150,9 @@ def adaptive_check(make, *, min_angle, hausdorff, tip_ratio):
             return problem
         V, F = np.asarray(got["V"], float), np.asarray(got["F"])
         q = quality(d["V"], d["F"], V, F)
-        E = topology.unique_edges(F)
-        e = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)
-        x = np.abs(0.5 * (V[E[:, 0], 0] + V[E[:, 1], 0]))
+        ends = topology.unique_edges(F)
+        e = np.linalg.norm(V[ends[:, 0]] - V[ends[:, 1]], axis=1)
+        x = np.abs(V[ends, 0].mean(axis=1))
         tips, waist = e[x > 0.8 * x.max()].mean(), e[x < 0.2 * x.max()].mean()
         if q["min_angle"] < min_angle:
             return f"min_angle = {q['min_angle']:.3g}, needs >= {min_angle:g}"
