@@ -13,7 +13,9 @@ The state (all arrays, edited in place):
 * ``VH (ncap,)`` one outgoing half-edge of every vertex (-1 for a removed vertex);
 * ``val (ncap,)`` valence; ``cls (ncap,)`` 0 free, 1 on a feature line / boundary, 2 corner;
 * ``feat (3 mcap,)`` half-edge on a feature line (boundary included when it is preserved);
-* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows.
+* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows;
+* passed to the split and collapse passes (and :func:`compact`) after these: ``high, low (ncap,)``
+  the split and collapse bounds of every vertex (one value everywhere for a uniform target).
 
 Every kernel is ``@njit(cache=True)`` and also runs as plain Python with ``NUMBA_DISABLE_JIT=1``.
 The passes are loops over edges: the algorithm is inherently sequential (each edit changes what

@@ -368,7 +368,11 @@ def collapse_short_edges(V, F, low, high, *, feature_edges=None, preserve_bounda
 
 
 def equalize_valences(V, F, *, feature_edges=None):
-    """Flip edges while that lowers Σ|valence − target| (target 6 inside, 4 on the boundary) (stage 3)."""
+    """Flip edges while that lowers Σ|valence − target| (target 6 inside, 4 on the boundary) (stage 3).
+
+    On a tie in that sum, a flip that lowers Σ(valence − target)² is made too; a flip whose new faces
+    turn by more than 60° from the old ones is not (see :func:`.kernels.flip_check`).
+    """
     where = "equalize_valences"
     V, F = _stage_input(V, F, feature_edges, where)
     S = make_state(V, F, feature_edges, preserve_boundary=True, where=where)
