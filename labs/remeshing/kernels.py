@@ -13,7 +13,9 @@ The state (all arrays, edited in place):
 * ``VH (ncap,)`` one outgoing half-edge of every vertex (-1 for a removed vertex);
 * ``val (ncap,)`` valence; ``cls (ncap,)`` 0 free, 1 on a feature line / boundary, 2 corner;
 * ``feat (3 mcap,)`` half-edge on a feature line (boundary included when it is preserved);
-* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows.
+* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows;
+* passed to the split and collapse passes (and :func:`compact`) after these: ``high, low (ncap,)``
+  the split and collapse bounds of every vertex (one value everywhere for a uniform target).
 
 Every kernel is ``@njit(cache=True)`` and also runs as plain Python with ``NUMBA_DISABLE_JIT=1``.
 The passes are loops over edges: the algorithm is inherently sequential (each edit changes what
@@ -37,6 +39,9 @@ RING = 256
 
 # result codes of the operations
 OK, LINK, FLIP, LONG, CONSTRAINED, VALENCE, FULL = 0, 1, 2, 3, 4, 5, 6
+#: A flip is refused when a new face's normal turns by more than 60° from either old face's
+#: (cos 60° = 0.5): flipping across a ridge would cut it off the surface (as gpytoolbox's remesher).
+FLIP_COS = 0.5
 
 
 @njit(cache=True)
@@ -91,35 +96,98 @@ def ring(F, T, VH, v, out):
 
 @njit(cache=True)
 def neighbours(F, T, VH, v, hes, out):
-    """Distinct neighbour vertices of ``v``; returns their count (-1: too many)."""
+    """Distinct neighbour vertices of ``v``; returns their count (-1: too many).
+
+    The ends of the outgoing half-edges, plus on an open fan the far end of its last face.
+    """
     n = ring(F, T, VH, v, hes)
-    if n < 0:
+    if n < 0 or n + 1 > len(out):
         return -1
     k = 0
     for i in range(n):
-        for w in (dst(F, hes[i]), org(F, pv(hes[i]))):
-            seen = False
-            for j in range(k):
-                if out[j] == w:
-                    seen = True
-                    break
-            if not seen:
-                if k >= len(out):
-                    return -1
-                out[k] = w
-                k += 1
+        out[k] = dst(F, hes[i])
+        k += 1
+        if T[pv(hes[i])] < 0:  # the face's edge back to v is on the boundary: its start ends the fan
+            out[k] = org(F, pv(hes[i]))
+            k += 1
     return k
 
 
 @njit(cache=True)
-def normal(a, b, c):
-    return np.cross(b - a, c - a)
+def normal(V, i, j, k):
+    """``(V[j] - V[i]) × (V[k] - V[i])`` as a tuple (no array is allocated: the kernels call it a lot)."""
+    return normal_at(V[i, 0], V[i, 1], V[i, 2], V, j, k)
+
+
+@njit(cache=True)
+def normal_at(x, y, z, V, j, k):
+    """``(V[j] - q) × (V[k] - q)`` for the point ``q = (x, y, z)``."""
+    ax, ay, az = V[j, 0] - x, V[j, 1] - y, V[j, 2] - z
+    bx, by, bz = V[k, 0] - x, V[k, 1] - y, V[k, 2] - z
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True)
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def distance(V, i, j):
+    return np.sqrt((V[i, 0] - V[j, 0]) ** 2 + (V[i, 1] - V[j, 1]) ** 2 + (V[i, 2] - V[j, 2]) ** 2)
 
 
 @njit(cache=True)
 def length(V, F, h):
-    d = V[dst(F, h)] - V[org(F, h)]
-    return np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+    return distance(V, org(F, h), dst(F, h))
+
+
+@njit(cache=True)
+def compact(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Move the live faces and used vertices to the front, in order, and renumber (given).
+
+    Collapses only mark faces and vertices dead; the passes visit every row, so the loop compacts
+    once per iteration to keep them visiting live rows only.
+    """
+    nf, nv = cnt[1], cnt[0]
+    fmap = np.full(nf, -1, np.int64)
+    k = 0
+    for f in range(nf):
+        if falive[f]:
+            fmap[f] = k
+            k += 1
+    vmap = np.full(nv, -1, np.int64)
+    j = 0
+    for v in range(nv):
+        if VH[v] >= 0:
+            vmap[v] = j
+            j += 1
+    for f in range(nf):  # targets never pass their sources: in place, in order
+        g = fmap[f]
+        if g < 0:
+            continue
+        for c in range(3):
+            F[g, c] = vmap[F[f, c]]
+            t = T[3 * f + c]
+            T[3 * g + c] = -1 if t < 0 else 3 * fmap[t // 3] + t % 3
+            feat[3 * g + c] = feat[3 * f + c]
+    for v in range(nv):
+        w = vmap[v]
+        if w < 0:
+            continue
+        V[w] = V[v]
+        h = VH[v]
+        VH[w] = 3 * fmap[h // 3] + h % 3
+        val[w] = val[v]
+        cls[w] = cls[v]
+        high[w] = high[v]
+        low[w] = low[v]
+    falive[:k] = True
+    falive[k:nf] = False
+    T[3 * k : 3 * nf] = -1
+    feat[3 * k : 3 * nf] = False
+    VH[j:nv] = -1
+    cnt[0], cnt[1] = j, k
 
 
 @njit(cache=True)
@@ -166,8 +234,12 @@ def flip(V, F, T, VH, val, feat, h):
 
 
 @njit(cache=True)
-def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
-    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low, start, stop):
+    """Split at its midpoint every edge longer than its bound among half-edges ``start..stop-1``.
+
+    ``high``, ``low`` (one per vertex row) are the split and collapse bounds of every vertex; an
+    edge's bound is the smaller of its two ends' (a uniform target length fills them with one
+    value). The new vertex takes the mean of its ends' bounds.
 
     Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
     same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
@@ -177,9 +249,13 @@ def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
 
 
 @njit(cache=True)
-def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
-    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
-    raise NotImplementedError('Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint otherwise')
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Collapse edges shorter than their bound unless that breaks a rule; returns the number of collapses.
+
+    ``high``, ``low`` as in :func:`split_pass`: an edge is short below the smaller ``low`` of its
+    ends, and the collapse may not create an edge longer than the smaller ``high`` of its ends.
+    """
+    raise NotImplementedError('Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint (else an end) otherwise')
 
 
 @njit(cache=True)

@@ -8,17 +8,22 @@ Tasks, in order:
 4-6. the stages :func:`split_long_edges`, :func:`collapse_short_edges`, :func:`equalize_valences`;
 7.   features: :func:`sharp_edges`;
 8-9. :func:`tangential_relaxation`, :func:`project_to_surface`;
-10.  the loop :func:`isotropic_remesh`.
+10.  the loop :func:`isotropic_remesh`;
+11.  extension: :func:`max_curvature`, :func:`adaptive_target_length` (target length per vertex
+     from curvature; ``isotropic_remesh(..., adaptive=True)`` or a per-vertex ``target_length``).
 """
 
 from .remesh import (
     RemeshState,
+    SurfaceProjector,
+    adaptive_target_length,
     collapse_edge,
     collapse_short_edges,
     equalize_valences,
     flip_edge,
     isotropic_remesh,
     make_state,
+    max_curvature,
     project_to_surface,
     sharp_edges,
     split_edge,
@@ -41,4 +46,7 @@ __all__ = [
     "tangential_relaxation",
     "project_to_surface",
     "isotropic_remesh",
+    "max_curvature",
+    "adaptive_target_length",
+    "SurfaceProjector",
 ]

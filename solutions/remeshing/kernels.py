@@ -13,7 +13,9 @@ The state (all arrays, edited in place):
 * ``VH (ncap,)`` one outgoing half-edge of every vertex (-1 for a removed vertex);
 * ``val (ncap,)`` valence; ``cls (ncap,)`` 0 free, 1 on a feature line / boundary, 2 corner;
 * ``feat (3 mcap,)`` half-edge on a feature line (boundary included when it is preserved);
-* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows.
+* ``falive (mcap,)`` live faces; ``cnt = [n_vertices, n_faces]`` used rows;
+* passed to the split and collapse passes (and :func:`compact`) after these: ``high, low (ncap,)``
+  the split and collapse bounds of every vertex (one value everywhere for a uniform target).
 
 Every kernel is ``@njit(cache=True)`` and also runs as plain Python with ``NUMBA_DISABLE_JIT=1``.
 The passes are loops over edges: the algorithm is inherently sequential (each edit changes what
@@ -37,6 +39,9 @@ RING = 256
 
 # result codes of the operations
 OK, LINK, FLIP, LONG, CONSTRAINED, VALENCE, FULL = 0, 1, 2, 3, 4, 5, 6
+#: A flip is refused when a new face's normal turns by more than 60° from either old face's
+#: (cos 60° = 0.5): flipping across a ridge would cut it off the surface (as gpytoolbox's remesher).
+FLIP_COS = 0.5
 
 
 @njit(cache=True)
@@ -91,35 +96,98 @@ def ring(F, T, VH, v, out):
 
 @njit(cache=True)
 def neighbours(F, T, VH, v, hes, out):
-    """Distinct neighbour vertices of ``v``; returns their count (-1: too many)."""
+    """Distinct neighbour vertices of ``v``; returns their count (-1: too many).
+
+    The ends of the outgoing half-edges, plus on an open fan the far end of its last face.
+    """
     n = ring(F, T, VH, v, hes)
-    if n < 0:
+    if n < 0 or n + 1 > len(out):
         return -1
     k = 0
     for i in range(n):
-        for w in (dst(F, hes[i]), org(F, pv(hes[i]))):
-            seen = False
-            for j in range(k):
-                if out[j] == w:
-                    seen = True
-                    break
-            if not seen:
-                if k >= len(out):
-                    return -1
-                out[k] = w
-                k += 1
+        out[k] = dst(F, hes[i])
+        k += 1
+        if T[pv(hes[i])] < 0:  # the face's edge back to v is on the boundary: its start ends the fan
+            out[k] = org(F, pv(hes[i]))
+            k += 1
     return k
 
 
 @njit(cache=True)
-def normal(a, b, c):
-    return np.cross(b - a, c - a)
+def normal(V, i, j, k):
+    """``(V[j] - V[i]) × (V[k] - V[i])`` as a tuple (no array is allocated: the kernels call it a lot)."""
+    return normal_at(V[i, 0], V[i, 1], V[i, 2], V, j, k)
+
+
+@njit(cache=True)
+def normal_at(x, y, z, V, j, k):
+    """``(V[j] - q) × (V[k] - q)`` for the point ``q = (x, y, z)``."""
+    ax, ay, az = V[j, 0] - x, V[j, 1] - y, V[j, 2] - z
+    bx, by, bz = V[k, 0] - x, V[k, 1] - y, V[k, 2] - z
+    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+
+
+@njit(cache=True)
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def distance(V, i, j):
+    return np.sqrt((V[i, 0] - V[j, 0]) ** 2 + (V[i, 1] - V[j, 1]) ** 2 + (V[i, 2] - V[j, 2]) ** 2)
 
 
 @njit(cache=True)
 def length(V, F, h):
-    d = V[dst(F, h)] - V[org(F, h)]
-    return np.sqrt(d[0] ** 2 + d[1] ** 2 + d[2] ** 2)
+    return distance(V, org(F, h), dst(F, h))
+
+
+@njit(cache=True)
+def compact(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Move the live faces and used vertices to the front, in order, and renumber (given).
+
+    Collapses only mark faces and vertices dead; the passes visit every row, so the loop compacts
+    once per iteration to keep them visiting live rows only.
+    """
+    nf, nv = cnt[1], cnt[0]
+    fmap = np.full(nf, -1, np.int64)
+    k = 0
+    for f in range(nf):
+        if falive[f]:
+            fmap[f] = k
+            k += 1
+    vmap = np.full(nv, -1, np.int64)
+    j = 0
+    for v in range(nv):
+        if VH[v] >= 0:
+            vmap[v] = j
+            j += 1
+    for f in range(nf):  # targets never pass their sources: in place, in order
+        g = fmap[f]
+        if g < 0:
+            continue
+        for c in range(3):
+            F[g, c] = vmap[F[f, c]]
+            t = T[3 * f + c]
+            T[3 * g + c] = -1 if t < 0 else 3 * fmap[t // 3] + t % 3
+            feat[3 * g + c] = feat[3 * f + c]
+    for v in range(nv):
+        w = vmap[v]
+        if w < 0:
+            continue
+        V[w] = V[v]
+        h = VH[v]
+        VH[w] = 3 * fmap[h // 3] + h % 3
+        val[w] = val[v]
+        cls[w] = cls[v]
+        high[w] = high[v]
+        low[w] = low[v]
+    falive[:k] = True
+    falive[k:nf] = False
+    T[3 * k : 3 * nf] = -1
+    feat[3 * k : 3 * nf] = False
+    VH[j:nv] = -1
+    cnt[0], cnt[1] = j, k
 
 
 @njit(cache=True)
@@ -212,12 +280,10 @@ def collapse_check(V, F, T, VH, val, cls, feat, h, p, high, hes, nb1, nb2):
         return VALENCE
     if na + nb - 2 - common < 3:
         return VALENCE
-    for j in range(nb):  # the edges b had become edges of a
-        w = nb2[j]
-        if w != a:
-            e = V[w] - p
-            if np.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2) > high:
-                return LONG
+    for j in range(na + nb):  # every edge of a at p: b's edges become a's, a's own change when a moves
+        w = nb1[j] if j < na else nb2[j - na]
+        if w != a and w != b and np.sqrt((V[w, 0] - p[0]) ** 2 + (V[w, 1] - p[1]) ** 2 + (V[w, 2] - p[2]) ** 2) > high:
+            return LONG
     for v in (a, b):  # no face around a or b may turn over
         n = ring(F, T, VH, v, hes)
         for i in range(n):
@@ -225,11 +291,11 @@ def collapse_check(V, F, T, VH, val, cls, feat, h, p, high, hes, nb1, nb2):
             x, y = dst(F, g), org(F, pv(g))
             if x == a or x == b or y == a or y == b:
                 continue  # one of the two faces that disappear
-            n0 = normal(V[v], V[x], V[y])
-            n1 = normal(p, V[x], V[y])
-            l0 = np.sqrt(np.sum(n0 * n0))
-            l1 = np.sqrt(np.sum(n1 * n1))
-            if l1 <= 1e-12 * (1.0 + l0) or np.dot(n0, n1) < 0.2 * l0 * l1:
+            n0 = normal(V, v, x, y)
+            n1 = normal_at(p[0], p[1], p[2], V, x, y)
+            l0 = np.sqrt(dot(n0, n0))
+            l1 = np.sqrt(dot(n1, n1))
+            if l1 <= 1e-12 * (1.0 + l0) or dot(n0, n1) < 0.2 * l0 * l1:
                 return FLIP
     return OK
     # END SOLUTION
@@ -314,16 +380,16 @@ def flip_check(V, F, T, VH, val, feat, h, hes, nb1):
     for i in range(k):
         if nb1[i] == d:
             return LINK
-    n_old1 = normal(V[a], V[b], V[c])
-    n_old2 = normal(V[b], V[a], V[d])
-    n1 = normal(V[c], V[a], V[d])
-    n2 = normal(V[d], V[b], V[c])
+    n_old1 = normal(V, a, b, c)
+    n_old2 = normal(V, b, a, d)
+    n1 = normal(V, c, a, d)
+    n2 = normal(V, d, b, c)
     for nn in (n1, n2):
-        ln = np.sqrt(np.sum(nn * nn))
+        ln = np.sqrt(dot(nn, nn))
         if ln <= 1e-12:
             return FLIP
         for no in (n_old1, n_old2):
-            if np.dot(nn, no) <= 0.0:
+            if dot(nn, no) <= FLIP_COS * ln * np.sqrt(dot(no, no)):
                 return FLIP
     return OK
     # END SOLUTION
@@ -366,8 +432,12 @@ def flip(V, F, T, VH, val, feat, h):
 
 
 @njit(cache=True)
-def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
-    """Split at its midpoint every edge longer than ``high`` among half-edges ``start..stop-1``.
+def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low, start, stop):
+    """Split at its midpoint every edge longer than its bound among half-edges ``start..stop-1``.
+
+    ``high``, ``low`` (one per vertex row) are the split and collapse bounds of every vertex; an
+    edge's bound is the smaller of its two ends' (a uniform target length fills them with one
+    value). The new vertex takes the mean of its ends' bounds.
 
     Only the edges that exist when the pass starts are visited: re-splitting the new edges in the
     same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
@@ -376,30 +446,43 @@ def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, start, stop):
     # BEGIN SOLUTION: Task 4 (split long edges): every edge with |e| > 4/3 L at its midpoint, one pass over the edges present at the start
     done = 0
     for h in range(start, stop):
-        if falive[h // 3] and (T[h] < 0 or h < T[h]) and length(V, F, h) > high:
-            p = 0.5 * (V[org(F, h)] + V[dst(F, h)])
+        if not falive[h // 3] or (T[h] >= 0 and h > T[h]):
+            continue
+        a, b = org(F, h), dst(F, h)
+        if length(V, F, h) > min(high[a], high[b]):
+            p = 0.5 * (V[a] + V[b])
             if split(V, F, T, VH, val, cls, feat, falive, cnt, h, p) == FULL:
                 return done, h
+            m = cnt[0] - 1
+            high[m] = 0.5 * (high[a] + high[b])
+            low[m] = 0.5 * (low[a] + low[b])
             done += 1
     return done, stop
     # END SOLUTION
 
 
 @njit(cache=True)
-def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
-    """Collapse edges shorter than ``low`` unless that breaks a rule; returns the number of collapses."""
-    # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint otherwise
+def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
+    """Collapse edges shorter than their bound unless that breaks a rule; returns the number of collapses.
+
+    ``high``, ``low`` as in :func:`split_pass`: an edge is short below the smaller ``low`` of its
+    ends, and the collapse may not create an edge longer than the smaller ``high`` of its ends.
+    """
+    # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint (else an end) otherwise
     hes = np.empty(RING, np.int64)
     nb1 = np.empty(RING, np.int64)
     nb2 = np.empty(RING, np.int64)
     done = 0
     for h in range(3 * cnt[1]):
-        if not falive[h // 3] or length(V, F, h) >= low:
+        if not falive[h // 3]:
+            continue
+        a, b = org(F, h), dst(F, h)
+        lo, hi = min(low[a], low[b]), min(high[a], high[b])
+        if length(V, F, h) >= lo:
             continue
         t = T[h]
         if t >= 0 and t < h and falive[t // 3]:
             continue  # each edge once (from its lower half-edge)
-        a, b = org(F, h), dst(F, h)
         hh = h
         if cls[b] > cls[a]:  # keep the more constrained end
             if t < 0:
@@ -410,13 +493,19 @@ def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, low, high):
             continue  # corners stay
         if cls[b] == 1 and not feat[hh]:
             continue  # a feature vertex may only slide along its own line
-        if cls[a] == 0 and cls[b] == 0:
-            p = 0.5 * (V[a] + V[b])
-        else:
-            p = V[a].copy()
-        if collapse_check(V, F, T, VH, val, cls, feat, hh, p, high, hes, nb1, nb2) == OK:
-            collapse(V, F, T, VH, val, cls, feat, falive, hh, p, hes)
-            done += 1
+        # two free ends meet at the midpoint; a very short edge (a needle, seen on thin ridges), when
+        # the midpoint is refused, at one of its ends; a constrained end stays
+        free = cls[a] == 0 and cls[b] == 0
+        tries = 3 if free and length(V, F, h) < 0.625 * lo else 1
+        for k in range(tries):
+            if free and k == 0:
+                p = 0.5 * (V[a] + V[b])
+            else:
+                p = (V[b] if k == 2 else V[a]).copy()
+            if collapse_check(V, F, T, VH, val, cls, feat, hh, p, hi, hes, nb1, nb2) == OK:
+                collapse(V, F, T, VH, val, cls, feat, falive, hh, p, hes)
+                done += 1
+                break
     return done
     # END SOLUTION
 
@@ -427,6 +516,11 @@ def flip_pass(V, F, T, VH, val, cls, feat, falive, cnt):
     # BEGIN SOLUTION: Task 6 (equalize valences): flip a-b to c-d when Σ|val - target| over a, b, c, d drops
     hes = np.empty(RING, np.int64)
     nb1 = np.empty(RING, np.int64)
+    target = np.full(cnt[0], 6, np.int64)  # flips never touch the boundary: its vertices stay the same
+    for h in range(3 * cnt[1]):
+        if falive[h // 3] and T[h] < 0:
+            target[org(F, h)] = 4
+            target[dst(F, h)] = 4
     done = 0
     for h in range(3 * cnt[1]):
         t = T[h]
@@ -434,13 +528,14 @@ def flip_pass(V, F, T, VH, val, cls, feat, falive, cnt):
             continue
         a, b = org(F, h), dst(F, h)
         c, d = org(F, pv(h)), org(F, pv(t))
-        ta = 4 if _on_boundary(F, T, VH, a, hes) else 6
-        tb = 4 if _on_boundary(F, T, VH, b, hes) else 6
-        tc = 4 if _on_boundary(F, T, VH, c, hes) else 6
-        td = 4 if _on_boundary(F, T, VH, d, hes) else 6
-        before = abs(val[a] - ta) + abs(val[b] - tb) + abs(val[c] - tc) + abs(val[d] - td)
-        after = abs(val[a] - 1 - ta) + abs(val[b] - 1 - tb) + abs(val[c] + 1 - tc) + abs(val[d] + 1 - td)
-        if after < before and flip_check(V, F, T, VH, val, feat, h, hes, nb1) == OK:
+        ta, tb, tc, td = target[a], target[b], target[c], target[d]
+        da, db, dc, dd = val[a] - ta, val[b] - tb, val[c] - tc, val[d] - td
+        before = abs(da) + abs(db) + abs(dc) + abs(dd)
+        after = abs(da - 1) + abs(db - 1) + abs(dc + 1) + abs(dd + 1)
+        # a tie in the sum of |deviations| is broken by the sum of squares: it moves an 8 toward a 4
+        # two edges away (8-6-6-4 -> 7-6-6-5), which the absolute sum alone never does
+        better = after < before or (after == before and 2 * (dc + dd - da - db) + 4 < 0)
+        if better and flip_check(V, F, T, VH, val, feat, h, hes, nb1) == OK:
             flip(V, F, T, VH, val, feat, h)
             done += 1
     return done

@@ -37,8 +37,9 @@ def test_sharp_edges_match_dihedral_angles():
 
 
 def test_every_kernel_edit_keeps_the_state_consistent():
-    """Random splits, flips and collapses on the corner table: its twins, vertex half-edges and
-    valences agree with the faces after each edit, and the rebuilt HalfEdgeMesh passes check_halfedges."""
+    """Random splits, flips and collapses on the corner table (compacted now and then): its twins,
+    vertex half-edges and valences agree with the faces after each edit, and the rebuilt HalfEdgeMesh
+    passes check_halfedges."""
     V, F = datasets.icosphere(2)
     S = M.make_state(V, F)
     rng = np.random.default_rng(1)
@@ -65,6 +66,9 @@ def test_every_kernel_edit_keeps_the_state_consistent():
                 continue
             K.collapse(*M._args(S)[:8], h, p, hes)
         edits += 1
+        if edits % 25 == 0:
+            S.compact()  # drops dead rows: the same mesh, renumbered
+            assert S.falive[: S.cnt[1]].all() and (S.VH[: S.cnt[0]] >= 0).all()
         Fl = S.faces()
         live = np.flatnonzero(np.repeat(S.falive[: S.cnt[1]], 3))
         t = S.T[live]
@@ -108,3 +112,58 @@ def test_boundary_and_features_kept():
     lo, hi = V[:, :2].min(axis=0), V[:, :2].max(axis=0)
     xy = W[b[0], :2]
     assert (np.isclose(xy, lo) | np.isclose(xy, hi)).any(axis=1).all()  # boundary stays on the square's sides
+
+
+def test_max_curvature_matches_igl_mean_and_gaussian_curvature():
+    """κ = |H| + sqrt(max(H² − K, 0)) from libigl's cotangent Laplacian, barycentric mass matrix and
+    angle defect (an independent implementation of the same formulas) agrees to round-off."""
+    V, F = datasets.torus(n_major=32, n_minor=16)
+    m = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_BARYCENTRIC).diagonal()
+    H = np.linalg.norm(igl.cotmatrix(V, F) @ V, axis=1) / m / 2
+    K = igl.gaussian_curvature(V, F) / m
+    np.testing.assert_allclose(R.max_curvature(V, F), H + np.sqrt(np.maximum(H * H - K, 0)), rtol=1e-9)
+
+
+def test_max_curvature_of_a_torus_and_boundary():
+    """On a torus the larger principal curvature is 1 / (minor radius) everywhere; boundary vertices get NaN."""
+    V, F = datasets.torus(n_major=48, n_minor=24)
+    r = 0.5 * (V[:, 2].max() - V[:, 2].min())
+    assert abs(np.median(R.max_curvature(V, F)) * r - 1) < 0.01
+    Vh, Fh = datasets.height_field(12)
+    k = R.max_curvature(Vh, Fh)
+    bnd = topology.halfedge_mesh(Fh, len(Vh)).boundary_vertex
+    assert np.isnan(k[bnd]).all() and np.isfinite(k[~bnd]).all()
+
+
+def test_adaptive_target_length_formula():
+    """On a sphere of radius r (κ = 1/r everywhere) every length is sqrt(6 ε r − 3 ε²) for a given
+    ε; with the default ε it is about L; clamping and the flat (boundary-only) fill behave."""
+    V, F = datasets.icosphere(4)
+    V = 2.0 * V
+    kap = R.max_curvature(V, F)
+    h = R.adaptive_target_length(V, F, 0.2, error=0.001, min_length=0.01, max_length=1.0, smoothing=0)
+    np.testing.assert_allclose(h, np.sqrt(6 * 0.001 / kap - 3 * 0.001**2), rtol=1e-12)
+    h = R.adaptive_target_length(V, F, 0.2)
+    assert abs(np.median(h) / 0.2 - 1) < 0.01
+    h = R.adaptive_target_length(V, F, 0.2, error=1e-9, min_length=0.05)
+    assert np.allclose(h, 0.05)  # every length below the clamp
+    Vh, Fh = datasets.height_field(12)
+    assert np.isfinite(R.adaptive_target_length(Vh, Fh, 0.05)).all()
+
+
+def test_adaptive_remesh_follows_curvature():
+    """A stretched sphere remeshed adaptively has shorter edges at its tips than at its waist."""
+    V, F = datasets.icosphere(3)
+    V = V * np.array([1.5, 0.6, 0.6])
+
+    def tips_over_waist(W, G):
+        E = topology.unique_edges(G)
+        e = np.linalg.norm(W[E[:, 0]] - W[E[:, 1]], axis=1)
+        x = np.abs(W[E, 0].mean(axis=1))
+        return e[x > 0.8 * x.max()].mean() / e[x < 0.2 * x.max()].mean()
+
+    assert tips_over_waist(*R.isotropic_remesh(V, F, 0.1, adaptive=True)) < 0.85
+    assert tips_over_waist(*R.isotropic_remesh(V, F, 0.1)) > 0.9
+    field = R.adaptive_target_length(V, F, 0.1)
+    W, G = R.isotropic_remesh(V, F, field)  # the same field given as an array
+    assert tips_over_waist(W, G) < 0.85

@@ -15,7 +15,7 @@ from geomlib import datasets
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
-from .support import bumpy_sphere, remesh_check, same_vertex_set, wavy_patch
+from .support import adaptive_check, bumpy_sphere, remesh_check, same_vertex_set, spheroid, wavy_patch
 
 
 def mesh(make, **extra):
@@ -120,5 +120,36 @@ CASES = [
         part="features",
         points=1,
         hint="vertices on sharp edges slide along them, corners stay",
+    ),
+    Case(
+        id="curvature-spheroid",
+        function="max_curvature",
+        inputs=mesh(spheroid),
+        outputs=("kappa",),
+        check=checks.Allclose(atol=1e-9),
+        part="adaptive",
+        points=1,
+        hint="H = |Δx| / 2 with the cotangent Laplacian and the barycentric area, K = angle defect / area",
+    ),
+    Case(
+        id="adaptive-lengths-spheroid",
+        function="adaptive_target_length",
+        inputs=mesh(spheroid, target_length=0.1),
+        outputs=("lengths",),
+        check=checks.Allclose(atol=1e-9),
+        part="adaptive",
+        points=1,
+        hint="smooth κ over closed 1-rings (twice), h = sqrt(6 ε r − 3 ε²) with r = 1/κ, ε = L² median(κ) / 6, clamp",
+    ),
+    Case(
+        id="remesh-adaptive-spheroid",
+        function="isotropic_remesh",
+        inputs=mesh(spheroid, target_length=0.1, adaptive=True),
+        outputs=("V", "F"),
+        # solution: min angle 39.5°, Hausdorff 0.0025, tips / waist 0.79 (a uniform remesh: 0.98)
+        check=adaptive_check(mesh(spheroid), min_angle=12.0, hausdorff=0.006, tip_ratio=0.9),
+        part="adaptive",
+        points=1,
+        hint="an edge's bounds use the smaller target of its two ends; a vertex takes the target of its projection",
     ),
 ]

@@ -9,7 +9,7 @@ from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
 from .cases import LOOP_HINT, QUALITY, bumpy, mesh, projection_points
-from .support import remesh_check, same_vertex_set
+from .support import adaptive_check, remesh_check, same_vertex_set, spheroid
 
 
 def torus():
@@ -18,6 +18,10 @@ def torus():
 
 def hf():
     return datasets.height_field(16)
+
+
+def flat_spheroid():
+    return spheroid(3, (1.8, 0.7, 0.45))
 
 
 def box8():
@@ -123,6 +127,48 @@ CASES = [
         outputs=("V", "F"),
         check=remesh_check(mesh(box8), 0.07, hausdorff=1e-3, **QUALITY),  # solution: 0
         part="features",
+        points=2,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-curvature-torus",
+        function="max_curvature",
+        inputs=mesh(torus),
+        outputs=("kappa",),
+        check=checks.Allclose(atol=1e-9),
+        part="adaptive",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-adaptive-lengths-height-field",
+        function="adaptive_target_length",
+        inputs=mesh(hf, target_length=0.05),
+        outputs=("lengths",),
+        check=checks.Allclose(atol=1e-9),
+        part="adaptive",
+        points=2,
+        visibility="hidden",
+        hint="boundary vertices have no curvature (NaN): the smoothing fills them from inside",
+    ),
+    Case(
+        id="hidden-adaptive-lengths-options",
+        function="adaptive_target_length",
+        inputs=mesh(flat_spheroid, target_length=0.08, error=0.002, min_length=0.05, max_length=0.12, smoothing=1),
+        outputs=("lengths",),
+        check=checks.Allclose(atol=1e-9),
+        part="adaptive",
+        points=1,
+        visibility="hidden",
+    ),
+    Case(
+        id="hidden-remesh-adaptive-flat-spheroid",
+        function="isotropic_remesh",
+        inputs=mesh(flat_spheroid, target_length=0.08, adaptive=True),
+        outputs=("V", "F"),
+        # solution: min angle 32.0°, Hausdorff 0.0021, tips / waist 0.74 (a uniform remesh: 1.0)
+        check=adaptive_check(mesh(flat_spheroid), min_angle=12.0, hausdorff=0.006, tip_ratio=0.9),
+        part="adaptive",
         points=2,
         visibility="hidden",
     ),

@@ -130,3 +130,39 @@ def same_vertex_set(expected, got, ctx):
     if not np.allclose(a, b, atol=1e-9):
         return "the new vertices are not the midpoints of the long edges"
     return validity_problem(expected["V"], expected["F"], got["V"], got["F"])
+
+
+def spheroid(level=3, axes=(1.5, 0.6, 0.6)):
+    """An icosphere stretched along x: its tips bend much more than its waist."""
+    V, F = datasets.icosphere(level)
+    return V * np.asarray(axes), F
+
+
+def adaptive_check(make, *, min_angle, hausdorff, tip_ratio):
+    """A check for adaptive ``isotropic_remesh`` outputs on a shape stretched along x: validity, the
+    minimum angle, Hausdorff distance, and edges at the tips (|x| > 0.8 max |x|) shorter than at the
+    waist (|x| < 0.2 max |x|) by at least ``tip_ratio`` (a uniform remesh gives about 1)."""
+
+    def fn(expected, got, ctx):
+        d = make()
+        problem = validity_problem(d["V"], d["F"], got.get("V"), got.get("F"))
+        if problem:
+            return problem
+        V, F = np.asarray(got["V"], float), np.asarray(got["F"])
+        q = quality(d["V"], d["F"], V, F)
+        ends = topology.unique_edges(F)
+        e = np.linalg.norm(V[ends[:, 0]] - V[ends[:, 1]], axis=1)
+        x = np.abs(V[ends, 0].mean(axis=1))
+        tips, waist = e[x > 0.8 * x.max()].mean(), e[x < 0.2 * x.max()].mean()
+        if q["min_angle"] < min_angle:
+            return f"min_angle = {q['min_angle']:.3g}, needs >= {min_angle:g}"
+        if q["hausdorff"] > hausdorff:
+            return f"hausdorff = {q['hausdorff']:.3g}, needs <= {hausdorff:g}"
+        if tips / waist > tip_ratio:
+            return (
+                f"mean edge at the tips {tips:.4g}, at the waist {waist:.4g}: ratio {tips / waist:.3g}, needs <= "
+                f"{tip_ratio:g} (shorter edges where the surface bends more)"
+            )
+        return None
+
+    return checks.Custom(fn)

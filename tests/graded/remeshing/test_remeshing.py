@@ -178,3 +178,20 @@ def test_rejects_bad_input(lab):
     Vnm = np.r_[SQUARE_V, [[0.5, 0.5, 1.0]]]
     expect_raises(lambda: lab.isotropic_remesh(Vnm, Fnm, 0.3), "MeshError", match="edge")
     expect_raises(lambda: lab.isotropic_remesh(SQUARE_V, SQUARE_F, 0.3, iterations=-1), "MeshError", match="iterations")
+
+
+@graded(points=0, part="bad input")
+def test_adaptive_rejects_bad_input(lab):
+    """adaptive lengths: min above max, a negative error; per-vertex targets of the wrong shape or <= 0"""
+    V, F = datasets.icosphere(1)
+    expect_raises(
+        lambda: lab.adaptive_target_length(V, F, 0.3, min_length=0.5, max_length=0.2), "MeshError", match="min_length"
+    )
+    expect_raises(lambda: lab.adaptive_target_length(V, F, 0.3, error=-1.0), "MeshError", match="error")
+    expect_raises(lambda: lab.isotropic_remesh(V, F, np.full(3, 0.3)), "MeshError", match="one length per vertex")
+    bad = np.full(len(V), 0.3)
+    bad[5] = 0.0
+    expect_raises(lambda: lab.isotropic_remesh(V, F, bad), "MeshError", match="vertex 5")
+    expect_raises(
+        lambda: lab.isotropic_remesh(V, F, np.full(len(V), 0.3), adaptive=True), "MeshError", match="adaptive"
+    )
