@@ -1,17 +1,18 @@
-"""Benchmark: lab "remeshing" (isotropic remeshing) against gpytoolbox's ``remesh_botsch``, in one run.
+"""Benchmark: lab "remeshing" (isotropic remeshing) against gpytoolbox's ``remesh_botsch``, trueform and CGAL, in one run.
 
 Run: ``uv run python bench/remeshing.py [--quick] [--iterations N]``
 
-gpytoolbox is a benchmark-only tool, not a dependency of the course: it is looked up in a
+The other tools are benchmark-only, not dependencies of the course: they are looked up in a
 throwaway virtual environment (``--gpy-python``, default ``/tmp/gpyvenv/bin/python``; make it with
-``uv venv /tmp/gpyvenv && VIRTUAL_ENV=/tmp/gpyvenv uv pip install gpytoolbox``) and run there in a
-subprocess on the same input, timed inside that process. Without it the comparison is skipped
-with a message.
+``uv venv /tmp/gpyvenv && VIRTUAL_ENV=/tmp/gpyvenv uv pip install gpytoolbox trueform cgal``) and
+run there in a subprocess on the same input, timed inside that process. A tool that is not
+installed is skipped with a message. CGAL's Python bindings cannot protect feature edges, so CGAL
+runs only on meshes remeshed without features.
 
 On bunny_hr it also runs the adaptive target length (task 11, ``adaptive=True`` with L = 0.03);
-gpytoolbox's ``remesh_botsch`` takes a single ``h``, so that row has no comparison.
+the other tools take a single ``h``, so that row has no comparison.
 
-Per mesh it prints, for ours and gpytoolbox: time (best of 2), faces, minimum angle, share of
+Per mesh it prints, for ours and each tool: time (best of 2), faces, minimum angle, share of
 angles below 30°, edge-length std / mean, valence-6 share of interior vertices, Hausdorff distance
 to the input relative to the bbox diagonal (``geomlib.geometry.mesh_distance``), and the time
 ratio. It also reports the kernels' first-call cost: compile (fresh numba cache, in a subprocess)
@@ -45,8 +46,11 @@ from solutions.remeshing import isotropic_remesh  # noqa: E402
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 
-GPY_SCRIPT = r"""
-import sys, time, json, numpy as np
+# Each tool runs in the throwaway environment: it reads in.npz (V, F, h, its, feature_edges or the
+# feature angle) and writes out.npz (V, F, t = best time of 2, timed inside that process).
+TOOL_SCRIPTS = {
+    "gpytoolbox": r"""
+import sys, time, numpy as np
 from gpytoolbox import remesh_botsch
 d = np.load(sys.argv[1])
 V, F, h, its = d["V"], d["F"].astype(np.int32), float(d["h"]), int(d["its"])
@@ -57,7 +61,52 @@ for _ in range(2):
     U, G = remesh_botsch(V, F, i=its, h=h, feature_edges=fe if len(fe) else None, project=True)
     best = min(best, time.perf_counter() - t)
 np.savez(sys.argv[2], V=U, F=G, t=best)
-"""
+""",
+    # trueform splits edges longer than target_length (not 4/3 of it) and relaxes 3 times per
+    # iteration by default; run as documented, with its own feature detection when asked for.
+    "trueform": r"""
+import sys, time, numpy as np
+import trueform as tf
+d = np.load(sys.argv[1])
+V, F, h, its, fa = d["V"], d["F"].astype(np.int32), float(d["h"]), int(d["its"]), float(d["feature_angle"])
+best = np.inf
+for _ in range(2):
+    t = time.perf_counter()
+    G, U = tf.isotropic_remeshed((F, V), h, iterations=its, feature_angle=fa)
+    best = min(best, time.perf_counter() - t)
+np.savez(sys.argv[2], V=U, F=G, t=best)
+""",
+    # CGAL's Python bindings (SWIG) take a Polyhedron_3, built from an OFF file; features are not
+    # protected here (the bindings expose no edge-constraint map), so it runs only without them.
+    "CGAL": r"""
+import sys, time, tempfile, os, numpy as np
+from CGAL.CGAL_Polyhedron_3 import Polyhedron_3
+from CGAL import CGAL_Polygon_mesh_processing as PMP
+d = np.load(sys.argv[1])
+V, F, h, its = d["V"], d["F"], float(d["h"]), int(d["its"])
+if float(d["feature_angle"]) >= 0:
+    sys.exit("features are not protected through CGAL's Python bindings: skipped")
+tmp = tempfile.mkdtemp()
+with open(os.path.join(tmp, "in.off"), "w") as f:
+    f.write(f"OFF\n{len(V)} {len(F)} 0\n")
+    np.savetxt(f, V, fmt="%.17g")
+    np.savetxt(f, np.column_stack([np.full(len(F), 3), F]), fmt="%d")
+best = np.inf
+for _ in range(2):
+    P = Polyhedron_3(os.path.join(tmp, "in.off"))
+    t = time.perf_counter()
+    PMP.isotropic_remeshing([f for f in P.facets()], h, P, its)
+    best = min(best, time.perf_counter() - t)
+P.write_to_file(os.path.join(tmp, "out.off"))
+lines = open(os.path.join(tmp, "out.off")).read().split()
+n, m = int(lines[1]), int(lines[2])
+U = np.array(lines[4 : 4 + 3 * n], float).reshape(n, 3)
+G = np.array(lines[4 + 3 * n : 4 + 3 * n + 4 * m], np.int64).reshape(m, 4)[:, 1:]
+np.savez(sys.argv[2], V=U, F=G, t=best)
+""",
+}
+#: What each tool needs importable in the throwaway environment.
+TOOL_MODULES = {"gpytoolbox": "gpytoolbox", "trueform": "trueform", "CGAL": "CGAL.CGAL_Polygon_mesh_processing"}
 
 
 def quality(V0, F0, V, F) -> dict:
@@ -109,15 +158,18 @@ def target(name, V, F):
     return 1.0 * mean_edge_length(V, F)
 
 
-def run_gpy(py, V, F, h, its, feature_angle):
+def run_tool(tool, py, V, F, h, its, feature_angle):
+    """Run ``tool`` (a key of :data:`TOOL_SCRIPTS`) in the environment of ``py``: (V, F, time) or (None, why)."""
     with tempfile.TemporaryDirectory() as tmp:
         feat = np.zeros((0, 2), np.int64)
         if feature_angle is not None:  # the same sharp edges for both
             from solutions.remeshing import sharp_edges
 
             feat = sharp_edges(V, F, feature_angle)
-        np.savez(f"{tmp}/in.npz", V=V, F=F, h=h, its=its, feature_edges=feat)
-        r = subprocess.run([py, "-c", GPY_SCRIPT, f"{tmp}/in.npz", f"{tmp}/out.npz"], capture_output=True, text=True)
+        fa = -1.0 if feature_angle is None else float(feature_angle)
+        np.savez(f"{tmp}/in.npz", V=V, F=F, h=h, its=its, feature_edges=feat, feature_angle=fa)
+        script = TOOL_SCRIPTS[tool]
+        r = subprocess.run([py, "-c", script, f"{tmp}/in.npz", f"{tmp}/out.npz"], capture_output=True, text=True)
         if r.returncode:
             return None, r.stderr.strip().splitlines()[-1] if r.stderr else "failed"
         d = np.load(f"{tmp}/out.npz")
@@ -145,12 +197,15 @@ def main() -> None:
     ap.add_argument("--iterations", type=int, default=10)
     ap.add_argument("--gpy-python", default="/tmp/gpyvenv/bin/python")
     args = ap.parse_args()
-    have_gpy = (
-        Path(args.gpy_python).exists()
-        and subprocess.run([args.gpy_python, "-c", "import gpytoolbox"], capture_output=True).returncode == 0
-    )
-    if not have_gpy:
-        print(f"gpytoolbox not found at {args.gpy_python}: comparison skipped (see the module docstring)")
+    tools = [
+        t
+        for t, mod in TOOL_MODULES.items()
+        if Path(args.gpy_python).exists()
+        and subprocess.run([args.gpy_python, "-c", f"import {mod}"], capture_output=True).returncode == 0
+    ]
+    for t in TOOL_MODULES:
+        if t not in tools:
+            print(f"{t} not found at {args.gpy_python}: its comparison is skipped (see the module docstring)")
     costs = first_call_costs()
     print(
         "first call of isotropic_remesh (tiny mesh, fresh process): "
@@ -167,14 +222,13 @@ def main() -> None:
             best = min(best, time.perf_counter() - t)
         q = {"time": best, **quality(V, F, *res)}
         rows.append((name, "ours", q))
-        if have_gpy:
-            g, err = run_gpy(args.gpy_python, V, F, h, args.iterations, fa)
+        for tool in tools:
+            g, err = run_tool(tool, args.gpy_python, V, F, h, args.iterations, fa)
             if g is None:
-                print(f"{name}: gpytoolbox failed: {err}")
-            else:
-                qg = {"time": g[2], **quality(V, F, g[0], g[1])}
-                rows.append((name, "gpytoolbox", qg))
-                print(f"{name}: h = {h:.4g}, time ratio ours / gpytoolbox = {best / g[2]:.2f}")
+                print(f"{name}: {tool}: {err}")
+                continue
+            rows.append((name, tool, {"time": g[2], **quality(V, F, g[0], g[1])}))
+            print(f"{name}: h = {h:.4g}, time ratio ours / {tool} = {best / g[2]:.2f}")
         if name == "bunny_hr":  # task 11 (gpytoolbox's remesh_botsch takes one h only: ours alone)
             t = time.perf_counter()
             res = isotropic_remesh(V, F, h, iterations=args.iterations, adaptive=True)
