@@ -40,9 +40,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from geomlib import datasets, topology  # noqa: E402
+from geomlib import datasets  # noqa: E402
 from geomlib.geometry import mesh_distance  # noqa: E402
 from solutions.remeshing import isotropic_remesh  # noqa: E402
+from solutions.remeshing.figures import quality as mesh_quality  # noqa: E402
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 
@@ -110,23 +111,9 @@ TOOL_MODULES = {"gpytoolbox": "gpytoolbox", "trueform": "trueform", "CGAL": "CGA
 
 
 def quality(V0, F0, V, F) -> dict:
-    H = topology.halfedge_mesh(F, len(V), manifold=True)
-    e = np.linalg.norm(V[H.E[:, 0]] - V[H.E[:, 1]], axis=1)
-    ang = []
-    for k in range(3):
-        a, b = V[F[:, (k + 1) % 3]] - V[F[:, k]], V[F[:, (k + 2) % 3]] - V[F[:, k]]
-        c = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
-        ang.append(np.degrees(np.arccos(np.clip(c, -1, 1))))
-    ang = np.concatenate(ang)
-    inner = ~H.boundary_vertex
-    return {
-        "faces": len(F),
-        "min_angle": float(ang.min()),
-        "below_30": float(np.mean(ang < 30)),
-        "edge_cv": float(e.std() / e.mean()),
-        "valence6": float(np.mean(H.valence[inner] == 6)),
-        "hausdorff": mesh_distance(V0, F0, V, F, n_samples=50_000)["hausdorff"],
-    }
+    """The lab figures' quality measures (:func:`solutions.remeshing.figures.quality`) and the
+    Hausdorff distance to the input relative to its bounding-box diagonal."""
+    return {**mesh_quality(V, F), "hausdorff": mesh_distance(V0, F0, V, F, n_samples=50_000)["hausdorff"]}
 
 
 def meshes(quick: bool) -> list:
