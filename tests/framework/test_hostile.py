@@ -78,8 +78,8 @@ def test_a_lone_surrogate_in_a_message_costs_only_its_tests(tmp_path):
 
 
 def test_a_half_written_message_header_cannot_hang_the_grader(tmp_path):
-    r = _grade("partial_header", tmp_path, GEOMLIB_TIME_LIMIT="5")
-    failed = [t for t in r["results"]["tests"] if "did not finish within 5 s" in t["text"]]
+    r = _grade("partial_header", tmp_path, GEOMLIB_TIME_LIMIT="2")
+    failed = [t for t in r["results"]["tests"] if "did not finish within 2 s" in t["text"]]
     assert failed and r["score"] > 0
 
 
