@@ -113,7 +113,7 @@ def _draw(V, F, **options):
 def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
     """Render expected and submitted meshes side by side with a distance heat map on the submission."""
     path = ctx.feedback_path()
-    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    if path is None:
         return None
 
     def draw(Vg=Vg):  # defaults: the body rebinds these names
@@ -172,7 +172,7 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
     """The input mesh with ``points`` ((k, 3) positions: the wrong vertices, edge midpoints, ...)
     marked in red, for failures that are about rows of a matrix rather than a drawn result."""
     path = ctx.feedback_path(suffix)
-    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    if path is None:
         return None
 
     def draw(V=V):  # the body rebinds V
@@ -207,7 +207,7 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str =
 def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -> str | None:
     """The mesh coloured by a per-vertex error, with its colour bar beside it (two views)."""
     path = ctx.feedback_path()
-    if path is None or os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    if path is None:
         return None
 
     def draw(values=values):  # the body rebinds values

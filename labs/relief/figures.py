@@ -308,7 +308,7 @@ def _arc(uv, depth=None):
     return P, T, B, N
 
 
-def _arc_render(H, size, cells, depth=None):
+def _arc_render(size, cells, depth=None):
     """Rasterize the half cylinder (displaced by ``depth(uv)`` when given) from ``_ARC_EYE``: mask and uv."""
     Vg, F = datasets.grid_patch(cells)
     uv = Vg[:, :2]
@@ -318,12 +318,12 @@ def _arc_render(H, size, cells, depth=None):
     return g.mask, g.attributes["uv"]
 
 
-def _arc_shade(H, mask, uv, normal_ts, kind="bumps"):
+def _arc_shade(H, mask, uv, normal_ts):
     """Lambert + ambient with tangent-space normals turned into world space on the cylinder."""
     _, T, B, N = _arc(uv)
     n = T * normal_ts[..., :1] + B * normal_ts[..., 1:2] + N * normal_ts[..., 2:]
     n /= np.maximum(np.linalg.norm(n, axis=-1, keepdims=True), 1e-12)
-    img = albedo(H, uv, kind) * (0.25 + 0.75 * np.clip(n @ _ARC_LIGHT, 0, None)[..., None])
+    img = albedo(H, uv, "bumps") * (0.25 + 0.75 * np.clip(n @ _ARC_LIGHT, 0, None)[..., None])
     img[~mask] = BACKGROUND
     return np.clip(img, 0, 1)
 
@@ -331,7 +331,7 @@ def _arc_shade(H, mask, uv, normal_ts, kind="bumps"):
 def _fig_silhouette(out: Path, quick: bool) -> Figure:
     size = 160 if quick else 300
     H = bumps(128 if quick else 256)
-    mask, uv = _arc_render(H, size, 64)
+    mask, uv = _arc_render(size, 64)
     P, T, B, N = _arc(uv)
     v = _ARC_EYE - P
     # The tangent-space view in uv units: a step of 1 in u is pi R long on the surface, in v it is W
@@ -351,7 +351,7 @@ def _fig_silhouette(out: Path, quick: bool) -> Figure:
     made, note = _try(pom, size)
     pom_img, pom_mask = made if made is not None else (_missing(size), mask)
     true_mask, true_uv = _arc_render(
-        H, size, 96 if quick else 200, depth=lambda q: _ARC_DEPTH * (1 - height_at(H, q[:, 0], q[:, 1]))
+        size, 96 if quick else 200, depth=lambda q: _ARC_DEPTH * (1 - height_at(H, q[:, 0], q[:, 1]))
     )
     up = np.zeros(true_uv.shape[:2] + (3,))
     up[..., 2] = 1.0
