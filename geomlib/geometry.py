@@ -3,7 +3,7 @@
 About 700 lines, over half of them the watertight ray caster and its BVH walk, kept next to the
 closest-point and distance queries that share their validation and bounding boxes.
 
-Measures (normals, areas, dihedral angles, edge lengths), spatial queries (closest points,
+Measures (normals, areas, corner and dihedral angles, edge lengths, triangle quality), spatial queries (closest points,
 ray casting, surface sampling) and the mesh-to-mesh distances every lab's grading reuses.
 
 All functions take a triangle mesh ``(V, F)``: ``V`` float64 ``(n, 3)``, ``F`` int ``(m, 3)``,
@@ -41,6 +41,8 @@ __all__ = [
     "face_normals",
     "face_areas",
     "vertex_normals",
+    "corner_angles",
+    "triangle_quality",
     "dihedral_angles",
     "bbox_diagonal",
     "mean_edge_length",
@@ -116,6 +118,51 @@ def _corner_angles(V: np.ndarray, F: np.ndarray) -> np.ndarray:
     cr = np.linalg.norm(np.cross(e1, e2), axis=2)
     dt = np.einsum("ijk,ijk->ij", e1, e2)
     return np.arctan2(cr, dt)
+
+
+def corner_angles(V, F) -> np.ndarray:
+    """Interior angle at each corner of each triangle.
+
+    Returns
+    -------
+    (m, 3) float64
+        Radians; the angle at corner ``k`` of face ``f`` is the one at vertex ``F[f, k]`` (0 at a
+        corner with a zero-length edge).
+    """
+    V, F = _mesh(V, F, "corner_angles")
+    return _corner_angles(V, F)
+
+
+def triangle_quality(V, F) -> dict:
+    """How close to equilateral and regular a triangle mesh is: the measures isotropic remeshing aims at.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+    F : (m, 3) int
+        An edge-manifold mesh.
+
+    Returns
+    -------
+    dict
+        ``faces``; ``min_angle`` (degrees, the smallest corner angle); ``below_30`` (share of corner
+        angles below 30 degrees); ``mean_edge`` (units of ``V``) and ``edge_cv`` (edge-length
+        std / mean); ``valence6`` (share of interior vertices with 6 neighbours; 1 without interior
+        vertices).
+    """
+    V, F = _mesh(V, F, "triangle_quality")
+    H = topology.halfedge_mesh(F, len(V), manifold=True)
+    angles = np.degrees(_corner_angles(V, F))
+    e = np.linalg.norm(V[H.E[:, 0]] - V[H.E[:, 1]], axis=1)
+    inner = ~H.boundary_vertex
+    return {
+        "faces": len(F),
+        "min_angle": float(angles.min()),
+        "below_30": float(np.mean(angles < 30)),
+        "mean_edge": float(e.mean()),
+        "edge_cv": float(e.std() / e.mean()),
+        "valence6": float(np.mean(H.valence[inner] == 6)) if inner.any() else 1.0,
+    }
 
 
 def vertex_normals(V, F, weighting: str = "area") -> np.ndarray:

@@ -410,3 +410,31 @@ def test_sample_counts_that_cannot_fit_in_memory_are_refused_clearly():
         geometry.random_points_on_mesh(TRI_V, TRI_F, 10**12)
     with pytest.raises(MeshError, match=r"^mesh_distance: n_samples = .* would need about .* GiB of memory"):
         geometry.mesh_distance(TRI_V, TRI_F, TRI_V, TRI_F, n_samples=10**12)
+
+
+def test_corner_angles_match_libigl_and_sum_to_pi():
+    V, F = datasets.icosphere(2)
+    V = datasets.add_noise(V, 0.05, seed=3)
+    A = geometry.corner_angles(V, F)
+    np.testing.assert_allclose(A, igl.internal_angles(V, F), atol=1e-12)
+    np.testing.assert_allclose(A.sum(axis=1), np.pi, atol=1e-12)
+
+
+def test_triangle_quality_against_independent_counts():
+    V, F = datasets.height_field(12)  # an open grid: its boundary vertices do not count for valence 6
+    V = V + np.random.default_rng(0).normal(scale=1e-3, size=V.shape)
+    q = geometry.triangle_quality(V, F)
+    angles = np.degrees(igl.internal_angles(V, F))
+    E = igl.edges(F)
+    lengths = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)
+    valence = np.bincount(E.ravel(), minlength=len(V))
+    inner = np.ones(len(V), bool)
+    inner[np.unique(igl.boundary_loop(F))] = False
+    assert q["faces"] == len(F)
+    assert q["min_angle"] == pytest.approx(angles.min(), abs=1e-9)
+    assert q["below_30"] == pytest.approx(np.mean(angles < 30))
+    assert q["mean_edge"] == pytest.approx(lengths.mean())
+    assert q["edge_cv"] == pytest.approx(lengths.std() / lengths.mean())
+    assert q["valence6"] == pytest.approx(np.mean(valence[inner] == 6))
+    with pytest.raises(MeshError):
+        geometry.triangle_quality(V, np.vstack([F, F[:2, [0, 2, 1]]]))  # edges shared by three faces
