@@ -1,6 +1,6 @@
 """Per-element geometry and spatial queries on triangle meshes.
 
-About 700 lines, over half of them the watertight ray caster and its BVH walk, kept next to the
+About 750 lines, over half of them the watertight ray caster and its BVH walk, kept next to the
 closest-point and distance queries that share their validation and bounding boxes.
 
 Measures (normals, areas, corner and dihedral angles, edge lengths, triangle quality), spatial queries (closest points,
