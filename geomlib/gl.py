@@ -78,6 +78,9 @@ _STATE: dict = {}
 
 def _gl():
     """The OpenGL module, with this module's context current (created on first use)."""
+    from geomlib.render.context import note_context_created, require_own_context
+
+    require_own_context("geomlib.gl")
     platform = _STATE.get("platform")
     if platform is None:
         from geomlib.render import backend, import_pyrender
@@ -99,6 +102,7 @@ def _gl():
                 f"geomlib.gl: could not create a headless OpenGL context ({type(e).__name__}: {e}). Fix: {_FIX}"
             ) from e
         _STATE["platform"] = platform
+        note_context_created()
     else:
         platform.make_current()
     from OpenGL import GL
@@ -122,8 +126,10 @@ def renderer_info() -> dict:
 
 def close() -> None:
     """Free the harness's OpenGL context (called automatically at exit)."""
+    from geomlib.render.context import inherited_context
+
     platform = _STATE.pop("platform", None)
-    if platform is not None:
+    if platform is not None and not inherited_context():  # a parent's context: freeing it would hang
         try:
             platform.delete_context()
         except Exception:  # the context may already be gone at interpreter shutdown

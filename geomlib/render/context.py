@@ -13,7 +13,15 @@ import sys
 
 import numpy as np
 
-__all__ = ["backend", "import_pyrender", "offscreen_renderer", "close"]
+__all__ = [
+    "backend",
+    "import_pyrender",
+    "offscreen_renderer",
+    "close",
+    "note_context_created",
+    "inherited_context",
+    "require_own_context",
+]
 
 _HEADLESS_FIX = (
     "install OSMesa (`sudo apt-get install libosmesa6` on Debian/Ubuntu), or a Mesa EGL driver "
@@ -78,6 +86,37 @@ def import_pyrender():
 
 _RENDERERS: dict[tuple[int, int], object] = {}
 
+#: The process that created this process's first OpenGL context (empty until one is created).
+_CONTEXT_OWNER: list[int] = []
+
+
+def note_context_created() -> None:
+    """Record that this process has created an OpenGL context (see :func:`inherited_context`)."""
+    if not _CONTEXT_OWNER:
+        _CONTEXT_OWNER.append(os.getpid())
+
+
+def inherited_context() -> bool:
+    """True in a process forked from one that had already created an OpenGL context.
+
+    Mesa's software rasteriser (llvmpipe, under OSMesa and EGL alike) draws with worker threads that
+    a fork does not copy: in the child, the inherited context and any new one wait for them forever
+    (measured: a 64x64 render that takes 0.06 s hangs). Such a process must not touch OpenGL;
+    :func:`geomlib.render.render` then draws in a fresh interpreter (:mod:`.fresh`).
+    """
+    return bool(_CONTEXT_OWNER) and _CONTEXT_OWNER[0] != os.getpid()
+
+
+def require_own_context(where: str) -> None:
+    """Raise a clear ``RuntimeError`` (naming ``where``) instead of hanging in an :func:`inherited_context`."""
+    if inherited_context():
+        raise RuntimeError(
+            f"{where}: this process was forked from one that had already rendered, and Mesa's OpenGL "
+            "does not survive a fork (its rasteriser threads stay behind, so any drawing would hang). "
+            "Render before forking, in a fresh process (multiprocessing's 'spawn'), or through "
+            "geomlib.render.render, which does that by itself."
+        )
+
 
 def offscreen_renderer(width: int, height: int):
     """The shared ``pyrender.OffscreenRenderer`` for this framebuffer size, created on first use.
@@ -88,8 +127,10 @@ def offscreen_renderer(width: int, height: int):
     Raises
     ------
     RuntimeError
-        When no headless OpenGL context can be created (the message names the fix).
+        When no headless OpenGL context can be created (the message names the fix), or in a process
+        forked after OpenGL was used (:func:`inherited_context`).
     """
+    require_own_context("geomlib.render.offscreen_renderer")
     r = _RENDERERS.get((width, height))
     if r is None:
         pyrender = import_pyrender()
@@ -101,11 +142,14 @@ def offscreen_renderer(width: int, height: int):
                 f"{os.environ.get('PYOPENGL_PLATFORM')!r} ({type(e).__name__}: {e}). Fix: {_HEADLESS_FIX}"
             ) from e
         _RENDERERS[(width, height)] = r
+        note_context_created()
     return r
 
 
 def close() -> None:
     """Free every cached OpenGL context (called automatically at exit)."""
+    if inherited_context():  # the parent's contexts: freeing them here would hang
+        _RENDERERS.clear()
     while _RENDERERS:
         _, r = _RENDERERS.popitem()
         try:

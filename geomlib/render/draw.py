@@ -13,7 +13,8 @@ import numpy as np
 from geomlib import topology
 from geomlib.halfedge import next_corners
 from geomlib.render.cameras import resolve_camera
-from geomlib.render.context import import_pyrender, offscreen_renderer
+from geomlib.render.context import import_pyrender, inherited_context, offscreen_renderer
+from geomlib.render.fresh import render_in_fresh_process
 from geomlib.render.lights import add_lights, light_specs
 from geomlib.render.options import RenderOptions, _as_rgb, _as_texture, check_options
 from geomlib.render.overlay import auto_wire_opacity, overlay
@@ -52,6 +53,8 @@ def render(V, F, options: RenderOptions | None = None, /, **overrides) -> np.nda
     **overrides
         Any field of :class:`RenderOptions` by name, e.g. ``wireframe=True, size=(320, 240)``.
     """
+    if inherited_context():  # forked after OpenGL was used: draw in a fresh interpreter (see .fresh)
+        return render_in_fresh_process("render", V, F, options, overrides)
     where = "render"
     o = RenderOptions.build(options, overrides, where)
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
@@ -87,6 +90,8 @@ def render_polygons(V, faces, options: RenderOptions | None = None, /, **overrid
         As for :func:`render`; ``face_colors`` has one row per polygon and flat shading uses one
         (Newell) normal per polygon.
     """
+    if inherited_context():
+        return render_in_fresh_process("render_polygons", V, faces, options, overrides)
     where = "render_polygons"
     o = RenderOptions.build(options, overrides, where)
     if isinstance(faces, tuple) and len(faces) == 2 and all(isinstance(a, np.ndarray) and a.ndim == 1 for a in faces):

@@ -30,6 +30,48 @@ def test_mesh_mismatch_writes_a_three_panel_picture(tmp_path, monkeypatch):
     assert img.shape[1] > 2.5 * img.shape[0] / 1.5 and img.std() > 10  # three panels side by side, not blank
 
 
+_PICTURE_AFTER_FIGURES = """
+import sys
+from pathlib import Path
+from geomlib import datasets, render
+from geomlib.grading import checks
+from geomlib.grading.errors import Mismatch
+
+V, F = datasets.icosphere(2)
+render.render(V, F, size=(64, 48))  # a figure first: this process now holds an OpenGL context
+bent = V.copy()
+bent[V[:, 2] > 0.5] *= 1.1
+ctx = checks.Context(label="loop_subdivide", lab="subdivision", case_id="ico", feedback_dir=Path("feedback"))
+try:
+    checks.MeshMatch()({"V": V, "F": F}, {"V": bent, "F": F}, ctx)
+except Mismatch as e:
+    print(e.feedback)
+"""
+
+
+@pytest.mark.render
+def test_a_picture_is_drawn_after_the_process_has_rendered(tmp_path):
+    """A notebook draws its figures, then grades: the picture's forked child cannot use the parent's
+    OpenGL (Mesa's threads stay behind) and draws through a fresh process instead of timing out."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_NO_FEEDBACK_PICTURES"}
+    proc = subprocess.run(
+        [sys.executable, "-c", _PICTURE_AFTER_FIGURES],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.strip() == "feedback/subdivision/ico.png", (proc.stdout, proc.stderr[-2000:])
+    img = image_io.read_image(tmp_path / "feedback/subdivision/ico.png")
+    assert img.std() > 10
+
+
 def test_image_mismatch_writes_a_difference_map(tmp_path):
     expected = np.zeros((32, 32, 3), np.uint8)
     got = expected.copy()

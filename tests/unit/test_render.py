@@ -321,3 +321,54 @@ def test_auto_wire_opacity_fades_with_screen_edge_length():
     V, F = datasets.icosphere(4)
     mid = auto_wire_opacity(V, topology.unique_edges(F), (320, 240))
     assert 0.0 < mid < 1.0
+
+
+# A process that has rendered, then forks (the grader's feedback pictures, a notebook that grades
+# after drawing figures): Mesa's rasteriser threads stay in the parent, so the child must not touch
+# OpenGL. Run in a fresh interpreter so the parent has certainly rendered, whatever ran before.
+_FORK_AFTER_RENDER = """
+import os, pickle, sys
+import numpy as np
+from geomlib import render as R
+from geomlib import gl
+from geomlib.render import context
+from geomlib.validate import MeshError
+
+V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+parent = R.render(V, F, size=(48, 40))
+r, w = os.pipe()
+pid = os.fork()
+if pid == 0:
+    out = {"inherited": context.inherited_context()}
+    out["same"] = bool(np.array_equal(R.render(V, F, size=(48, 40)), parent))
+    out["polygons"] = R.render_polygons(V, [[0, 2, 1], [0, 1, 3, 2]], size=(48, 40)).shape
+    for name, call in [("bad", lambda: R.render(V, F[:, :2])), ("direct", lambda: context.offscreen_renderer(8, 8)),
+                       ("gl", lambda: gl.renderer_info())]:
+        try:
+            call()
+            out[name] = "no error"
+        except Exception as e:
+            out[name] = (type(e).__name__, str(e))
+    os.write(w, pickle.dumps(out))
+    os._exit(0)
+os.close(w)
+data = b"".join(iter(lambda: os.read(r, 1 << 16), b""))
+os.waitpid(pid, 0)
+sys.stdout.buffer.write(data)
+"""
+
+
+@pytest.mark.render
+def test_a_process_forked_after_rendering_renders_in_a_fresh_one():
+    import pickle
+
+    proc = subprocess.run([sys.executable, "-c", _FORK_AFTER_RENDER], capture_output=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr.decode()[-2000:]
+    out = pickle.loads(proc.stdout)
+    assert out["inherited"] is True
+    assert out["same"], "the image drawn in the fresh process differs from the parent's"
+    assert out["polygons"] == (40, 48, 3)
+    assert out["bad"][0] == "MeshError" and "(m, 3)" in out["bad"][1]  # the entry point's own error, not a pipe's
+    for name in ("direct", "gl"):  # raw GL in the child: a clear error instead of a hang
+        assert out[name][0] == "RuntimeError" and "does not survive a fork" in out[name][1], out[name]
