@@ -1,5 +1,6 @@
 """The layering: library modules never import the course tooling (``geomlib.grading``) or pytest,
-and the tooling a student needs to grade locally imports without pytest."""
+the tooling a student needs to grade locally imports without pytest, and no package has an
+import cycle."""
 
 from __future__ import annotations
 
@@ -75,3 +76,90 @@ def test_the_grading_tooling_imports_without_pytest():
     p = _run(code)
     assert p.returncode == 0, p.stderr
     assert p.stdout.strip() == "ok True"
+
+
+def _module_level_imports(path: Path, name: str, known: set[str]) -> set[str]:
+    """The modules of ``known`` that module ``name`` (file ``path``) imports when it is imported:
+    its top-level imports, in ``try``/``if`` blocks too, but not under ``if TYPE_CHECKING`` and not
+    inside functions (a lazy import runs later and cannot close a cycle at import time)."""
+    import ast
+
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    out = set()
+
+    def visit(stmts):
+        for s in stmts:
+            if isinstance(s, ast.If) and "TYPE_CHECKING" in ast.unparse(s.test):
+                visit(s.orelse)
+            elif isinstance(s, (ast.If, ast.Try)):
+                visit(s.body)
+                visit(getattr(s, "orelse", []))
+                for h in getattr(s, "handlers", []):
+                    visit(h.body)
+                visit(getattr(s, "finalbody", []))
+            elif isinstance(s, ast.Import):
+                out.update(a.name for a in s.names)
+            elif isinstance(s, ast.ImportFrom):
+                base = s.module or ""
+                if s.level:
+                    parts = package.split(".")
+                    base = ".".join(parts[: len(parts) - s.level + 1] + ([s.module] if s.module else []))
+                for a in s.names:
+                    out.add(f"{base}.{a.name}" if f"{base}.{a.name}" in known else base)
+
+    visit(ast.parse(path.read_text(encoding="utf-8")).body)
+    return {m for m in out if m in known and m != name}
+
+
+def import_cycles(root: Path, top: str) -> list[list[str]]:
+    """The import cycles among the modules of package ``top`` under ``root`` (strongly connected
+    components of the module-level import graph with more than one module)."""
+    files = {}
+    for p in sorted((root / top).rglob("*.py")):
+        rel = p.relative_to(root).with_suffix("")
+        parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+        files[".".join(parts)] = p
+    graph = {n: _module_level_imports(p, n, set(files)) for n, p in files.items()}
+    index, low, stack, on, cycles = {}, {}, [], set(), []
+
+    def strong(v):  # Tarjan's algorithm
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                strong(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in graph:
+        if v not in index:
+            strong(v)
+    return cycles
+
+
+def test_no_import_cycles_in_the_library_the_tooling_or_the_labs():
+    for top in ("geomlib", "solutions", "labs"):
+        assert import_cycles(ROOT, top) == [], top
+
+
+def test_a_planted_import_cycle_is_found(tmp_path):
+    pkg = tmp_path / "pkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from pkg import b\n")
+    (pkg / "b.py").write_text("from .c import x\n")
+    (pkg / "c.py").write_text("import pkg.a\nx = 1\n")
+    (pkg / "d.py").write_text("def f():\n    from pkg import a  # lazy: no cycle\n")
+    assert import_cycles(tmp_path, "pkg") == [["pkg.a", "pkg.b", "pkg.c"]]
