@@ -13,6 +13,7 @@ Loaded by ``tests/conftest.py``. A graded test lives in ``tests/graded/<lab>/`` 
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from pathlib import Path
 
@@ -26,6 +27,7 @@ from geomlib.grading.sandbox import LabProxy
 
 #: Records of the most recent run in this process (read by ``geomlib grade``).
 RECORDS: list[Record] = []
+_RECORD_KEY = "geomlib_graded_record"
 
 
 def pytest_addoption(parser):
@@ -149,23 +151,37 @@ def pytest_runtest_makereport(item, call):
         # An assertion in a graded test or an error in the grader: show the short reason, not a traceback.
         passed = False
         message = f"{type(exc).__name__}: {exc}" if exc is not None else str(rep.longrepr)[-800:]
-    RECORDS.append(
-        Record(
-            nodeid=item.nodeid,
-            lab=_lab_of(item.path) or "?",
-            part=marker.kwargs.get("part", "other"),
-            name=_display_name(item),
-            points=float(marker.kwargs.get("points", 0)),
-            visibility=marker.kwargs.get("visibility", "visible"),
-            passed=passed,
-            message=sandbox.clean_text(message),
-            duration=getattr(rep, "duration", 0.0),
-            not_implemented=isinstance(exc, NotImplementedYet),
-            picture=getattr(exc, "feedback", None) if isinstance(exc, GradingFailure) else None,
-            error=exc is not None
-            and (isinstance(exc, GraderError) or not isinstance(exc, GradingFailure | AssertionError)),
+    # The record travels on the report: with pytest-xdist the report reaches the controlling process
+    # (which prints the score table) from a worker, and only what the report carries comes along.
+    rep.user_properties.append(
+        (
+            _RECORD_KEY,
+            dataclasses.asdict(
+                Record(
+                    nodeid=item.nodeid,
+                    lab=_lab_of(item.path) or "?",
+                    part=marker.kwargs.get("part", "other"),
+                    name=_display_name(item),
+                    points=float(marker.kwargs.get("points", 0)),
+                    visibility=marker.kwargs.get("visibility", "visible"),
+                    passed=passed,
+                    message=sandbox.clean_text(message),
+                    duration=getattr(rep, "duration", 0.0),
+                    not_implemented=isinstance(exc, NotImplementedYet),
+                    picture=getattr(exc, "feedback", None) if isinstance(exc, GradingFailure) else None,
+                    error=exc is not None
+                    and (isinstance(exc, GraderError) or not isinstance(exc, GradingFailure | AssertionError)),
+                )
+            ),
         )
     )
+
+
+def pytest_runtest_logreport(report):
+    """Keep the graded record a report carries (see :func:`pytest_runtest_makereport`)."""
+    for key, value in report.user_properties:
+        if key == _RECORD_KEY:
+            RECORDS.append(Record(**value))
 
 
 def score_table(records: list[Record]) -> str:

@@ -172,6 +172,35 @@ def test_plain_pytest_shows_the_message_not_a_traceback(sample_course, tmp_path)
     assert "graded score" in out
 
 
+def test_the_score_table_is_the_same_with_pytest_xdist(sample_course, tmp_path):
+    """`./run tests` runs the whole suite on every core (pytest-xdist): the graded records travel on
+    the reports from the workers, so the score table is printed there too, and is the same."""
+    import importlib.util
+    import re
+    import subprocess
+    import sys
+
+    if importlib.util.find_spec("xdist") is None:
+        pytest.skip("pytest-xdist is not installed (a dev dependency)")
+    wrong = GOOD_OPS.replace("return c + s * (V - c)", "return s * V")
+    sub = _submission(tmp_path, wrong)
+    tables = []
+    for extra in ([], ["-n", "2"]):
+        p = subprocess.run(
+            [sys.executable, "-m", "pytest", "tests/graded/sample", f"--impl={sub}", "-p", "no:cacheprovider", *extra],
+            cwd=sample_course,
+            capture_output=True,
+            text=True,
+            env={**__import__("os").environ, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"},
+        )
+        m = re.search(r"=+ graded score =+\n(.*?\ntotal[^\n]*)", p.stdout, re.S)
+        assert m, p.stdout[-3000:]
+        tables.append(m.group(1))
+    assert tables[0] == tables[1]
+    score, out_of = map(float, re.search(r"total\s+([\d.]+) / ([\d.]+)", tables[0]).groups())
+    assert 0 < score < out_of  # the wrong submission passes some tests and fails others
+
+
 def test_refs_check_detects_a_changed_solution(sample_course, tmp_path):
     copy = tmp_path / "course"
     shutil.copytree(sample_course, copy)
