@@ -49,9 +49,10 @@ __all__ = [
     "write_index",
     "lab_package",
     "missing_task_figure",
-    "lab_figures",
-    "lab_view",
     "figures_or_placeholders",
+    "figure_name",
+    "partial_figure",
+    "lab_figure_makers",
 ]
 
 
@@ -731,33 +732,183 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
     return figures
 
 
-def lab_figures(builders, out_dir, lab_name: str, *args) -> list[Figure]:
-    """The body of a lab's ``make_figures``: create ``out_dir``, then :func:`figures_or_placeholders`.
+def figure_name(name: str):
+    """Decorator: the file name (without suffix) a figure builder writes.
+
+    :func:`figures_or_placeholders` writes a builder's "Task N not implemented yet" picture to
+    ``<name>.png``, so a student's unfinished figure sits where the finished one will be.
+
+    Examples
+    --------
+    >>> @figure_name("loop_levels")
+    ... def fig_levels(out, lab, quick): ...
+    >>> fig_levels.figure_name
+    'loop_levels'
+    """
+
+    def mark(build):
+        build.figure_name = name
+        return build
+
+    return mark
+
+
+def partial_figure(build, missing: list[str]):
+    """Wrap a figure builder that draws grey panels for missing tasks instead of stopping.
+
+    Some figures still show what they can when one of their panels needs a task that is not
+    implemented yet: the builder draws a stand-in panel and appends the task's label (``"3"``,
+    ``"1a"``) to ``missing``. The wrapped builder empties ``missing``, draws, and where panels were
+    left out starts every caption with ``"Task N not implemented yet; the other panels show: "``
+    (``N`` the first missing task), so the figure index says what is missing.
 
     Parameters
     ----------
-    builders : sequence of callables
-        ``build(out_dir, *args)``, as for :func:`figures_or_placeholders`.
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
+    build : callable
+        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them.
+    missing : list of str
+        The list the builder's stand-in panels append to.
+
+    Returns
+    -------
+    callable
+        ``drawn(out_dir, *args) -> list of Figure``, with ``build``'s ``figure_name`` and name.
+    """
+
+    def drawn(out_dir, *args) -> list[Figure]:
+        missing.clear()
+        out = build(out_dir, *args)
+        figs = out if isinstance(out, list) else [out]
+        if missing:
+            head = f"Task {missing[0]} not implemented yet; the other panels show: "
+            figs = [Figure(f.path, head + f.caption, f.lab) for f in figs]
+        return figs
+
+    drawn.__name__ = build.__name__
+    drawn.figure_name = getattr(build, "figure_name", None)
+    return drawn
+
+
+_MAKE_FIGURES_DOC = """Render the lab's figures into ``out_dir`` and return them with their captions.
+
+Parameters
+----------
+out_dir : str or Path
+    Folder for the PNG files (created if missing).
+lab : module, optional
+    {lab_doc}
+quick : bool
+    {quick}
+
+Returns
+-------
+list of Figure
+    Every figure; one whose tasks are not implemented yet is a picture saying
+    "Task N not implemented yet" (under the same file name).
+"""
+
+_MAKE_VIEW_DOC = """Write ``{page}``, the lab's interactive 3D view (:mod:`geomlib.viewer`), into ``out_dir``.
+
+Open the page in a browser and turn the result with the mouse; ``geomlib figures`` shows it in
+the index.
+
+Parameters
+----------
+out_dir : str or Path
+    Folder for the page (created if missing).
+lab : module, optional
+    {lab_doc}
+quick : bool
+    {quick}
+
+Returns
+-------
+Figure
+    The page; before the tasks it needs are implemented, a "Task N not implemented yet" picture
+    (``{stem}.png``) instead.
+"""
+
+
+def lab_figure_makers(
+    lab_name: str, module: str, builders, view, *, quick: str, shared: dict | None = None, draws_lab: bool = True
+):
+    """A lab's ``make_figures`` and ``make_view``, built the same way for every lab.
+
+    Every lab's ``figures.py`` ends with::
+
+        make_figures, make_view = lab_figure_makers(LAB, __name__, (fig_a, fig_b), fig_view, quick="...")
+
+    and so offers ``make_figures(out_dir, lab=None, quick=False) -> list[Figure]`` and
+    ``make_view(out_dir, lab=None, quick=False) -> Figure`` with full docstrings. Both create
+    ``out_dir``, resolve ``lab`` with :func:`lab_package` (a module of the lab's functions; None: the
+    package ``module`` is in, so in ``labs/<lab>/`` the student's own code) and run the builders
+    through :func:`figures_or_placeholders`, so a figure whose task is missing becomes a
+    "Task N not implemented yet" picture under its own name (:func:`figure_name`).
+
+    Parameters
+    ----------
     lab_name : str
-    *args
-        Passed on to every builder (typically the lab module from :func:`lab_package`, and ``quick``).
+        The lab (``"subdivision"``): the figures' ``lab`` and the package named in the docstrings.
+    module : str
+        ``__name__`` of the figures module (``"solutions.subdivision.figures"``): where the made
+        functions say they live, and whose package is the default ``lab``.
+    builders : sequence of callables
+        The figures, in order: ``build(out_dir, L, quick)`` with ``L`` the lab module (or
+        ``build(out_dir, quick)`` when ``draws_lab`` is False), returning a :class:`Figure` or a list.
+    view : callable
+        The builder of the interactive 3D page (same arguments); its ``figure_name`` is the page's
+        file name without ``.html``.
+    quick : str
+        What ``quick=True`` makes smaller (one sentence, for the docstrings).
+    shared : dict, optional
+        Results the builders share across figures (a mesh several figures draw); emptied before
+        and after every call, so no call sees another lab module's results.
+    draws_lab : bool
+        False for a lab whose figures call the package they sit in directly (``lab`` is then
+        checked but not used, and the docstrings say so).
+
+    Returns
+    -------
+    (make_figures, make_view)
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders(builders, out, lab_name, *args)
+    package = module.rpartition(".")[0]
+    if draws_lab:
+        lab_doc = (
+            f"The lab package whose functions the figures draw (``solutions.{lab_name}``, ``labs.{lab_name}``, a\n"
+            f"    submission); default: the package this file is in, so in ``labs/{lab_name}/`` your own code."
+        )
+    else:
+        lab_doc = (
+            "Not used: the figures draw the functions of the package this file is in (so in\n"
+            f"    ``labs/{lab_name}/`` your own code); a value other than None must still be a module."
+        )
 
+    def run(chosen, out_dir, lab, quick_: bool) -> list[Figure]:
+        L = lab_package(lab, package)
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        args = (L, quick_) if draws_lab else (quick_,)
+        if shared is not None:
+            shared.clear()
+        try:
+            return figures_or_placeholders(chosen, out, lab_name, *args)
+        finally:
+            if shared is not None:
+                shared.clear()
 
-def lab_view(builder, out_dir, lab_name: str, *args) -> Figure:
-    """The body of a lab's ``make_view``: write its interactive 3D view (:mod:`geomlib.viewer`).
+    def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
+        return run(builders, out_dir, lab, quick)
 
-    ``builder(out_dir, *args)`` writes ``<lab>_3d.html`` into ``out_dir`` (created if missing) and
-    returns its :class:`Figure`. Open the page in a browser and turn the result with the mouse;
-    ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the figure
-    returned is a "Task N not implemented yet" picture instead.
-    """
-    return lab_figures((builder,), out_dir, lab_name, *args)[0]
+    def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+        return run((view,), out_dir, lab, quick)[0]
+
+    stem = getattr(view, "figure_name", None) or f"{lab_name}_3d"
+    make_figures.__doc__ = _MAKE_FIGURES_DOC.format(lab_doc=lab_doc, quick=quick)
+    make_view.__doc__ = _MAKE_VIEW_DOC.format(lab_doc=lab_doc, quick=quick, page=f"{stem}.html", stem=stem)
+    for fn in (make_figures, make_view):
+        fn.__module__ = module
+        fn.__qualname__ = fn.__name__
+    return make_figures, make_view
 
 
 # --------------------------------------------------------------------------------------------
