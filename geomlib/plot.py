@@ -38,6 +38,7 @@ from geomlib.validate import MeshError, as_array, as_image, check_float, check_i
 
 __all__ = [
     "Figure",
+    "MeshView",
     "to_rgb8",
     "panels",
     "colorbar",
@@ -77,6 +78,30 @@ class Figure:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))
+
+
+class MeshView:
+    """What a lab's interactive 3D page shows: a mesh, optional per-vertex scalars, and the caption.
+
+    A lab's view builder returns one; :func:`lab_figure_makers` writes it with
+    :func:`geomlib.viewer.write_html` under the builder's :func:`figure_name` (``<lab>_3d.html``).
+
+    Parameters
+    ----------
+    V : (n, 3) array_like
+        Vertex positions.
+    faces : (m, 3) array_like
+        Triangles.
+    scalars : (n,) array_like, optional
+        Per-vertex values coloured with ``cmap``.
+    caption : str
+        One or two sentences saying what the page shows (the index prints it under the frame).
+    **options
+        Passed on to :func:`geomlib.viewer.html_page` (``title``, ``up``, ``cmap``, ``scalar_name``, ...).
+    """
+
+    def __init__(self, V, faces, scalars=None, *, caption: str, **options):
+        self.V, self.faces, self.scalars, self.caption, self.options = V, faces, scalars, caption, options
 
 
 # --------------------------------------------------------------------------------------------
@@ -856,8 +881,8 @@ def lab_figure_makers(
         The figures, in order: ``build(out_dir, L, quick)`` with ``L`` the lab module (or
         ``build(out_dir, quick)`` when ``draws_lab`` is False), returning a :class:`Figure` or a list.
     view : callable
-        The builder of the interactive 3D page (same arguments); its ``figure_name`` is the page's
-        file name without ``.html``.
+        The interactive 3D page: ``view(L, quick)`` (or ``view(quick)``) returning a :class:`MeshView`,
+        written to ``<figure_name>.html`` (:func:`figure_name`; default ``<lab>_3d``).
     quick : str
         What ``quick=True`` makes smaller (one sentence, for the docstrings).
     shared : dict, optional
@@ -899,10 +924,19 @@ def lab_figure_makers(
     def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
         return run(builders, out_dir, lab, quick)
 
-    def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-        return run((view,), out_dir, lab, quick)[0]
-
     stem = getattr(view, "figure_name", None) or f"{lab_name}_3d"
+
+    @figure_name(stem)
+    def page(out_dir: Path, *args) -> Figure:
+        from geomlib.viewer import write_html
+
+        shown = view(*args)
+        path = write_html(out_dir / f"{stem}.html", shown.V, shown.faces, shown.scalars, **shown.options)
+        return Figure(path, shown.caption, lab_name)
+
+    def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
+        return run((page,), out_dir, lab, quick)[0]
+
     make_figures.__doc__ = _MAKE_FIGURES_DOC.format(lab_doc=lab_doc, quick=quick)
     make_view.__doc__ = _MAKE_VIEW_DOC.format(lab_doc=lab_doc, quick=quick, page=f"{stem}.html", stem=stem)
     for fn in (make_figures, make_view):

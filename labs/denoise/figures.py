@@ -16,6 +16,7 @@ from geomlib import datasets
 from geomlib.geometry import vertex_normals
 from geomlib.plot import (
     Figure,
+    MeshView,
     colorbar,
     figure_name,
     heat_colors,
@@ -27,7 +28,6 @@ from geomlib.plot import (
     with_colorbar,
 )
 from geomlib.render import camera_pose, render
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view"]
 
@@ -254,21 +254,17 @@ def fig_seam(out: Path, L, quick: bool) -> Figure:
 
 
 @figure_name("denoise_3d")
-def fig_view(out: Path, L, quick: bool) -> Figure:
+def fig_view(L, quick: bool) -> MeshView:
     V, F = datasets.torus(n_major=64, n_minor=32)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
     X = L.denoise_vertices(Vn, F, N, 0.7)
     err = 100 * np.asarray(L.surface_error(V, F, X))
-    path = write_html(
-        out / "denoise_3d.html", X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
+    return MeshView(
+        X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
         cmap=CMAP, scalar_name="% of diagonal",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
+        caption="Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
         "to the clean surface (% of the bounding-box diagonal).",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

@@ -20,9 +20,18 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.plot import Figure, colorbar, figure_name, heat_colors, lab_figure_makers, line_plot, panels, save_png
+from geomlib.plot import (
+    Figure,
+    MeshView,
+    colorbar,
+    figure_name,
+    heat_colors,
+    lab_figure_makers,
+    line_plot,
+    panels,
+    save_png,
+)
 from geomlib.render import render
-from geomlib.viewer import write_html
 
 __all__ = [
     "make_figures",
@@ -444,23 +453,20 @@ def fig_operations(out: Path, R, quick: bool) -> Figure:
 
 
 @figure_name("remeshing_3d")
-def fig_view(out: Path, R, quick: bool) -> Figure:
+def fig_view(R, quick: bool) -> MeshView:
     V, F = metaball_bunny(48 if quick else 64)
     L = 0.08 if quick else 0.06
     U, G = R.isotropic_remesh(V, F, L, iterations=5 if quick else 10)
     U, G = np.asarray(U, float), np.asarray(G)
     H = topology.halfedge_mesh(G, len(U))
     dev = np.abs(H.valence - np.where(H.boundary_vertex, 4, 6)).astype(float)
-    path = write_html(
-        out / "remeshing_3d.html", U, G, dev, title=f"Remeshed bunny (L = {L})",
+    return MeshView(
+        U, G, dev, title=f"Remeshed bunny (L = {L})",
         cmap="viridis", scalar_name="|valence - 6|",
-    )  # fmt: skip
-    return Figure(
-        path,
-        f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far its "
+        caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far "
+        "its "
         "valence is from 6 (0: regular).",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

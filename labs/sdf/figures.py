@@ -18,6 +18,7 @@ import numpy as np
 from geomlib import camera, datasets, raster
 from geomlib.plot import (
     Figure,
+    MeshView,
     colorbar,
     figure_name,
     heatmap_image,
@@ -26,7 +27,6 @@ from geomlib.plot import (
     partial_figure,
     save_png,
 )
-from geomlib.viewer import write_html
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
 from .bricks import EMPTY_INSIDE, compress_bricks
@@ -427,21 +427,17 @@ def fig_ao_push(out: Path, quick: bool) -> Figure:
 
 
 @figure_name("sdf_3d")
-def fig_view(out: Path, quick: bool) -> Figure:
+def fig_view(quick: bool) -> MeshView:
     V, F, grid = _torus_grid(quick)
     bricks = compress_bricks(grid, band_voxels=4)
     # On the surface the exact distance is 0, so what the bricks return there is their error.
     err = np.abs(np.asarray(bricks.sample(V))) / bricks.step
-    path = write_html(
-        out / "sdf_3d.html", V, F, err, title="Brick SDF on the torus surface", up="z",
+    return MeshView(
+        V, F, err, title="Brick SDF on the torus surface", up="z",
         cmap="viridis", scalar_name="|d| in quantisation steps",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: the torus, each vertex coloured by the distance the 8-bit brick field returns there "
+        caption="Turn it: the torus, each vertex coloured by the distance the 8-bit brick field returns there "
         "(exactly 0 on the surface), in quantisation steps: trilinear lookups of stored samples.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 #: The figures in order; one drawn without some of its panels names the missing task in its caption.

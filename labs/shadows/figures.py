@@ -14,6 +14,7 @@ import numpy as np
 
 from geomlib.plot import (
     Figure,
+    MeshView,
     colorbar,
     figure_name,
     heatmap_image,
@@ -22,7 +23,6 @@ from geomlib.plot import (
     save_png,
     with_colorbar,
 )
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view"]
 
@@ -282,7 +282,7 @@ def _refine_soup(V: np.ndarray, F: np.ndarray, n: int) -> tuple[np.ndarray, np.n
 
 
 @figure_name("shadows_3d")
-def fig_view(out: Path, L, quick: bool) -> Figure:
+def fig_view(L, quick: bool) -> MeshView:
     scene = L.classic_scene()
     V, F = _refine_soup(scene.V, scene.F, 3 if quick else 5)
     M = L.light_setup(scene, L.CLASSIC_LIGHT).matrices[0]
@@ -291,17 +291,14 @@ def fig_view(out: Path, L, quick: bool) -> Figure:
     N = np.cross(e1, e2)
     N /= np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
     vis = L.shadow_visibility(V[F].mean(axis=1), N, D, M, pcf=3)
-    path = write_html(
-        out / "shadows_3d.html", V, F, vis, title="Classic scene: light visibility per face", up="z",
+    return MeshView(
+        V, F, vis, title="Classic scene: light visibility per face", up="z",
         cmap="gray", clim=(0.0, 1.0), edges=False, scalar_name="visibility",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: every face of the classic scene coloured by the visibility of the directional light your shadow "
+        caption="Turn it: every face of the classic scene coloured by the visibility of the directional light your "
+        "shadow "
         "map gives (1 lit, 0 in shadow, 1024 x 1024 map, 3 x 3 PCF): the shadows stay attached to their casters "
         "from every side.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

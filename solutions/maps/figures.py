@@ -13,9 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, figure_name, lab_figure_makers, panels, save_png
+from geomlib.plot import Figure, MeshView, figure_name, lab_figure_makers, panels, save_png
 from geomlib.textures import triangle_atlas
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]
 
@@ -236,18 +235,17 @@ def _fig_bake(out: Path, L, quick: bool) -> list[Figure]:
 
 
 @figure_name("maps_3d")
-def _fig_view(out: Path, L, quick: bool) -> Figure:
+def _fig_view(L, quick: bool) -> MeshView:
     R, r, lam = 1.0, 0.4, 0.045
     s = 128 if quick else 256
     H = bump_tiles(s, 24, 8)
     Vd0, Fd, UVd = datasets.uv_torus(*((144, 48) if quick else (288, 96)), R, r)
     Vd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
-    path = write_html(out / "maps_3d.html", Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False)
-    return Figure(
-        path,
-        f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map imitates.",
-        LAB,
-    )
+    return MeshView(
+        Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False,
+        caption=f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map "
+        "imitates.",
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

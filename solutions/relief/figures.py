@@ -19,6 +19,7 @@ import numpy as np
 from geomlib import camera, datasets
 from geomlib.plot import (
     Figure,
+    MeshView,
     colorbar,
     figure_name,
     heatmap_image,
@@ -29,7 +30,6 @@ from geomlib.plot import (
     save_png,
 )
 from geomlib.raster import rasterize
-from geomlib.viewer import write_html
 
 from .bump import bump_normal
 from .heights import bricks, bumps
@@ -402,7 +402,7 @@ def _fig_silhouette(out: Path, quick: bool) -> Figure:
 
 
 @figure_name("relief_3d")
-def fig_view(out: Path, quick: bool) -> Figure:
+def fig_view(quick: bool) -> MeshView:
     H = bricks(64 if quick else 128)
     s = H.shape[0]
     Vg, F = datasets.grid_patch(s - 1)
@@ -413,17 +413,14 @@ def fig_view(out: Path, quick: bool) -> Figure:
     V[:, 2] = -SCALE * (1 - H[r, c])  # the relief lies below the polygon
     n = bump_normal(H, V[:, :2], strength=SCALE)
     tilt = np.degrees(np.arccos(np.clip(n[:, 2] / np.linalg.norm(n, axis=1), -1, 1)))
-    path = write_html(
-        out / "relief_3d.html", V, F, tilt, title="Bricks as real geometry", up="z",
+    return MeshView(
+        V, F, tilt, title="Bricks as real geometry", up="z",
         cmap="viridis", scalar_name="bump-normal tilt (degrees)",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured by "
+        caption="Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured "
+        "by "
         "how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
         "this relief on one flat quad; seen edge-on, that quad's silhouette stays a straight line.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 #: The figures in order; one drawn without some of its panels names the missing task in its caption.

@@ -13,9 +13,18 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import closest_points, mesh_distance
-from geomlib.plot import Figure, colorbar, figure_name, heat_colors, lab_figure_makers, line_plot, panels, save_png
+from geomlib.plot import (
+    Figure,
+    MeshView,
+    colorbar,
+    figure_name,
+    heat_colors,
+    lab_figure_makers,
+    line_plot,
+    panels,
+    save_png,
+)
 from geomlib.render import render
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "airplane", "cracked_sheet"]
 
@@ -229,22 +238,19 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
 
 
 @figure_name("simplification_3d")
-def fig_view(out: Path, lab, quick: bool) -> Figure:
+def fig_view(lab, quick: bool) -> MeshView:
     qem_simplify = _simplify(lab)
     V, F = airplane()
     U, G = qem_simplify(V, F, max(4, round(0.1 * len(F))))
     U, G = np.asarray(U), np.asarray(G)
     err = 100 * np.sqrt(closest_points(V, F, U)[0]) / float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-    path = write_html(
-        out / "simplification_3d.html", U, G, err, title="QEM: the airplane at 10% of its faces", up="z",
+    return MeshView(
+        U, G, err, title="QEM: the airplane at 10% of its faces", up="z",
         cmap=CMAP, scalar_name="% of diagonal",
-    )  # fmt: skip
-    return Figure(
-        path,
-        f"Turn it: the airplane simplified to {len(G):,} faces, each vertex coloured by its distance to the input "
+        caption=f"Turn it: the airplane simplified to {len(G):,} faces, each vertex coloured by its distance to the "
+        "input "
         "surface (% of the bounding-box diagonal).",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

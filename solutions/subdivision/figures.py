@@ -14,6 +14,7 @@ import numpy as np
 from geomlib import datasets, topology
 from geomlib.plot import (
     Figure,
+    MeshView,
     colorbar,
     figure_name,
     heat_colors,
@@ -24,7 +25,6 @@ from geomlib.plot import (
     with_colorbar,
 )
 from geomlib.render import camera_pose, render, render_polygons
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "airplane"]
 
@@ -246,20 +246,17 @@ def fig_convergence(out: Path, lab, quick: bool) -> Figure:
 
 
 @figure_name("subdivision_3d")
-def fig_view(out: Path, lab, quick: bool) -> Figure:
+def fig_view(lab, quick: bool) -> MeshView:
     loop_subdivide, _ = _functions(lab)
     V, F = airplane()
     levels = 1 if quick else 2
     Vs, Fs = loop_subdivide(V, F, levels=levels)
-    path = write_html(
-        out / "subdivision_3d.html", Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z"
-    )
-    return Figure(
-        path,
-        f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are open "
+    return MeshView(
+        Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z",
+        caption=f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are "
+        "open "
         "sheets, and their boundary edges stay sharp and straight.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(

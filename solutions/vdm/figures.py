@@ -18,8 +18,17 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.plot import Figure, colorbar, figure_name, lab_figure_makers, line_plot, panels, save_png, with_colorbar
-from geomlib.viewer import write_html
+from geomlib.plot import (
+    Figure,
+    MeshView,
+    colorbar,
+    figure_name,
+    lab_figure_makers,
+    line_plot,
+    panels,
+    save_png,
+    with_colorbar,
+)
 
 __all__ = ["make_figures", "make_view"]
 
@@ -304,17 +313,15 @@ def _background_sweep(out: Path, L, quick: bool) -> Figure:
 
 
 @figure_name("vdm_3d")
-def _fig_view(out: Path, L, quick: bool) -> Figure:
+def _fig_view(L, quick: bool) -> MeshView:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 32 if quick else 64
     Vr, Fr = L.vdm_to_mesh(L.bake_vdm(V, F, res, UV=L.parameterize_square(V, F)))
-    path = write_html(out / "vdm_3d.html", Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z")
-    return Figure(
-        path,
-        f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
+    return MeshView(
+        Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z",
+        caption=f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
         "gather on the crease of the plinth and follow it.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
 make_figures, make_view = lab_figure_makers(
