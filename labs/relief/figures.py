@@ -17,18 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heatmap_image,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    partial_figure,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
 
 from .bump import bump_normal
@@ -417,8 +407,7 @@ def fig_view(quick: bool) -> MeshView:
         V, F, tilt, title="Bricks as real geometry", up="z",
         cmap="viridis", scalar_name="bump-normal tilt (degrees)",
         caption="Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured "
-        "by "
-        "how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
+        "by how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
         "this relief on one flat quad; seen edge-on, that quad's silhouette stays a straight line.",
     )  # fmt: skip
 

@@ -20,17 +20,8 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heat_colors,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
 from geomlib.render import render
 
 __all__ = [
@@ -464,8 +455,7 @@ def fig_view(R, quick: bool) -> MeshView:
         U, G, dev, title=f"Remeshed bunny (L = {L})",
         cmap="viridis", scalar_name="|valence - 6|",
         caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far "
-        "its "
-        "valence is from 6 (0: regular).",
+        "its valence is from 6 (0: regular).",
     )  # fmt: skip
 
 

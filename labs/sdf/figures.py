@@ -16,17 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets, raster
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heatmap_image,
-    lab_figure_makers,
-    panels,
-    partial_figure,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
 from .bricks import EMPTY_INSIDE, compress_bricks

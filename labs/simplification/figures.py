@@ -13,17 +13,8 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import closest_points, mesh_distance
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heat_colors,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
 from geomlib.render import render
 
 __all__ = ["make_figures", "make_view", "airplane", "cracked_sheet"]
@@ -248,8 +239,7 @@ def fig_view(lab, quick: bool) -> MeshView:
         U, G, err, title="QEM: the airplane at 10% of its faces", up="z",
         cmap=CMAP, scalar_name="% of diagonal",
         caption=f"Turn it: the airplane simplified to {len(G):,} faces, each vertex coloured by its distance to the "
-        "input "
-        "surface (% of the bounding-box diagonal).",
+        "input surface (% of the bounding-box diagonal).",
     )  # fmt: skip
 
 

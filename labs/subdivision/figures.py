@@ -12,18 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heat_colors,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png, with_colorbar
 from geomlib.render import camera_pose, render, render_polygons
 
 __all__ = ["make_figures", "make_view", "airplane"]
@@ -254,8 +244,7 @@ def fig_view(lab, quick: bool) -> MeshView:
     return MeshView(
         Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z",
         caption=f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are "
-        "open "
-        "sheets, and their boundary edges stay sharp and straight.",
+        "open sheets, and their boundary edges stay sharp and straight.",
     )  # fmt: skip
 
 

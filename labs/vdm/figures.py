@@ -18,17 +18,8 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, line_plot, panels, save_png, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
 

@@ -14,19 +14,8 @@ import numpy as np
 
 from geomlib import datasets
 from geomlib.geometry import vertex_normals
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heat_colors,
-    heatmap_image,
-    lab_figure_makers,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, heatmap_image, line_plot, panels, save_png, with_colorbar
 from geomlib.render import camera_pose, render
 
 __all__ = ["make_figures", "make_view"]

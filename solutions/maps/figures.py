@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, MeshView, figure_name, lab_figure_makers, panels, save_png
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, panels, save_png
 from geomlib.textures import triangle_atlas
 
 __all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]

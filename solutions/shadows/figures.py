@@ -12,17 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geomlib.plot import (
-    Figure,
-    MeshView,
-    colorbar,
-    figure_name,
-    heatmap_image,
-    lab_figure_makers,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
 
@@ -295,8 +286,7 @@ def fig_view(L, quick: bool) -> MeshView:
         V, F, vis, title="Classic scene: light visibility per face", up="z",
         cmap="gray", clim=(0.0, 1.0), edges=False, scalar_name="visibility",
         caption="Turn it: every face of the classic scene coloured by the visibility of the directional light your "
-        "shadow "
-        "map gives (1 lit, 0 in shadow, 1024 x 1024 map, 3 x 3 PCF): the shadows stay attached to their casters "
+        "shadow map gives (1 lit, 0 in shadow, 1024 x 1024 map, 3 x 3 PCF): the shadows stay attached to their casters "
         "from every side.",
     )  # fmt: skip
 
