@@ -1,8 +1,8 @@
 """Figure helpers: image panels with captions, colour maps and bars, line plots, deterministic PNGs.
 
-Longer than most modules (about 850 lines) on purpose: it is the one place every figure of every
-lab is composed, and its parts (panels, text, colour maps and bars, line plots, placeholder
-figures for unfinished tasks) share the same uint8 canvas conventions and font handling.
+Longer than most modules (about 740 lines) on purpose: it is the one place every figure of every
+lab is composed, and its parts (panels, text, colour maps and bars, line plots, the index page)
+share the same uint8 canvas conventions and font handling.
 
 Everything returns plain ``(h, w, 3)`` uint8 arrays, so renders (:mod:`geomlib.render`), plots
 and colour bars compose freely with :func:`panels` and are written with :func:`save_png`.
@@ -11,7 +11,8 @@ matplotlib's Agg canvas directly (no pyplot state, no display). Output bytes are
 the same inputs give the same PNG file.
 
 :class:`Figure` is the record that figure builders (the gallery, every lab's ``figures.py``)
-return so the figures command can index them.
+return so the figures command can index them; how a lab's builders become its ``make_figures``
+is :mod:`geomlib.labfigures`.
 
 Examples
 --------
@@ -47,11 +48,6 @@ __all__ = [
     "line_plot",
     "save_png",
     "write_index",
-    "lab_package",
-    "missing_task_figure",
-    "lab_figures",
-    "lab_view",
-    "figures_or_placeholders",
 ]
 
 
@@ -637,127 +633,6 @@ def save_png(path, image) -> Path:
     # No pnginfo, dpi or timestamps: Pillow then writes only IHDR/IDAT/IEND, a function of the pixels.
     Image.fromarray(img).save(path, format="PNG", compress_level=6, optimize=False)
     return path
-
-
-# --------------------------------------------------------------------------------------------
-# Lab figures on partial work
-# --------------------------------------------------------------------------------------------
-
-
-def lab_package(lab, package: str):
-    """The lab whose functions a ``make_figures`` draws: ``lab`` (a module) or the package ``package``.
-
-    Every lab's ``make_figures(out_dir, lab=None, quick=False)`` takes ``lab`` the same way: a module
-    that provides the lab's public functions (``solutions.<lab>``, ``labs.<lab>``, a submission
-    loaded as a module); None means the package the figures file lives in.
-    """
-    import importlib
-    import types
-
-    if lab is None:
-        return importlib.import_module(package)
-    if not isinstance(lab, types.ModuleType):
-        raise MeshError(
-            f"make_figures: lab must be a module providing the lab's functions (or None), got {type(lab).__name__}"
-        )
-    return lab
-
-
-def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "") -> Figure:
-    """A placeholder figure saying which task is missing, written where the real figure would go.
-
-    Parameters
-    ----------
-    path : str or Path
-        The PNG to write (the name the finished figure will have).
-    error : NotImplementedError
-        Raised by a stub; its message starts with the task (``"Task 2 (even vertices): ..."``).
-    lab : str
-        The lab name for the figure record.
-    what : str
-        What the figure will show once the task is done (goes into the caption).
-    """
-    import re
-
-    msg = str(error).strip() or type(error).__name__
-    m = re.search(r"Task\s+(\d+[a-z]?)", msg)
-    head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
-    blank = np.full((160, 560, 3), 244, dtype=np.uint8)
-    img = panels([blank], [msg if len(msg) <= 300 else msg[:297] + "..."], title=Path(path).stem, font_size=14)
-    # Write the head into the grey box too, so a thumbnail still says it.
-    from PIL import Image, ImageDraw
-
-    page = Image.fromarray(img)
-    draw = ImageDraw.Draw(page)
-    font = _font(22, bold=True)
-    w = draw.textlength(head, font=font)
-    top = img.shape[0] // 2 - 40
-    draw.text(((img.shape[1] - w) / 2, top), head, fill=(150, 40, 30), font=font)
-    path = save_png(path, np.asarray(page))
-    caption = (
-        f"{head}, so {Path(path).name} cannot be drawn yet" + (f" (it will show {what})" if what else "") + f". {msg}"
-    )
-    return Figure(path, caption, lab)
-
-
-def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Figure]:
-    """Run figure builders; a builder stopped by a missing task gives a placeholder figure instead.
-
-    Parameters
-    ----------
-    builders : sequence of callables
-        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them. The placeholder
-        goes to ``out_dir / "<name>.png"``, where ``<name>`` is the builder's ``figure_name``
-        attribute or its name without the ``fig_`` / ``_fig_`` / ``_`` prefix.
-    out_dir : Path
-    lab_name : str
-    *args
-        Passed on to every builder.
-
-    Returns
-    -------
-    list of Figure
-        In builder order; students see every figure their finished tasks allow, and one
-        "Task N not implemented yet" picture for each of the others.
-    """
-    figures: list[Figure] = []
-    for build in builders:
-        try:
-            out = build(out_dir, *args)
-        except NotImplementedError as e:
-            name = getattr(build, "figure_name", None) or build.__name__.removeprefix("_").removeprefix("fig_")
-            out = missing_task_figure(Path(out_dir) / f"{name}.png", e, lab_name)
-        figures.extend(out if isinstance(out, list) else [out])
-    return figures
-
-
-def lab_figures(builders, out_dir, lab_name: str, *args) -> list[Figure]:
-    """The body of a lab's ``make_figures``: create ``out_dir``, then :func:`figures_or_placeholders`.
-
-    Parameters
-    ----------
-    builders : sequence of callables
-        ``build(out_dir, *args)``, as for :func:`figures_or_placeholders`.
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab_name : str
-    *args
-        Passed on to every builder (typically the lab module from :func:`lab_package`, and ``quick``).
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders(builders, out, lab_name, *args)
-
-
-def lab_view(builder, out_dir, lab_name: str, *args) -> Figure:
-    """The body of a lab's ``make_view``: write its interactive 3D view (:mod:`geomlib.viewer`).
-
-    ``builder(out_dir, *args)`` writes ``<lab>_3d.html`` into ``out_dir`` (created if missing) and
-    returns its :class:`Figure`. Open the page in a browser and turn the result with the mouse;
-    ``geomlib figures`` shows it in the index. Before the task it needs is implemented, the figure
-    returned is a "Task N not implemented yet" picture instead.
-    """
-    return lab_figures((builder,), out_dir, lab_name, *args)[0]
 
 
 # --------------------------------------------------------------------------------------------

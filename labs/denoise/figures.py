@@ -9,27 +9,14 @@ Built-in meshes only (``geomlib.datasets``).
 from __future__ import annotations
 
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 
 from geomlib import datasets
 from geomlib.geometry import vertex_normals
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    heat_colors,
-    heatmap_image,
-    lab_figures,
-    lab_package,
-    lab_view,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, heatmap_image, line_plot, panels, save_png, with_colorbar
 from geomlib.render import camera_pose, render
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view"]
 
@@ -38,24 +25,6 @@ CMAP = "YlOrRd"  # light at zero error, so the shape stays readable where the er
 DIVERGING = "RdBu_r"  # signed offsets: blue sinks in, red sticks out
 BACK = (0.75, 0.1, 0.1)  # colour of back faces: what shows through a crack
 LOW_NOISE = 0.05  # noise (x mean edge length) at which the curvature leak dominates
-
-
-def _functions(lab) -> SimpleNamespace:
-    """The lab functions used here: from ``lab`` (a module) if given, else from this package."""
-    if lab is None:
-        from . import denoise, laplacian, noise, offsetmap, seams
-
-        lab = SimpleNamespace(
-            laplacian_offsets=laplacian.laplacian_offsets,
-            normal_offsets=laplacian.normal_offsets,
-            denoise_vertices=denoise.denoise_vertices,
-            bake_offset_map=offsetmap.bake_offset_map,
-            denoise_with_map=offsetmap.denoise_with_map,
-            weld_seams=seams.weld_seams,
-            make_noisy=noise.make_noisy,
-            surface_error=noise.surface_error,
-        )
-    return lab
 
 
 def _passes(n: int) -> str:
@@ -78,8 +47,8 @@ def _seam_normals(X: np.ndarray, F: np.ndarray, group: np.ndarray) -> np.ndarray
 # 1. the lambda sequence with error heat maps
 
 
-def fig_lambda_sequence(out: Path, lab, quick: bool) -> Figure:
-    L = _functions(lab)
+@figure_name("lambda_sequence")
+def fig_lambda_sequence(out: Path, L, quick: bool) -> Figure:
     size = (180, 125) if quick else (190, 134)
     V, F = datasets.torus(n_major=64, n_minor=32) if quick else datasets.torus(n_major=96, n_minor=48)
     lams = (0.3, 0.7, 1.0)
@@ -139,8 +108,8 @@ def _error_curves(L, V, F, sigma: float, iterations: int):
     return xs, ys, labels
 
 
-def fig_iterations(out: Path, lab, quick: bool) -> Figure:
-    L = _functions(lab)
+@figure_name("error_vs_iterations")
+def fig_iterations(out: Path, L, quick: bool) -> Figure:
     V, F = datasets.torus(n_major=64, n_minor=32) if quick else datasets.torus(n_major=96, n_minor=48)
     iterations = 3 if quick else 5
     size = (460, 340) if quick else (560, 400)
@@ -174,8 +143,8 @@ def fig_iterations(out: Path, lab, quick: bool) -> Figure:
 # 3. the offset map
 
 
-def fig_offset_map(out: Path, lab, quick: bool) -> Figure:
-    L = _functions(lab)
+@figure_name("offset_map")
+def fig_offset_map(out: Path, L, quick: bool) -> Figure:
     V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
     s = np.asarray(L.normal_offsets(L.laplacian_offsets(Vn, F), N))
@@ -217,8 +186,8 @@ def fig_offset_map(out: Path, lab, quick: bool) -> Figure:
 # 4. crack vs fixed seam
 
 
-def fig_seam(out: Path, lab, quick: bool) -> Figure:
-    L = _functions(lab)
+@figure_name("seam_crack")
+def fig_seam(out: Path, L, quick: bool) -> Figure:
     V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
     _, _, group = L.weld_seams(V, F)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
@@ -273,63 +242,21 @@ def fig_seam(out: Path, lab, quick: bool) -> Figure:
     )
 
 
-def fig_view(out: Path, lab, quick: bool) -> Figure:
-    L = _functions(lab)
+@figure_name("denoise_3d")
+def fig_view(L, quick: bool) -> MeshView:
     V, F = datasets.torus(n_major=64, n_minor=32)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
     X = L.denoise_vertices(Vn, F, N, 0.7)
     err = 100 * np.asarray(L.surface_error(V, F, X))
-    path = write_html(
-        out / "denoise_3d.html", X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
+    return MeshView(
+        X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
         cmap=CMAP, scalar_name="% of diagonal",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
+        caption="Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
         "to the clean surface (% of the bounding-box diagonal).",
-        LAB,
-    )
+    )  # fmt: skip
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-fig_lambda_sequence.figure_name = "lambda_sequence"
-fig_iterations.figure_name = "error_vs_iterations"
-fig_offset_map.figure_name = "offset_map"
-fig_seam.figure_name = "seam_crack"
-fig_view.figure_name = "denoise_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.denoise``, ``labs.denoise``, a
-        submission); default: the package this file is in, so in ``labs/denoise/`` your own code.
-    quick : bool
-        Smaller meshes, images and iteration counts (for notebooks and smoke tests).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    return lab_figures(
-        (fig_lambda_sequence, fig_iterations, fig_offset_map, fig_seam),
-        out_dir,
-        LAB,
-        lab_package(lab, __package__),
-        quick,
-    )
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``denoise_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    return lab_view(fig_view, out_dir, LAB, lab_package(lab, __package__), quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (fig_lambda_sequence, fig_iterations, fig_offset_map, fig_seam), fig_view,
+    quick="Smaller meshes, images and iteration counts (for notebooks and smoke tests).",
+)  # fmt: skip

@@ -13,14 +13,11 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, lab_figures, lab_package, lab_view, panels, save_png
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, panels, save_png
 from geomlib.textures import triangle_atlas
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]
-
-#: The lab package whose functions the figures draw (set by :func:`make_figures`).
-_L = None
 
 LAB = "maps"
 ALBEDO = (0.80, 0.66, 0.52)
@@ -65,9 +62,9 @@ def _view(V: np.ndarray, direction, size: int, fov: float = 30.0, margin: float 
     return eye, M
 
 
-def _shaded(V, F, eye, M, size, lights, *, N=None, UV=None, tangents=None, normal_map=None, wrap="clamp"):
-    g = _L.rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
-    img = _L.shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
+def _shaded(L, V, F, eye, M, size, lights, *, N=None, UV=None, tangents=None, normal_map=None, wrap="clamp"):
+    g = L.rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
+    img = L.shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
     return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)  # display gamma
 
 
@@ -82,29 +79,30 @@ def _thumb(img: np.ndarray, size: int) -> np.ndarray:
     return np.asarray(Image.fromarray(img).resize((size, size), Image.Resampling.BOX))
 
 
-def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
+@figure_name("mapped_vs_displaced")
+def _fig_mapped_vs_displaced(out: Path, L, quick: bool) -> list[Figure]:
     size, s = (160, 256) if quick else (300, 512)
     nu, nv = 24, 8
     H = bump_tiles(s, nu, nv)
     R, r, lam = 1.0, 0.35, 0.05
     # Tangent-space slope of the relief: the UV square spans 2 pi R around and 2 pi r across.
-    nmap = _L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
+    nmap = L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
     V, F, UV = datasets.uv_torus(48, 24, R, r)
-    N = _L.welded_vertex_normals(V, F)
-    T, _, _, w = _L.tangent_frames(V, F, UV, N)
+    N = L.welded_vertex_normals(V, F)
+    T, _, _, w = L.tangent_frames(V, F, UV, N)
     tg = np.column_stack([T, w])
     dm, dn = (144, 48) if quick else (384, 128)
     Vd0, Fd, UVd = datasets.uv_torus(dm, dn, R, r)
-    Vd, Nd = _L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
+    Vd, Nd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
     eye, M = _view(Vd, (0.15, -1.0, 0.85), size, margin=0.8)
     figs = []
     for name, lights, label in (
         ("mapped_vs_displaced", KEY_LIGHTS, "key and fill light"),
         ("mapped_vs_displaced_grazing", GRAZING_LIGHTS, "one grazing light"),
     ):
-        plain = _shaded(V, F, eye, M, size, lights, N=N)
-        mapped = _shaded(V, F, eye, M, size, lights, N=N, UV=UV, tangents=tg, normal_map=nmap, wrap="repeat")
-        real = _shaded(Vd, Fd, eye, M, size, lights, N=Nd)
+        plain = _shaded(L, V, F, eye, M, size, lights, N=N)
+        mapped = _shaded(L, V, F, eye, M, size, lights, N=N, UV=UV, tangents=tg, normal_map=nmap, wrap="repeat")
+        real = _shaded(L, Vd, Fd, eye, M, size, lights, N=Nd)
         imgs = [plain, mapped, real]
         caps = [
             f"plain: {len(F):,} faces, smooth normals",
@@ -112,7 +110,7 @@ def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
             f"displaced: {len(Fd):,} faces moved by λh along the normal",
         ]
         if name == "mapped_vs_displaced":
-            imgs = [_thumb(_grey(H), size), _thumb(_L.encode_normal_map(nmap), size)] + imgs
+            imgs = [_thumb(_grey(H), size), _thumb(L.encode_normal_map(nmap), size)] + imgs
             caps = ["height map h (24 x 8 bumps)", "its tangent-space normal map (RGB = (n + 1) / 2)"] + caps
         img = panels(imgs, caps, ncols=len(imgs), title=f"Normal mapping vs displacement, {label}")
         path = save_png(out / f"{name}.png", img)
@@ -129,7 +127,8 @@ def _fig_mapped_vs_displaced(out: Path, quick: bool) -> list[Figure]:
     return figs
 
 
-def _fig_bias_scale(out: Path, quick: bool) -> Figure:
+@figure_name("bias_scale")
+def _fig_bias_scale(out: Path, L, quick: bool) -> Figure:
     from geomlib.render import render
 
     size, s = (160, 128) if quick else (300, 256)
@@ -141,7 +140,7 @@ def _fig_bias_scale(out: Path, quick: bool) -> Figure:
     lam = 0.12
     imgs, caps = [_thumb(_grey(H), size)], ["displacement map h in [0, 1] (black = 0), mid-grey at the poles"]
     for bias, scale in ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0)):
-        Vd = _L.displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
+        Vd = L.displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
         rad = np.linalg.norm(Vd, axis=1)
         imgs.append(render(Vd, F, camera="three_quarter", up_axis="z", size=(size, size)))
         caps.append(
@@ -158,7 +157,7 @@ def _fig_bias_scale(out: Path, quick: bool) -> Figure:
     )
 
 
-def _rock(quick: bool):
+def _rock(L, quick: bool):
     """A detailed rock (built-in) and its decimated version with a one-chart-per-triangle atlas."""
     import fast_simplification
 
@@ -168,26 +167,27 @@ def _rock(quick: bool):
     Vl, Fl = np.asarray(Vl, np.float64), np.asarray(Fl, np.int64)
     # Decimated triangles vary a lot in size and shape: every chart gets half a cell (mode="fill").
     Vs, Fs, UV, src = triangle_atlas(Vl, Fl, gutter=0.04, mode="fill")
-    N_lo = _L.welded_vertex_normals(Vs, Fs)
+    N_lo = L.welded_vertex_normals(Vs, Fs)
     return Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo
 
 
-def _fig_bake(out: Path, quick: bool) -> list[Figure]:
+@figure_name("bake")
+def _fig_bake(out: Path, L, quick: bool) -> list[Figure]:
     size, s = (160, 128) if quick else (300, 512)
-    Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo = _rock(quick)
-    nmap, mask = _L.bake_normal_map(Vh, Fh, Vs, Fs, UV, s, N_lo=N_lo, padding=4, return_mask=True)
-    T, _, _, w = _L.tangent_frames(Vs, Fs, UV, N_lo)
+    Vh, Fh, Vl, Fl, Vs, Fs, UV, N_lo = _rock(L, quick)
+    nmap, mask = L.bake_normal_map(Vh, Fh, Vs, Fs, UV, s, N_lo=N_lo, padding=4, return_mask=True)
+    T, _, _, w = L.tangent_frames(Vs, Fs, UV, N_lo)
     tg = np.column_stack([T, w])
-    Nh = _L.welded_vertex_normals(Vh, Fh)
+    Nh = L.welded_vertex_normals(Vh, Fh)
     eye, M = _view(Vh, (0.9, -1.0, 0.9), size, margin=0.85)
-    enc = _L.encode_normal_map(nmap)
+    enc = L.encode_normal_map(nmap)
     figs = []
     shots = {}
     for key, lights in (("key", KEY_LIGHTS), ("grazing", GRAZING_LIGHTS)):
         shots[key] = [
-            _shaded(Vs, Fs, eye, M, size, lights, N=N_lo),
-            _shaded(Vs, Fs, eye, M, size, lights, N=N_lo, UV=UV, tangents=tg, normal_map=enc),
-            _shaded(Vh, Fh, eye, M, size, lights, N=Nh),
+            _shaded(L, Vs, Fs, eye, M, size, lights, N=N_lo),
+            _shaded(L, Vs, Fs, eye, M, size, lights, N=N_lo, UV=UV, tangents=tg, normal_map=enc),
+            _shaded(L, Vh, Fh, eye, M, size, lights, N=Nh),
         ]
     caps = [
         f"decimated: {len(Fl):,} faces, smooth normals",
@@ -235,56 +235,21 @@ def _fig_bake(out: Path, quick: bool) -> list[Figure]:
     return figs
 
 
-def _fig_view(out: Path, quick: bool) -> Figure:
+@figure_name("maps_3d")
+def _fig_view(L, quick: bool) -> MeshView:
     R, r, lam = 1.0, 0.4, 0.045
     s = 128 if quick else 256
     H = bump_tiles(s, 24, 8)
     Vd0, Fd, UVd = datasets.uv_torus(*((144, 48) if quick else (288, 96)), R, r)
-    Vd = _L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
-    path = write_html(out / "maps_3d.html", Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False)
-    return Figure(
-        path,
-        f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map imitates.",
-        LAB,
-    )
+    Vd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
+    return MeshView(
+        Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False,
+        caption=f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map "
+        "imitates.",
+    )  # fmt: skip
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-_fig_mapped_vs_displaced.figure_name = "mapped_vs_displaced"
-_fig_bias_scale.figure_name = "bias_scale"
-_fig_bake.figure_name = "bake"
-_fig_view.figure_name = "maps_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.maps``, ``labs.maps``, a
-        submission); default: the package this file is in, so in ``labs/maps/`` your own code.
-    quick : bool
-        Smaller images and meshes (for the notebook and tests).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    return lab_figures((_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), out_dir, LAB, quick)
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``maps_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    return lab_view(_fig_view, out_dir, LAB, quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (_fig_mapped_vs_displaced, _fig_bias_scale, _fig_bake), _fig_view,
+    quick="Smaller images and meshes (for the notebook and tests).",
+)  # fmt: skip

@@ -20,19 +20,9 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    heat_colors,
-    lab_figures,
-    lab_package,
-    lab_view,
-    line_plot,
-    panels,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
 from geomlib.render import render
-from geomlib.viewer import write_html
 
 __all__ = [
     "make_figures",
@@ -50,10 +40,6 @@ LAB = "remeshing"
 LOW, SIX, HIGH = np.array([0.25, 0.45, 0.95]), np.array([0.82, 0.82, 0.82]), np.array([0.95, 0.3, 0.25])
 VALENCE_TITLE = "vertices coloured by valence: blue below 6, grey 6, red above"
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error vanishes
-
-
-def _lab(lab):
-    return lab_package(lab, __package__)  # this package: the solution, or your lab in labs/
 
 
 def _ss(quick: bool) -> int:
@@ -220,8 +206,8 @@ def _mesh(result):
 # the figures
 
 
-def fig_before_after(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("before_after")
+def fig_before_after(out: Path, R, quick: bool) -> Figure:
     n = 48 if quick else 64
     bunny, decimated = metaball_bunny(n), decimated_bunny(800 if quick else 1200, n)
     L = 0.08 if quick else 0.06
@@ -259,8 +245,8 @@ def fig_before_after(out: Path, lab, quick: bool) -> Figure:
     )
 
 
-def fig_iterations(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("iterations")
+def fig_iterations(out: Path, R, quick: bool) -> Figure:
     n = 48 if quick else 64
     V, F = decimated_bunny(800 if quick else 1200, n)
     L = 0.08 if quick else 0.06
@@ -293,8 +279,8 @@ def _bar_beside_row(grid: np.ndarray, bar: np.ndarray, row: np.ndarray, pad: int
     return np.concatenate([grid, bar], axis=1)
 
 
-def fig_features(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("features")
+def fig_features(out: Path, R, quick: bool) -> Figure:
     V, F = curved_block(4)
     L, angle = (0.14, 45.0) if quick else (0.1, 45.0)
     its = 5 if quick else 10
@@ -356,8 +342,8 @@ def _boundary_offset(U, G, A, B) -> tuple[int, float, float]:
     return len(P), float(d.max()), float(np.linalg.norm(U[E[:, 1]] - U[E[:, 0]], axis=1).sum())
 
 
-def fig_boundary(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("boundary")
+def fig_boundary(out: Path, R, quick: bool) -> Figure:
     V, F = bunny_head(48 if quick else 64)
     L = 0.06 if quick else 0.045
     its = 5 if quick else 10
@@ -408,8 +394,8 @@ def _new_edge_ends(G, F) -> np.ndarray:
     return np.unique([e for e in topology.unique_edges(G).tolist() if tuple(e) not in old])
 
 
-def fig_operations(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("operations")
+def fig_operations(out: Path, R, quick: bool) -> Figure:
     V, F = datasets.grid_patch(3)
     H = topology.halfedge_mesh(F, len(V), manifold=True)
     # the diagonal of the middle cell: both ends inside the patch
@@ -457,49 +443,23 @@ def fig_operations(out: Path, lab, quick: bool) -> Figure:
     )
 
 
-fig_before_after.figure_name = "before_after"
-fig_iterations.figure_name = "iterations"
-fig_features.figure_name = "features"
-fig_boundary.figure_name = "boundary"
-fig_operations.figure_name = "operations"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` (``lab``: a lab module, default this package).
-
-    A figure whose task is not implemented yet becomes a "Task N not implemented yet" picture.
-    """
-    builders = (fig_before_after, fig_operations, fig_iterations, fig_features, fig_boundary)
-    return lab_figures(builders, out_dir, LAB, lab, quick)
-
-
-def fig_view(out: Path, lab, quick: bool) -> Figure:
-    R = _lab(lab)
+@figure_name("remeshing_3d")
+def fig_view(R, quick: bool) -> MeshView:
     V, F = metaball_bunny(48 if quick else 64)
     L = 0.08 if quick else 0.06
     U, G = R.isotropic_remesh(V, F, L, iterations=5 if quick else 10)
     U, G = np.asarray(U, float), np.asarray(G)
     H = topology.halfedge_mesh(G, len(U))
     dev = np.abs(H.valence - np.where(H.boundary_vertex, 4, 6)).astype(float)
-    path = write_html(
-        out / "remeshing_3d.html", U, G, dev, title=f"Remeshed bunny (L = {L})",
+    return MeshView(
+        U, G, dev, title=f"Remeshed bunny (L = {L})",
         cmap="viridis", scalar_name="|valence - 6|",
+        caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far "
+        "its valence is from 6 (0: regular).",
     )  # fmt: skip
-    return Figure(
-        path,
-        f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far its "
-        "valence is from 6 (0: regular).",
-        LAB,
-    )
 
 
-fig_view.figure_name = "remeshing_3d"
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``remeshing_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
-
-    Same arguments as :func:`make_figures`; before the loop (Task 10) is implemented, the returned
-    figure is a "Task N not implemented yet" picture instead.
-    """
-    return lab_view(fig_view, out_dir, LAB, lab, quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (fig_before_after, fig_operations, fig_iterations, fig_features, fig_boundary), fig_view,
+    quick="Smaller meshes, fewer iterations and smaller images (for notebooks and smoke tests).",
+)  # fmt: skip

@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets, raster
-from geomlib.plot import Figure, colorbar, heatmap_image, lab_view, panels, save_png
-from geomlib.viewer import write_html
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
 from .bricks import EMPTY_INSIDE, compress_bricks
@@ -126,6 +126,7 @@ def _torus_grid(quick):
 # ---------------------------------------------------------------------------------- figures
 
 
+@figure_name("sdf_csg")
 def fig_csg(out: Path, quick: bool) -> Figure:
     size = (150, 220) if quick else (300, 440)
     M = _camera([0.4, -4.2, 2.4], [0.0, 0.0, 0.4], size)
@@ -162,6 +163,7 @@ def fig_csg(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("sdf_slices")
 def fig_slices(out: Path, quick: bool) -> Figure:
     def make():
         V, F, g = _torus_grid(quick)
@@ -190,6 +192,7 @@ def fig_slices(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("sdf_bricks")
 def fig_bricks(out: Path, quick: bool) -> Figure:
     try:
         V, F, g = _torus_grid(quick)
@@ -232,6 +235,7 @@ def fig_bricks(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("sdf_normals")
 def fig_normals(out: Path, quick: bool) -> Figure:
     size = (120, 160) if quick else (240, 320)
     try:
@@ -275,6 +279,7 @@ def fig_normals(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("sdf_trace")
 def fig_trace(out: Path, quick: bool) -> Figure:
     size = (120, 160) if quick else (300, 400)
     try:
@@ -318,6 +323,7 @@ def _shadow_setup(quick):
     return S, SF, P, n
 
 
+@figure_name("sdf_soft_shadows")
 def fig_soft_shadows(out: Path, quick: bool) -> Figure:
     try:
         S, SF, P, n = _shadow_setup(quick)
@@ -359,6 +365,7 @@ def fig_soft_shadows(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("sdf_ao_push")
 def fig_ao_push(out: Path, quick: bool) -> Figure:
     size = (120, 160) if quick else (260, 360)
     try:
@@ -410,65 +417,27 @@ def fig_ao_push(out: Path, quick: bool) -> Figure:
     )
 
 
-FIGURES = (fig_csg, fig_slices, fig_bricks, fig_normals, fig_trace, fig_soft_shadows, fig_ao_push)
-
-
-def _named_missing(fig, out: Path, quick: bool) -> Figure:
-    """Draw one figure; where panels had to be left out, the caption starts with the missing task."""
-    _MISSING.clear()
-    f = fig(out, quick)
-    if _MISSING:
-        f = Figure(f.path, f"Task {_MISSING[0]} not implemented yet; the other panels show: {f.caption}", f.lab)
-    return f
-
-
-def make_figures(out_dir: Path, lab=None, quick: bool = False) -> list[Figure]:
-    """Render every figure of the lab into ``out_dir``.
-
-    Parameters
-    ----------
-    out_dir : Path
-        Output folder (created).
-    lab : module, optional
-        Ignored (the figures use the functions of the package this file is in).
-    quick : bool
-        Smaller grids and images (for the notebook and CI).
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    _CACHE.clear()
-    try:
-        return [_named_missing(fig, out, quick) for fig in FIGURES]
-    finally:
-        _CACHE.clear()
-
-
-def fig_view(out: Path, quick: bool) -> Figure:
+@figure_name("sdf_3d")
+def fig_view(quick: bool) -> MeshView:
     V, F, grid = _torus_grid(quick)
     bricks = compress_bricks(grid, band_voxels=4)
     # On the surface the exact distance is 0, so what the bricks return there is their error.
     err = np.abs(np.asarray(bricks.sample(V))) / bricks.step
-    path = write_html(
-        out / "sdf_3d.html", V, F, err, title="Brick SDF on the torus surface", up="z",
+    return MeshView(
+        V, F, err, title="Brick SDF on the torus surface", up="z",
         cmap="viridis", scalar_name="|d| in quantisation steps",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: the torus, each vertex coloured by the distance the 8-bit brick field returns there "
+        caption="Turn it: the torus, each vertex coloured by the distance the 8-bit brick field returns there "
         "(exactly 0 on the surface), in quantisation steps: trilinear lookups of stored samples.",
-        "sdf",
-    )
+    )  # fmt: skip
 
 
-fig_view.figure_name = "sdf_3d"
+#: The figures in order; one drawn without some of its panels names the missing task in its caption.
+FIGURES = [
+    partial_figure(build, _MISSING)
+    for build in (fig_csg, fig_slices, fig_bricks, fig_normals, fig_trace, fig_soft_shadows, fig_ao_push)
+]
 
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``sdf_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    try:
-        return lab_view(fig_view, out_dir, "sdf", quick)
-    finally:
-        _CACHE.clear()
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, FIGURES, fig_view, draws_lab=False,
+    quick="Smaller grids and images (for the notebook and CI).", shared=_CACHE,
+)  # fmt: skip

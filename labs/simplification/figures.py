@@ -13,19 +13,9 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import closest_points, mesh_distance
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    heat_colors,
-    lab_figures,
-    lab_package,
-    lab_view,
-    line_plot,
-    panels,
-    save_png,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
 from geomlib.render import render
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "airplane", "cracked_sheet"]
 
@@ -34,12 +24,8 @@ CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error va
 
 
 def _simplify(lab):
-    """``qem_simplify`` of the given lab module, or of this package."""
-    if lab is not None:
-        return lab.qem_simplify
-    from .simplify import qem_simplify
-
-    return qem_simplify
+    """``qem_simplify`` of the lab module the figures draw."""
+    return lab.qem_simplify
 
 
 def _ss(quick: bool) -> int:
@@ -61,6 +47,7 @@ def cracked_sheet(n: int = 12, gap: float = 0.03) -> tuple[np.ndarray, np.ndarra
     return np.r_[V1, V2], np.r_[F1, F1 + len(V1)]
 
 
+@figure_name("series")
 def fig_series(out: Path, lab, quick: bool) -> Figure:
     qem_simplify = _simplify(lab)
     V, F = airplane()
@@ -133,6 +120,7 @@ def _anchor_runs(V, F, targets):
     return runs
 
 
+@figure_name("error_vs_faces")
 def fig_error_curve(out: Path, lab, quick: bool) -> Figure:
     qem_simplify = _simplify(lab)
     V, F = datasets.icosphere(3 if quick else 4)
@@ -177,6 +165,7 @@ def fig_error_curve(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("pairs")
 def fig_pairs(out: Path, lab, quick: bool) -> Figure:
     qem_simplify = _simplify(lab)
     V, F = cracked_sheet(8 if quick else 12)
@@ -213,6 +202,7 @@ def fig_pairs(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("boundary")
 def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     qem_simplify = _simplify(lab)
     V, F = datasets.height_field(16 if quick else 32)
@@ -238,59 +228,22 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     )
 
 
-def fig_view(out: Path, lab, quick: bool) -> Figure:
+@figure_name("simplification_3d")
+def fig_view(lab, quick: bool) -> MeshView:
     qem_simplify = _simplify(lab)
     V, F = airplane()
     U, G = qem_simplify(V, F, max(4, round(0.1 * len(F))))
     U, G = np.asarray(U), np.asarray(G)
     err = 100 * np.sqrt(closest_points(V, F, U)[0]) / float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-    path = write_html(
-        out / "simplification_3d.html", U, G, err, title="QEM: the airplane at 10% of its faces", up="z",
+    return MeshView(
+        U, G, err, title="QEM: the airplane at 10% of its faces", up="z",
         cmap=CMAP, scalar_name="% of diagonal",
+        caption=f"Turn it: the airplane simplified to {len(G):,} faces, each vertex coloured by its distance to the "
+        "input surface (% of the bounding-box diagonal).",
     )  # fmt: skip
-    return Figure(
-        path,
-        f"Turn it: the airplane simplified to {len(G):,} faces, each vertex coloured by its distance to the input "
-        "surface (% of the bounding-box diagonal).",
-        LAB,
-    )
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-fig_series.figure_name = "series"
-fig_error_curve.figure_name = "error_vs_faces"
-fig_pairs.figure_name = "pairs"
-fig_boundary.figure_name = "boundary"
-fig_view.figure_name = "simplification_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.simplification``, ``labs.simplification``, a
-        submission); default: the package this file is in, so in ``labs/simplification/`` your own code.
-    quick : bool
-        Smaller meshes and images (for notebooks and smoke tests).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    return lab_figures(
-        (fig_series, fig_error_curve, fig_pairs, fig_boundary), out_dir, LAB, lab_package(lab, __package__), quick
-    )
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``simplification_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    return lab_view(fig_view, out_dir, LAB, lab_package(lab, __package__), quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (fig_series, fig_error_curve, fig_pairs, fig_boundary), fig_view,
+    quick="Smaller meshes and images (for notebooks and smoke tests).",
+)  # fmt: skip

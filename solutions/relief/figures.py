@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.plot import Figure, colorbar, figures_or_placeholders, heatmap_image, line_plot, panels, save_png
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
-from geomlib.viewer import write_html
 
 from .bump import bump_normal
 from .heights import bricks, bumps
@@ -142,6 +142,7 @@ def _displaced(H, kind, size):
     return shade(H, kind, g.mask, uv, bump_normal(H, uv, strength=SCALE))
 
 
+@figure_name("methods_bumps")
 def _fig_methods(out: Path, quick: bool) -> list[Figure]:
     size = 120 if quick else 220
     figs = []
@@ -169,6 +170,7 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
     return figs
 
 
+@figure_name("uv_error")
 def _fig_errors(out: Path, quick: bool) -> Figure:
     size = 96 if quick else 200
     H = bricks(256)
@@ -205,6 +207,7 @@ def _fig_errors(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("error_vs_angle")
 def _fig_error_vs_angle(out: Path, quick: bool) -> Figure:
     p = 48 if quick else 128
     t = (np.arange(p) + 0.5) / p
@@ -252,6 +255,7 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Figure:
     )
 
 
+@figure_name("steps")
 def _fig_steps(out: Path, quick: bool) -> Figure:
     size = 120 if quick else 220
     H = bricks(256)
@@ -328,6 +332,7 @@ def _arc_shade(H, mask, uv, normal_ts):
     return np.clip(img, 0, 1)
 
 
+@figure_name("silhouette")
 def _fig_silhouette(out: Path, quick: bool) -> Figure:
     size = 160 if quick else 300
     H = bumps(128 if quick else 256)
@@ -386,51 +391,8 @@ def _fig_silhouette(out: Path, quick: bool) -> Figure:
     )
 
 
-def _named_missing(build, out: Path, quick: bool) -> list[Figure]:
-    """Draw one figure builder; where panels had to be left out, each caption starts with the missing task."""
-    _MISSING.clear()
-    figs = build(out, quick)
-    figs = figs if isinstance(figs, list) else [figs]
-    if _MISSING:
-        figs = [
-            Figure(f.path, f"Task {_MISSING[0]} not implemented yet; the other panels show: {f.caption}", f.lab)
-            for f in figs
-        ]
-    return figs
-
-
-def make_figures(out_dir: Path, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with captions.
-
-    Parameters
-    ----------
-    out_dir : Path
-        Folder for the PNG files (created).
-    lab : module, optional
-        Ignored (the figures use the functions of the package this file is in).
-    quick : bool
-        Smaller images (for the notebook and tests).
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    figs: list[Figure] = []
-    names = {
-        _fig_methods: "methods_bumps",
-        _fig_errors: "uv_error",
-        _fig_error_vs_angle: "error_vs_angle",
-        _fig_silhouette: "silhouette",
-    }
-    for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps, _fig_silhouette):
-
-        def draw(o, q, b=build):
-            return _named_missing(b, o, q)
-
-        draw.figure_name = names.get(build, "steps")  # the placeholder's file when the figure cannot be drawn
-        figs += figures_or_placeholders((draw,), out, LAB, quick)
-    return figs
-
-
-def fig_view(out: Path, quick: bool) -> Figure:
+@figure_name("relief_3d")
+def fig_view(quick: bool) -> MeshView:
     H = bricks(64 if quick else 128)
     s = H.shape[0]
     Vg, F = datasets.grid_patch(s - 1)
@@ -441,28 +403,21 @@ def fig_view(out: Path, quick: bool) -> Figure:
     V[:, 2] = -SCALE * (1 - H[r, c])  # the relief lies below the polygon
     n = bump_normal(H, V[:, :2], strength=SCALE)
     tilt = np.degrees(np.arccos(np.clip(n[:, 2] / np.linalg.norm(n, axis=1), -1, 1)))
-    path = write_html(
-        out / "relief_3d.html", V, F, tilt, title="Bricks as real geometry", up="z",
+    return MeshView(
+        V, F, tilt, title="Bricks as real geometry", up="z",
         cmap="viridis", scalar_name="bump-normal tilt (degrees)",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured by "
-        "how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
+        caption="Turn it: the bricks as real geometry (a grid moved down by scale · (1 − h)), each vertex coloured "
+        "by how far the bump-mapped normal (Task 1) tilts from the quad's. Parallax and relief mapping imitate "
         "this relief on one flat quad; seen edge-on, that quad's silhouette stays a straight line.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
-fig_view.figure_name = "relief_3d"
+#: The figures in order; one drawn without some of its panels names the missing task in its caption.
+FIGURES = [
+    partial_figure(build, _MISSING)
+    for build in (_fig_methods, _fig_errors, _fig_error_vs_angle, _fig_steps, _fig_silhouette)
+]
 
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write the lab's interactive 3D view, ``relief_3d.html`` (:mod:`geomlib.viewer`), into ``out_dir``.
-
-    Same arguments as :func:`make_figures`; before Task 1 is implemented, the returned figure is a
-    "Task 1 not implemented yet" picture instead.
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    return figures_or_placeholders((fig_view,), out, LAB, quick)[0]
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, FIGURES, fig_view, draws_lab=False, quick="Smaller images (for the notebook and tests)."
+)

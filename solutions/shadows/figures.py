@@ -12,21 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    heatmap_image,
-    lab_figures,
-    lab_package,
-    lab_view,
-    panels,
-    save_png,
-    with_colorbar,
-)
-from geomlib.viewer import write_html
-
-#: The lab package whose functions the figures draw (set by :func:`make_figures`).
-_L = None
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
 
@@ -55,18 +42,19 @@ def _pct(x: float) -> str:
 class _Measured:
     """Eye buffer and ray-cast truth of one view, shared by the panels of a figure."""
 
-    def __init__(self, scene, camera, light, size):
-        self.scene, self.camera, self.light, self.size = scene, camera, light, size
-        self.eb = _L.eye_gbuffer(scene, camera, size)
-        self.truth = _L.raycast_visibility(scene, self.eb, light)
+    def __init__(self, L, scene, camera, light, size):
+        self.L, self.scene, self.camera, self.light, self.size = L, scene, camera, light, size
+        self.eb = L.eye_gbuffer(scene, camera, size)
+        self.truth = L.raycast_visibility(scene, self.eb, light)
 
     def render(self, band: int = 2, **options) -> tuple[np.ndarray, dict]:
         """The shaded image (uint8) with these shadow options, and its metrics against the truth.
 
         ``band`` as in ``shadow_metrics``: 0 counts every pixel, edges included.
         """
-        vis, _ = _L.light_visibility(self.scene, self.eb, self.light, **options)
-        return _u8(_L.shade(self.eb, vis, self.light)), _L.shadow_metrics(vis, self.truth, self.eb.mask, band=band)
+        L = self.L
+        vis, _ = L.light_visibility(self.scene, self.eb, self.light, **options)
+        return _u8(L.shade(self.eb, vis, self.light)), L.shadow_metrics(vis, self.truth, self.eb.mask, band=band)
 
     def panel(self, caption: str, **options) -> tuple[np.ndarray, str]:
         img, m = self.render(**options)
@@ -76,17 +64,18 @@ class _Measured:
 _CACHE: dict = {}
 
 
-def _measured(name: str, scene_fn, camera, light, size) -> _Measured:
+def _measured(L, name: str, scene_fn, camera, light, size) -> _Measured:
     """One :class:`_Measured` per view and size, shared by the figures of one run."""
     key = (name, size)
     if key not in _CACHE:
-        _CACHE[key] = _Measured(scene_fn(), camera, light, size)
+        _CACHE[key] = _Measured(L, scene_fn(), camera, light, size)
     return _CACHE[key]
 
 
-def fig_bias(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_bias")
+def fig_bias(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
-    meas = _measured("classic", _L.classic_scene, _L.CLASSIC_CAMERA, _L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
     ms = 1024
     rows = [
         meas.panel("no bias, no culling: acne", map_size=ms, bias=0.0, slope_bias=0.0, cull="none", pcf=1),
@@ -111,10 +100,11 @@ def fig_bias(out: Path, quick: bool) -> Figure:
     )
 
 
-def fig_frustum(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_frustum")
+def fig_frustum(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
     B = np.array([[-1.5, -1.5, 0.0], [1.5, 1.5, 2.1]])  # the map covers the middle of the floor only
-    meas = _measured("classic", _L.classic_scene, _L.CLASSIC_CAMERA, _L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
     off = meas.panel("frustum fix off: border texels repeat, far side dark", map_size=1024, bounds=B, frustum_fix=False)
     on = meas.panel("fix on: outside is lit (the sphere's shadow too)", map_size=1024, bounds=B, frustum_fix=True)
     full = meas.panel("map fitted to the whole scene", map_size=1024)
@@ -130,9 +120,10 @@ def fig_frustum(out: Path, quick: bool) -> Figure:
     )
 
 
-def fig_resolution(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_resolution")
+def fig_resolution(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
-    meas = _measured("zoom", _L.classic_scene, ZOOM_CAMERA, _L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
     sizes = (256, 1024, 2048) if quick else (256, 1024, 4096)
     rows = []
     for s in sizes:
@@ -153,9 +144,10 @@ def fig_resolution(out: Path, quick: bool) -> Figure:
     )
 
 
-def fig_pcf(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_pcf")
+def fig_pcf(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
-    meas = _measured("zoom", _L.classic_scene, ZOOM_CAMERA, _L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
     rows = [meas.panel(f"PCF {k} x {k}, 512² map", map_size=512, pcf=k) for k in (1, 3, 5)]
     rows.append(meas.panel("Poisson disk: 16 samples, radius 2.5 texels", map_size=512, pcf=5, pcf_sampling="poisson"))
     page = panels([r[0] for r in rows], [r[1] for r in rows], ncols=2, title="Percentage-closer filtering")
@@ -171,17 +163,18 @@ def fig_pcf(out: Path, quick: bool) -> Figure:
     )
 
 
-def fig_pyrender(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_pyrender")
+def fig_pyrender(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
-    scene = _L.torus_scene(125, 50) if quick else _L.torus_scene()
-    meas = _Measured(scene, TORUS_CAMERA, TORUS_LIGHT, size)
-    vis, _ = _L.light_visibility(scene, meas.eb, TORUS_LIGHT, map_size=2048, pcf=3)
-    ours_img = _u8(_L.shade(meas.eb, vis, TORUS_LIGHT))
-    ps, rend, pyrender = _L.pyrender_scene(scene, TORUS_CAMERA, TORUS_LIGHT, size=size)
+    scene = L.torus_scene(125, 50) if quick else L.torus_scene()
+    meas = _Measured(L, scene, TORUS_CAMERA, TORUS_LIGHT, size)
+    vis, _ = L.light_visibility(scene, meas.eb, TORUS_LIGHT, map_size=2048, pcf=3)
+    ours_img = _u8(L.shade(meas.eb, vis, TORUS_LIGHT))
+    ps, rend, pyrender = L.pyrender_scene(scene, TORUS_CAMERA, TORUS_LIGHT, size=size)
     py_img = np.asarray(rend.render(ps, flags=pyrender.RenderFlags.SHADOWS_DIRECTIONAL)[0])[:, :, :3].copy()
     # pyrender clears to black; give its empty pixels our background so the two panels compare.
     py_img[~meas.eb.mask] = ours_img[~meas.eb.mask]
-    pv = _L.pyrender_visibility(scene, TORUS_CAMERA, TORUS_LIGHT, size=size)
+    pv = L.pyrender_visibility(scene, TORUS_CAMERA, TORUS_LIGHT, size=size)
     h, w = meas.eb.mask.shape
     flat = np.flatnonzero(meas.eb.mask.ravel())
     reached = meas.truth["reached"]
@@ -192,8 +185,8 @@ def fig_pyrender(out: Path, quick: bool) -> Figure:
     pvk = np.nan_to_num(pv.ravel()[flat])
     err_py = np.full(h * w, np.nan)
     err_py[flat[reached]] = np.abs(pvk[reached] - meas.truth["lit"][reached])
-    m_ours = _L.shadow_metrics(vis, meas.truth, meas.eb.mask, band=0)
-    m_py = _L.shadow_metrics(pvk, meas.truth, meas.eb.mask, band=0)
+    m_ours = L.shadow_metrics(vis, meas.truth, meas.eb.mask, band=0)
+    m_py = L.shadow_metrics(pvk, meas.truth, meas.eb.mask, band=0)
 
     def wrong(m):
         return f"{round((1.0 - m['agreement']) * m['measured']):,} pixels differ from the truth"
@@ -228,14 +221,15 @@ def fig_pyrender(out: Path, quick: bool) -> Figure:
     )
 
 
-def fig_lights(out: Path, quick: bool) -> Figure:
+@figure_name("shadows_lights")
+def fig_lights(out: Path, L, quick: bool) -> Figure:
     size = (240, 180) if quick else (400, 300)
-    scene = _L.classic_scene()
+    scene = L.classic_scene()
     ms = 512 if quick else 1024
-    spot = _u8(_L.render_with_shadows(scene, _L.CLASSIC_CAMERA, SPOT_LIGHT, size=size, map_size=ms))
-    point = _u8(_L.render_with_shadows(scene, _L.CLASSIC_CAMERA, POINT_LIGHT, size=size, map_size=ms))
-    M = _L.light_setup(scene, _L.CLASSIC_LIGHT).matrices[0]
-    D = _L.depth_map(scene.V, scene.F, M, size[1], cull="none")
+    spot = _u8(L.render_with_shadows(scene, L.CLASSIC_CAMERA, SPOT_LIGHT, size=size, map_size=ms))
+    point = _u8(L.render_with_shadows(scene, L.CLASSIC_CAMERA, POINT_LIGHT, size=size, map_size=ms))
+    M = L.light_setup(scene, L.CLASSIC_LIGHT).matrices[0]
+    D = L.depth_map(scene.V, scene.F, M, size[1], cull="none")
     # Empty texels (depth 1) in light grey and a dark frame: the map's square extent stays visible.
     depth_img = heatmap_image(np.where(D < 1, D, np.nan), "viridis", nan_color=(235, 235, 235))
     depth_img = np.pad(depth_img, ((2, 2), (2, 2), (0, 0)), constant_values=60)
@@ -278,73 +272,26 @@ def _refine_soup(V: np.ndarray, F: np.ndarray, n: int) -> tuple[np.ndarray, np.n
     return P, (T[None] + (len(i) * np.arange(len(F)))[:, None, None]).reshape(-1, 3)
 
 
-def fig_view(out: Path, quick: bool) -> Figure:
-    scene = _L.classic_scene()
+@figure_name("shadows_3d")
+def fig_view(L, quick: bool) -> MeshView:
+    scene = L.classic_scene()
     V, F = _refine_soup(scene.V, scene.F, 3 if quick else 5)
-    M = _L.light_setup(scene, _L.CLASSIC_LIGHT).matrices[0]
-    D = _L.depth_map(scene.V, scene.F, M, 1024)
+    M = L.light_setup(scene, L.CLASSIC_LIGHT).matrices[0]
+    D = L.depth_map(scene.V, scene.F, M, 1024)
     e1, e2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
     N = np.cross(e1, e2)
     N /= np.maximum(np.linalg.norm(N, axis=1, keepdims=True), 1e-300)
-    vis = _L.shadow_visibility(V[F].mean(axis=1), N, D, M, pcf=3)
-    path = write_html(
-        out / "shadows_3d.html", V, F, vis, title="Classic scene: light visibility per face", up="z",
+    vis = L.shadow_visibility(V[F].mean(axis=1), N, D, M, pcf=3)
+    return MeshView(
+        V, F, vis, title="Classic scene: light visibility per face", up="z",
         cmap="gray", clim=(0.0, 1.0), edges=False, scalar_name="visibility",
-    )  # fmt: skip
-    return Figure(
-        path,
-        "Turn it: every face of the classic scene coloured by the visibility of the directional light your shadow "
-        "map gives (1 lit, 0 in shadow, 1024 x 1024 map, 3 x 3 PCF): the shadows stay attached to their casters "
+        caption="Turn it: every face of the classic scene coloured by the visibility of the directional light your "
+        "shadow map gives (1 lit, 0 in shadow, 1024 x 1024 map, 3 x 3 PCF): the shadows stay attached to their casters "
         "from every side.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-fig_bias.figure_name = "shadows_bias"
-fig_frustum.figure_name = "shadows_frustum"
-fig_resolution.figure_name = "shadows_resolution"
-fig_pcf.figure_name = "shadows_pcf"
-fig_pyrender.figure_name = "shadows_pyrender"
-fig_lights.figure_name = "shadows_lights"
-fig_view.figure_name = "shadows_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.shadows``, ``labs.shadows``, a
-        submission); default: the package this file is in, so in ``labs/shadows/`` your own code.
-    quick : bool
-        Smaller images and maps (for the notebook and CI).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    _CACHE.clear()
-    try:
-        return lab_figures(
-            (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), out_dir, LAB, quick
-        )
-    finally:
-        _CACHE.clear()
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``shadows_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    return lab_view(fig_view, out_dir, LAB, quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), fig_view,
+    quick="Smaller images and maps (for the notebook and CI).", shared=_CACHE,
+)  # fmt: skip

@@ -12,20 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    heat_colors,
-    lab_figures,
-    lab_package,
-    lab_view,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png, with_colorbar
 from geomlib.render import camera_pose, render, render_polygons
-from geomlib.viewer import write_html
 
 __all__ = ["make_figures", "make_view", "airplane"]
 
@@ -39,13 +28,8 @@ def _ss(quick: bool) -> int:
 
 
 def _functions(lab):
-    """``(loop_subdivide, catmull_clark)`` of the given lab module, or of this package."""
-    if lab is not None:
-        return lab.loop_subdivide, lab.catmull_clark
-    from .catmullclark import catmull_clark
-    from .loop import loop_subdivide
-
-    return loop_subdivide, catmull_clark
+    """``(loop_subdivide, catmull_clark)`` of the lab module the figures draw."""
+    return lab.loop_subdivide, lab.catmull_clark
 
 
 def airplane() -> tuple[np.ndarray, np.ndarray]:
@@ -61,6 +45,7 @@ def _levels(subdivide, V, F, levels: int, **kw) -> list[tuple[np.ndarray, np.nda
     return out
 
 
+@figure_name("loop_levels")
 def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
     loop_subdivide, _ = _functions(lab)
     size = (240, 200) if quick else (330, 270)
@@ -104,6 +89,7 @@ def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("warren_vs_loop")
 def fig_weights(out: Path, lab, quick: bool) -> Figure:
     loop_subdivide, _ = _functions(lab)
     size = (260, 220) if quick else (360, 300)
@@ -138,6 +124,7 @@ def fig_weights(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("catmull_clark_levels")
 def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
     _, catmull_clark = _functions(lab)
     size = (240, 200) if quick else (330, 270)
@@ -168,6 +155,7 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("boundary")
 def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     loop_subdivide, catmull_clark = _functions(lab)
     import trimesh
@@ -214,6 +202,7 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
     )
 
 
+@figure_name("convergence")
 def fig_convergence(out: Path, lab, quick: bool) -> Figure:
     loop_subdivide, catmull_clark = _functions(lab)
     L = 4 if quick else 6
@@ -246,62 +235,20 @@ def fig_convergence(out: Path, lab, quick: bool) -> Figure:
     )
 
 
-def fig_view(out: Path, lab, quick: bool) -> Figure:
+@figure_name("subdivision_3d")
+def fig_view(lab, quick: bool) -> MeshView:
     loop_subdivide, _ = _functions(lab)
     V, F = airplane()
     levels = 1 if quick else 2
     Vs, Fs = loop_subdivide(V, F, levels=levels)
-    path = write_html(
-        out / "subdivision_3d.html", Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z"
-    )
-    return Figure(
-        path,
-        f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are open "
-        "sheets, and their boundary edges stay sharp and straight.",
-        LAB,
-    )
+    return MeshView(
+        Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z",
+        caption=f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are "
+        "open sheets, and their boundary edges stay sharp and straight.",
+    )  # fmt: skip
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-fig_loop_levels.figure_name = "loop_levels"
-fig_weights.figure_name = "warren_vs_loop"
-fig_catmull_clark.figure_name = "catmull_clark_levels"
-fig_boundary.figure_name = "boundary"
-fig_convergence.figure_name = "convergence"
-fig_view.figure_name = "subdivision_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.subdivision``, ``labs.subdivision``, a
-        submission); default: the package this file is in, so in ``labs/subdivision/`` your own code.
-    quick : bool
-        Fewer levels and smaller images (for notebooks and smoke tests).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    return lab_figures(
-        (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence),
-        out_dir,
-        LAB,
-        lab_package(lab, __package__),
-        quick,
-    )
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``subdivision_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    return lab_view(fig_view, out_dir, LAB, lab_package(lab, __package__), quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (fig_loop_levels, fig_weights, fig_catmull_clark, fig_boundary, fig_convergence), fig_view,
+    quick="Fewer levels and smaller images (for notebooks and smoke tests).",
+)  # fmt: skip

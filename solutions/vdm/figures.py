@@ -18,23 +18,10 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.plot import (
-    Figure,
-    colorbar,
-    lab_figures,
-    lab_package,
-    lab_view,
-    line_plot,
-    panels,
-    save_png,
-    with_colorbar,
-)
-from geomlib.viewer import write_html
+from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.plot import Figure, colorbar, line_plot, panels, save_png, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
-
-#: The lab package whose functions the figures draw (set by :func:`make_figures`).
-_L = None
 
 LAB = "vdm"
 STAGES = {
@@ -111,17 +98,18 @@ def _render(V, F, size, **kw):
 # ------------------------------------------------------------------------------------------------
 
 
-def _pipeline(out: Path, quick: bool) -> Figure:
+@figure_name("vdm_pipeline")
+def _pipeline(out: Path, L, quick: bool) -> Figure:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     px = 200 if quick else 340
-    UV = _L.parameterize_square(V, F)
-    imp = _L.vertex_importance(V, F)
-    fld = _L.importance_field(UV, imp, 64, density=_L.area_density(V, F, UV, 64))
-    G0 = _L.uniform_grid(res)
-    G = _L.transport_grid(fld, res)
-    edges, corners = _L.sharp_features(V, F)
-    vdm = _L.bake_vdm(V, F, res, UV=UV)
+    UV = L.parameterize_square(V, F)
+    imp = L.vertex_importance(V, F)
+    fld = L.importance_field(UV, imp, 64, density=L.area_density(V, F, UV, 64))
+    G0 = L.uniform_grid(res)
+    G = L.transport_grid(fld, res)
+    edges, corners = L.sharp_features(V, F)
+    vdm = L.bake_vdm(V, F, res, UV=UV)
 
     mesh_img = _render(V, F, (px * 4 // 3, px))
     z = V[:, 2]
@@ -171,18 +159,19 @@ def _pipeline(out: Path, quick: bool) -> Figure:
     )
 
 
-def _rock_reconstruction(out: Path, quick: bool) -> Figure:
+@figure_name("vdm_rock_naive_vs_optimised")
+def _rock_reconstruction(out: Path, L, quick: bool) -> Figure:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     size = (300, 225) if quick else (420, 315)
     ns = 5000 if quick else 30000
-    UV = _L.parameterize_square(V, F)
+    UV = L.parameterize_square(V, F)
     # One camera for the three panels, framing the original tightly: same place, same size.
     pose = render.camera_pose(V, "three_quarter", size=size, margin=0.02)
     imgs, caps = [_render(V, F, size, camera=pose)], [f"original ({len(F)} triangles)"]
     for name in ("naive", "+diagonals"):
-        vdm = _L.bake_vdm(V, F, res, UV=UV, **STAGES[name])
-        Vr, Fr = _L.vdm_to_mesh(vdm)
+        vdm = L.bake_vdm(V, F, res, UV=UV, **STAGES[name])
+        Vr, Fr = L.vdm_to_mesh(vdm)
         h, c = _errors(V, F, Vr, Fr, ns)
         imgs.append(_render(Vr, Fr, size, camera=pose, wireframe=True, edge_width=0.6))
         label = "naive (uniform grid)" if name == "naive" else "optimised (density + alignment + diagonals)"
@@ -197,16 +186,17 @@ def _rock_reconstruction(out: Path, quick: bool) -> Figure:
     )
 
 
-def _box_stages(out: Path, quick: bool) -> Figure:
-    V, F = _L.open_box(8)
+@figure_name("vdm_box_stages")
+def _box_stages(out: Path, L, quick: bool) -> Figure:
+    V, F = L.open_box(8)
     res = 16
     size = (280, 210) if quick else (340, 255)
     ns = 5000 if quick else 20000
-    UV = _L.parameterize_square(V, F)
+    UV = L.parameterize_square(V, F)
     imgs, caps = [], []
     for name, st in STAGES.items():
-        vdm = _L.bake_vdm(V, F, res, UV=UV, **st)
-        Vr, Fr = _L.vdm_to_mesh(vdm)
+        vdm = L.bake_vdm(V, F, res, UV=UV, **st)
+        Vr, Fr = L.vdm_to_mesh(vdm)
         h, c = _errors(V, F, Vr, Fr, ns)
         imgs.append(_render(Vr, Fr, size, wireframe=True, edge_width=0.7))
         caps.append(f"{name}: Hausdorff {h:.1e}, Chamfer {c:.1e}")
@@ -221,22 +211,23 @@ def _box_stages(out: Path, quick: bool) -> Figure:
     )
 
 
-def _diagonals(out: Path, quick: bool) -> Figure:
-    V, F = _L.open_box(8)
+@figure_name("vdm_diagonals")
+def _diagonals(out: Path, L, quick: bool) -> Figure:
+    V, F = L.open_box(8)
     res = 16
     px = 260 if quick else 340
-    UV = _L.parameterize_square(V, F)
-    edges, _ = _L.sharp_features(V, F)
-    vdm = _L.bake_vdm(V, F, res, UV=UV)
+    UV = L.parameterize_square(V, F)
+    edges, _ = L.sharp_features(V, F)
+    vdm = L.bake_vdm(V, F, res, UV=UV)
     G = vdm.grid_uv
     imgs, caps = [], []
-    for name, diag in (("global", _L.valid_diagonals(G)), ("per-quad", vdm.diagonals)):
-        T = _L.grid_faces(res, diag)
+    for name, diag in (("global", L.valid_diagonals(G)), ("per-quad", vdm.diagonals)):
+        T = L.grid_faces(res, diag)
         P = G.reshape(-1, 2)
         fig, ax = _canvas(px)
         ax.triplot(P[:, 0], P[:, 1], T, color="#1f3b73", lw=0.6)
         _draw_sharp(ax, UV, edges, lw=1.6)
-        flipped = np.flatnonzero(~diag.ravel() != ~_L.valid_diagonals(G).ravel()) if name == "per-quad" else []
+        flipped = np.flatnonzero(~diag.ravel() != ~L.valid_diagonals(G).ravel()) if name == "per-quad" else []
         for c in flipped:
             i, j = divmod(int(c), res - 1)
             quad = G[[i, i, i + 1, i + 1], [j, j + 1, j + 1, j]]
@@ -249,7 +240,7 @@ def _diagonals(out: Path, quick: bool) -> Figure:
         )
         from dataclasses import replace
 
-        Vr, Fr = _L.vdm_to_mesh(replace(vdm, diagonals=diag))
+        Vr, Fr = L.vdm_to_mesh(replace(vdm, diagonals=diag))
         # Close-up of the vertical crease above the rim corner (1, 0, 0), which runs along the cells'
         # b-d diagonals in uv. The eye stays below the top (z = 0.5): seen from just above it, the top
         # face would be an almost edge-on dark band.
@@ -267,17 +258,18 @@ def _diagonals(out: Path, quick: bool) -> Figure:
     )
 
 
-def _background_sweep(out: Path, quick: bool) -> Figure:
+@figure_name("vdm_background_sweep")
+def _background_sweep(out: Path, L, quick: bool) -> Figure:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     px = 180 if quick else 240
     values = [0.01, 0.3, 5.0] if quick else [0.01, 0.1, 0.3, 1.0, 5.0]
-    UV = _L.parameterize_square(V, F)
-    edges, _ = _L.sharp_features(V, F)
+    UV = L.parameterize_square(V, F)
+    edges, _ = L.sharp_features(V, F)
     imgs, caps, haus, cham = [], [], [], []
     for bg in values:
-        vdm = _L.bake_vdm(V, F, res, UV=UV, background=bg)
-        h, c = _errors(V, F, *_L.vdm_to_mesh(vdm), 5000 if quick else 20000)
+        vdm = L.bake_vdm(V, F, res, UV=UV, background=bg)
+        h, c = _errors(V, F, *L.vdm_to_mesh(vdm), 5000 if quick else 20000)
         haus.append(h)
         cham.append(c)
         fig, ax = _canvas(px)
@@ -311,59 +303,19 @@ def _background_sweep(out: Path, quick: bool) -> Figure:
     )
 
 
-def _fig_view(out: Path, quick: bool) -> Figure:
+@figure_name("vdm_3d")
+def _fig_view(L, quick: bool) -> MeshView:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 32 if quick else 64
-    Vr, Fr = _L.vdm_to_mesh(_L.bake_vdm(V, F, res, UV=_L.parameterize_square(V, F)))
-    path = write_html(out / "vdm_3d.html", Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z")
-    return Figure(
-        path,
-        f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
+    Vr, Fr = L.vdm_to_mesh(L.bake_vdm(V, F, res, UV=L.parameterize_square(V, F)))
+    return MeshView(
+        Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z",
+        caption=f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
         "gather on the crease of the plinth and follow it.",
-        LAB,
-    )
+    )  # fmt: skip
 
 
-#: File name of each figure (the "not implemented yet" picture of a student's copy goes there too).
-_pipeline.figure_name = "vdm_pipeline"
-_rock_reconstruction.figure_name = "vdm_rock_naive_vs_optimised"
-_box_stages.figure_name = "vdm_box_stages"
-_diagonals.figure_name = "vdm_diagonals"
-_background_sweep.figure_name = "vdm_background_sweep"
-_fig_view.figure_name = "vdm_3d"
-
-
-def make_figures(out_dir, lab=None, quick: bool = False) -> list[Figure]:
-    """Render the lab's figures into ``out_dir`` and return them with their captions.
-
-    Parameters
-    ----------
-    out_dir : str or Path
-        Folder for the PNG files (created if missing).
-    lab : module, optional
-        The lab package whose functions the figures draw (``solutions.vdm``, ``labs.vdm``, a
-        submission); default: the package this file is in, so in ``labs/vdm/`` your own code.
-    quick : bool
-        Smaller meshes, grids and images (for the notebook and tests).
-
-    Returns
-    -------
-    list of Figure
-        Every figure; one whose tasks are not implemented yet is a picture saying
-        "Task N not implemented yet" (under the same file name).
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    return lab_figures(
-        (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep), out_dir, LAB, quick
-    )
-
-
-def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
-    """Write ``vdm_3d.html``, the lab's interactive 3D view, into ``out_dir`` (:func:`geomlib.plot.lab_view`).
-
-    Same arguments as :func:`make_figures`.
-    """
-    global _L
-    _L = lab_package(lab, __package__)
-    return lab_view(_fig_view, out_dir, LAB, quick)
+make_figures, make_view = lab_figure_makers(
+    LAB, __name__, (_pipeline, _rock_reconstruction, _box_stages, _diagonals, _background_sweep), _fig_view,
+    quick="Smaller meshes, grids and images (for the notebook and tests).",
+)  # fmt: skip

@@ -247,24 +247,6 @@ def test_with_colorbar_puts_the_bar_beside_the_map():
     assert (both[:, :80] == 0).all()  # the map untouched, on the left
 
 
-def test_a_missing_task_becomes_a_labelled_placeholder(tmp_path):
-    from geomlib.plot import figures_or_placeholders, lab_package, save_png
-
-    def fig_done(out, quick):
-        return Figure(save_png(out / "done.png", np.zeros((8, 8, 3), np.uint8)), "done", "lab")
-
-    def fig_todo(out, quick):
-        raise NotImplementedError("Task 3b (odd vertices): E = ...")
-
-    fig_todo.figure_name = "todo_figure"
-    figs = figures_or_placeholders((fig_done, fig_todo), tmp_path, "lab", True)
-    assert [f.path.name for f in figs] == ["done.png", "todo_figure.png"]
-    assert figs[1].caption.startswith("Task 3b not implemented yet") and "odd vertices" in figs[1].caption
-    assert figs[1].path.is_file()
-    with pytest.raises(MeshError, match="lab must be a module"):
-        lab_package("subdivision", "solutions.subdivision")
-
-
 def test_the_index_frames_interactive_views(tmp_path):
     png = Figure(save_png(tmp_path / "lab" / "a.png", np.zeros((8, 8, 3), np.uint8)), "a picture", "lab")
     page = tmp_path / "lab" / "lab_3d.html"
