@@ -33,11 +33,14 @@ def fallback_perpendicular(N: np.ndarray) -> np.ndarray:
     return normalize_rows(T, fallback=(1.0, 0.0, 0.0))
 
 
-def as_height_map(H, where: str, name: str = "height", *, unit_range: bool = False) -> np.ndarray:
-    """A square single-channel height map as float64 ``(s, s)``.
+def as_height_map(
+    H, where: str, name: str = "height", *, unit_range: bool = False, what: str = "height map"
+) -> np.ndarray:
+    """A square single-channel map of heights or offsets as float64 ``(s, s)``.
 
     uint8 and uint16 images are scaled to ``[0, 1]`` (black = 0); float maps are used as they are
-    and, with ``unit_range``, must lie in ``[0, 1]``.
+    and, with ``unit_range``, must lie in ``[0, 1]``. ``what`` names the kind of map in the
+    messages (``"displacement map"``, ``"offset map"``).
 
     Raises
     ------
@@ -49,12 +52,10 @@ def as_height_map(H, where: str, name: str = "height", *, unit_range: bool = Fal
     if img.ndim == 3:
         raise MeshError(
             f"{where}: {name} has {img.shape[2]} channels (shape {img.shape}); expected a single-channel (grey) "
-            f"height map (s, s)"
+            f"{what} (s, s)"
         )
     if img.shape[0] != img.shape[1]:
-        raise MeshError(
-            f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; maps in this lab are square (s x s texels)"
-        )
+        raise MeshError(f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; {what}s are square (s x s texels)")
     if img.dtype == np.uint8:
         return img.astype(np.float64) / 255.0
     if img.dtype == np.uint16:
@@ -64,8 +65,8 @@ def as_height_map(H, where: str, name: str = "height", *, unit_range: bool = Fal
     out = as_array(img, name, dtype=np.float64, where=where)
     if unit_range and (out.min() < 0 or out.max() > 1):
         raise MeshError(
-            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; a displacement map holds values in [0, 1] "
-            f"(use bias and scale to map them to offsets)"
+            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; {what} values lie in [0, 1] "
+            f"(bias and scale turn them into offsets)"
         )
     return out
 

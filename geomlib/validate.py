@@ -379,15 +379,23 @@ def check_int(
 
 
 def check_float(
-    value, name: str, *, minimum: float | None = None, maximum: float | None = None, where: str | None = None
+    value,
+    name: str,
+    *,
+    minimum: float | None = None,
+    maximum: float | None = None,
+    positive: bool = False,
+    where: str | None = None,
 ) -> float:
-    """A finite real parameter within optional bounds."""
+    """A finite real parameter within optional bounds (``positive``: strictly greater than 0)."""
     p = _prefix(where)
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise MeshError(f"{p}{name} must be a number, got {value!r} ({type(value).__name__})")
     value = float(value)
     if not np.isfinite(value):
         raise MeshError(f"{p}{name} must be finite, got {value}")
+    if positive and value <= 0:
+        raise MeshError(f"{p}{name} must be > 0, got {value}")
     if minimum is not None and value < minimum:
         raise MeshError(f"{p}{name} must be >= {minimum}, got {value}")
     if maximum is not None and value > maximum:

@@ -17,7 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, as_array, as_image, check_choice, check_uv
+from geomlib.tangent_space import as_height_map
+from geomlib.validate import MeshError, as_array, check_choice, check_uv
 from geomlib.vectors import as_unit_vectors as as_unit_normals
 from geomlib.vectors import normalize_rows
 
@@ -76,26 +77,7 @@ def as_offset_image(image, where: str, name: str = "image") -> np.ndarray:
     """A square single-channel offset map as float64 ``(s, s)`` in ``[0, 1]``.
 
     ``uint8`` images are divided by 255 and ``uint16`` images by 65535 (the inverse of the
-    quantisation in :func:`bake_offset_map`); float images must already lie in ``[0, 1]``.
+    quantisation in :func:`bake_offset_map`); float images must already lie in ``[0, 1]``
+    (:func:`geomlib.tangent_space.as_height_map`, shared with the maps and relief labs).
     """
-    img = as_image(image, name, where=where)
-    if img.ndim == 3:
-        raise MeshError(
-            f"{where}: {name} has {img.shape[2]} channels (shape {img.shape}); an offset map is a single-channel "
-            f"image (s, s)"
-        )
-    if img.shape[0] != img.shape[1]:
-        raise MeshError(f"{where}: {name} is {img.shape[0]}x{img.shape[1]} texels; offset maps are square (s x s)")
-    if img.dtype == np.uint8:
-        return img.astype(np.float64) / 255.0
-    if img.dtype == np.uint16:
-        return img.astype(np.float64) / 65535.0
-    if img.dtype.kind != "f":
-        raise MeshError(f"{where}: {name} has dtype {img.dtype}; expected uint8, uint16 or floats in [0, 1]")
-    out = as_array(img, name, dtype=np.float64, where=where)
-    if out.min() < 0 or out.max() > 1:
-        raise MeshError(
-            f"{where}: {name} values span [{out.min():.6g}, {out.max():.6g}]; a float offset map holds values in "
-            f"[0, 1] (bias and scale turn them into offsets)"
-        )
-    return out
+    return as_height_map(image, where, name, unit_range=True, what="offset map")

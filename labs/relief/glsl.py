@@ -18,9 +18,18 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import gl
-from geomlib.validate import MeshError, as_array, check_float
 
-from .inputs import check_directions, check_height, check_layers, check_march, check_scale, check_uv_points
+from .inputs import (
+    check_bias,
+    check_depths,
+    check_directions,
+    check_height,
+    check_layers,
+    check_march,
+    check_scale,
+    check_uv_points,
+    check_view_ray,
+)
 from .relief import REFINEMENTS
 
 __all__ = ["SHADERS", "shader_path", "glsl_parallax_uv", "glsl_relief_uv", "glsl_relief_shadow"]
@@ -43,21 +52,11 @@ def _run(name: str, size: tuple[int, int], textures: dict, uniforms: dict) -> np
     return gl.render_quad(source, size, textures=textures, uniforms=uniforms, name=f"shaders/{name}.frag")
 
 
-def _grid(uv, where: str) -> np.ndarray:
-    uv = check_uv_points(uv, where)
-    if uv.ndim != 3:
-        raise MeshError(f"{where}: uv has shape {uv.shape}; the GLSL route renders images, expected (h, w, 2)")
-    return uv
-
-
 def glsl_parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, offset_limit: bool = False):
     """:func:`parallax_uv` computed by ``shaders/parallax.frag``; ``uv`` is ``(h, w, 2)``."""
     where = "glsl_parallax_uv"
-    H = check_height(height, where)
-    uv = _grid(uv, where)
-    V = check_directions(view, uv.shape[:-1], where)
-    scale = check_scale(scale, where)
-    bias = -scale if bias is None else check_float(bias, "bias", where=where)
+    H, uv, V, scale = check_view_ray(height, uv, view, scale, where, grid=True)
+    bias = check_bias(bias, scale, where)
     out = _run(
         "parallax",
         (uv.shape[1], uv.shape[0]),
@@ -80,10 +79,7 @@ def glsl_relief_uv(
 ):
     """:func:`relief_uv` computed by ``shaders/relief.frag``; ``uv`` is ``(h, w, 2)``."""
     where = "glsl_relief_uv"
-    H = check_height(height, where)
-    uv = _grid(uv, where)
-    V = check_directions(view, uv.shape[:-1], where)
-    scale = check_scale(scale, where)
+    H, uv, V, scale = check_view_ray(height, uv, view, scale, where, grid=True)
     lo, hi, steps = check_march(min_layers, max_layers, refine, refine_steps, REFINEMENTS, where)
     out = _run(
         "relief",
@@ -104,10 +100,8 @@ def glsl_relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 
     """:func:`relief_shadow` computed by ``shaders/shadow.frag``; ``uv`` is ``(h, w, 2)``."""
     where = "glsl_relief_shadow"
     H = check_height(height, where)
-    uv = _grid(uv, where)
-    D = as_array(depth, "depth", dtype=np.float64, where=where)
-    if D.shape != uv.shape[:-1]:
-        raise MeshError(f"{where}: depth has shape {D.shape}; expected {uv.shape[:-1]}, one depth per uv")
+    uv = check_uv_points(uv, where, grid=True)
+    D = check_depths(depth, uv.shape[:-1], where)
     L = check_directions(light, uv.shape[:-1], where, name="light")
     out = _run(
         "shadow",

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import check_float
-
-from .inputs import check_directions, check_height, check_scale, check_uv_points, height_at
+from .inputs import check_bias, check_view_ray, height_at
 
 __all__ = ["parallax_uv"]
 
@@ -43,9 +41,6 @@ def parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, of
     (..., 2) float64
     """
     where = "parallax_uv"
-    H = check_height(height, where)
-    uv = check_uv_points(uv, where)
-    V = check_directions(view, uv.shape[:-1], where)
-    scale = check_scale(scale, where)
-    bias = -scale if bias is None else check_float(bias, "bias", where=where)
+    H, uv, V, scale = check_view_ray(height, uv, view, scale, where)
+    bias = check_bias(bias, scale, where)
     raise NotImplementedError("Task 2 (parallax): hsb = scale h(uv) + bias; uv' = uv + hsb view_xy / view_z (offset limiting: uv + hsb view_xy)")

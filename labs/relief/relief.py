@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .inputs import check_directions, check_height, check_march, check_scale, check_uv_points, height_at
+from .inputs import check_march, check_view_ray, height_at
 
 __all__ = ["relief_uv", "layer_count", "REFINEMENTS"]
 
@@ -82,10 +82,7 @@ def relief_uv(
     over layers; each iteration works on all the pixels still marching at once.
     """
     where = "relief_uv"
-    H = check_height(height, where)
-    uv = check_uv_points(uv, where)
-    V = check_directions(view, uv.shape[:-1], where)
-    scale = check_scale(scale, where)
+    H, uv, V, scale = check_view_ray(height, uv, view, scale, where)
     lo_n, hi_n, steps_n = check_march(min_layers, max_layers, refine, refine_steps, REFINEMENTS, where)
 
     shape = uv.shape[:-1]

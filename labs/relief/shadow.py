@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, as_array
-
-from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points, height_at
+from .inputs import check_depths, check_directions, check_height, check_layers, check_scale, check_uv_points, height_at
 
 __all__ = ["relief_shadow"]
 
@@ -48,11 +46,7 @@ def relief_shadow(height, uv, depth, light, *, scale: float, layers: int = 32) -
     H = check_height(height, where)
     uv = check_uv_points(uv, where)
     shape = uv.shape[:-1]
-    D = as_array(depth, "depth", dtype=np.float64, where=where)
-    if D.shape != shape:
-        raise MeshError(f"{where}: depth has shape {D.shape}; expected {shape}, one depth per uv")
-    if (D < 0).any():
-        raise MeshError(f"{where}: depth has negative values (min {D.min():.6g}); depths below the polygon are >= 0")
+    D = check_depths(depth, shape, where)
     L = check_directions(light, shape, where, name="light")
     scale = check_scale(scale, where)
     n = check_layers(layers, "layers", where)

@@ -61,9 +61,7 @@ def sd_sphere(P, center, radius: float) -> np.ndarray:
     where = "sd_sphere"
     P = as_points(P, where)
     c = _vec3(center, "center", where)
-    r = check_float(radius, "radius", minimum=0.0, where=where)
-    if r <= 0:
-        raise MeshError(f"{where}: radius must be > 0, got {r}")
+    r = check_float(radius, "radius", positive=True, where=where)
     raise NotImplementedError('Task 1 (analytic SDFs): phi(p) = |p - c| - r')
 
 
@@ -137,9 +135,7 @@ def sd_capsule(P, a, b, radius: float) -> np.ndarray:
     P = as_points(P, where)
     a = _vec3(a, "a", where)
     b = _vec3(b, "b", where)
-    r = check_float(radius, "radius", minimum=0.0, where=where)
-    if r <= 0:
-        raise MeshError(f"{where}: radius must be > 0, got {r}")
+    r = check_float(radius, "radius", positive=True, where=where)
     raise NotImplementedError('Task 1 (analytic SDFs): h = clamp((p-a).(b-a)/|b-a|^2, 0, 1); phi = |p - a - h(b-a)| - r')
 
 
@@ -195,8 +191,6 @@ def smooth_union(a, b, k: float = 0.1) -> np.ndarray:
     ``min(a, b)`` where ``|a - b| >= k``; it is a bound, not an exact distance, in the blend.
     """
     a, b = _pair(a, b, "smooth_union")
-    k = check_float(k, "k", where="smooth_union")
-    if k <= 0:
-        raise MeshError(f"smooth_union: k must be > 0, got {k}")
+    k = check_float(k, "k", positive=True, where="smooth_union")
     h = np.clip(0.5 + 0.5 * (b - a) / k, 0.0, 1.0)
     return b + (a - b) * h - k * h * (1.0 - h)

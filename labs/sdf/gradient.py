@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.validate import MeshError, check_float
+from geomlib.validate import check_float
 
 from .analytic import as_points
 from .scene import as_field
@@ -29,10 +29,7 @@ TETRA = np.array([[1.0, -1.0, -1.0], [-1.0, -1.0, 1.0], [-1.0, 1.0, -1.0], [1.0,
 
 
 def _h(h, where):
-    h = check_float(h, "h", where=where)
-    if h <= 0:
-        raise MeshError(f"{where}: h must be > 0, got {h}")
-    return h
+    return check_float(h, "h", positive=True, where=where)
 
 
 def _unit(G):

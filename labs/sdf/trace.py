@@ -58,9 +58,7 @@ def sphere_trace(sdf, origins, directions, *, max_steps: int = 64, eps: float = 
         raise MeshError(f"{where}: directions must be non-zero (row {int(np.flatnonzero(L == 0)[0])})")
     D = D / L[:, None]
     max_steps = check_int(max_steps, "max_steps", minimum=1, where=where)
-    eps = check_float(eps, "eps", where=where)
-    if eps <= 0:
-        raise MeshError(f"{where}: eps must be > 0, got {eps}")
+    eps = check_float(eps, "eps", positive=True, where=where)
     t_max = np.inf if t_max is None else check_float(t_max, "t_max", minimum=0.0, where=where)
     raise NotImplementedError('Task 8 (sphere tracing): keep an index array of active rays; each step: d = phi(o + t dir) for them, steps += 1, d < eps -> hit; t += max(d, eps); t > t_max -> miss; drop finished rays')
 

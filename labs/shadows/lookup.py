@@ -369,12 +369,8 @@ def poisson_pcf_visibility(
 
     Parameters
     ----------
-    D : (size, size) array_like
-        Shadow map (row 0 = top, ``v = 1``).
-    uvz : (n, 3) array_like
-        Finite map coordinates from :func:`light_uvz`.
-    bias : float or (n,) array_like
-        Depth bias, as in :func:`compare_depth`.
+    D, uvz, bias
+        Shadow map, map coordinates and depth bias, as in :func:`pcf_visibility`.
     radius : float, > 0
         Disk radius in texels; ``k / 2`` covers about the area of a k x k block.
     samples : int

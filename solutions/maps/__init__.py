@@ -1,26 +1,19 @@
 """Lab "maps": tangent frames, normal maps (encode, decode, from heights, baking), per-pixel shading and displacement maps."""
 
-from .bake import bake_normal_map, barycentric, project_to_surface
-from .displacement import displace, group_mean, welded_vertex_normals
-from .encoding import decode_normal_map, encode_normal_map
-from .heightmap import BORDERS, height_to_normal_map
-from .shading import rasterize_mesh, shade, surface_frames
-from .tangents import face_uv_gradients, tangent_frames
+# ruff: noqa: F403 (the package re-exports what its modules export)
+from . import bake, displacement, encoding, heightmap, shading, tangents
+from .bake import *
+from .displacement import *
+from .encoding import *
+from .heightmap import *
+from .shading import *
+from .tangents import *
 
+#: Exported by their modules for the lab's other modules (input checks and the like), not by the lab.
+_MODULE_ONLY = {"cross_rows", "scatter_to_vertices"}
 __all__ = [
-    "tangent_frames",
-    "face_uv_gradients",
-    "encode_normal_map",
-    "decode_normal_map",
-    "height_to_normal_map",
-    "BORDERS",
-    "shade",
-    "rasterize_mesh",
-    "surface_frames",
-    "displace",
-    "welded_vertex_normals",
-    "group_mean",
-    "bake_normal_map",
-    "project_to_surface",
-    "barycentric",
+    name
+    for module in (tangents, encoding, heightmap, shading, displacement, bake)
+    for name in module.__all__
+    if name not in _MODULE_ONLY
 ]

@@ -110,7 +110,7 @@ def displace(
     V, F = check_mesh(V, F, where=where)
     check_choice(wrap, "wrap", WRAP_MODES, where=where)
     UV = check_uv(UV, len(V), where, in_range=(wrap == "clamp"))
-    Hm = as_height_map(height, where, name="height", unit_range=True)
+    Hm = as_height_map(height, where, name="height", unit_range=True, what="displacement map")
     lam = check_float(lam, "lam", where=where)
     bias = check_float(bias, "bias", where=where)
     scale = check_float(scale, "scale", where=where)

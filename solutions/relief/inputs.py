@@ -23,7 +23,17 @@ from geomlib.tangent_space import as_height_map
 from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int
 from geomlib.vectors import normalize_rows
 
-__all__ = ["as_height_map", "check_height", "check_uv_points", "check_directions", "height_at", "normalize_rows"]
+__all__ = [
+    "as_height_map",
+    "check_height",
+    "check_uv_points",
+    "check_directions",
+    "check_view_ray",
+    "check_bias",
+    "check_depths",
+    "height_at",
+    "normalize_rows",
+]
 
 
 def check_height(height, where: str) -> np.ndarray:
@@ -37,11 +47,13 @@ def check_height(height, where: str) -> np.ndarray:
     return H
 
 
-def check_uv_points(uv, where: str, name: str = "uv") -> np.ndarray:
-    """Texture coordinates ``(..., 2)`` float64, finite."""
+def check_uv_points(uv, where: str, name: str = "uv", *, grid: bool = False) -> np.ndarray:
+    """Texture coordinates ``(..., 2)`` float64, finite; with ``grid`` an image of them, ``(h, w, 2)``."""
     a = as_array(uv, name, dtype=np.float64, where=where)
     if a.ndim == 0 or a.shape[-1] != 2:
         raise MeshError(f"{where}: {name} has shape {a.shape}; expected (..., 2) texture coordinates (u, v)")
+    if grid and a.ndim != 3:
+        raise MeshError(f"{where}: {name} has shape {a.shape}; the GLSL route renders images, expected (h, w, 2)")
     return a
 
 
@@ -74,6 +86,33 @@ def check_directions(d, shape: tuple, where: str, name: str = "view") -> np.ndar
 
 def check_scale(scale, where: str) -> float:
     return check_float(scale, "scale", minimum=0.0, where=where)
+
+
+def check_view_ray(height, uv, view, scale, where: str, *, grid: bool = False):
+    """The inputs of a view ray through the relief, checked: ``(H, uv, V, scale)``.
+
+    ``H`` from :func:`check_height`, ``uv`` from :func:`check_uv_points` (``grid``: the ``(h, w, 2)``
+    image the GLSL route renders), ``V`` the unit view directions, one per uv
+    (:func:`check_directions`), and ``scale >= 0``.
+    """
+    H = check_height(height, where)
+    uv = check_uv_points(uv, where, grid=grid)
+    return H, uv, check_directions(view, uv.shape[:-1], where), check_scale(scale, where)
+
+
+def check_depths(depth, shape: tuple, where: str) -> np.ndarray:
+    """Depths below the polygon (``>= 0``), one per uv: ``shape`` float64."""
+    D = as_array(depth, "depth", dtype=np.float64, where=where)
+    if D.shape != shape:
+        raise MeshError(f"{where}: depth has shape {D.shape}; expected {shape}, one depth per uv")
+    if (D < 0).any():
+        raise MeshError(f"{where}: depth has negative values (min {D.min():.6g}); depths below the polygon are >= 0")
+    return D
+
+
+def check_bias(bias, scale: float, where: str) -> float:
+    """Parallax mapping's height bias: ``-scale`` by default (the relief lies below the polygon)."""
+    return -scale if bias is None else check_float(bias, "bias", where=where)
 
 
 def check_layers(n, name: str, where: str, minimum: int = 1) -> int:

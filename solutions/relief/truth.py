@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .inputs import check_directions, check_height, check_layers, check_scale, check_uv_points, height_at
+from .inputs import check_layers, check_view_ray, height_at
 
 __all__ = ["exact_uv", "uv_error_texels"]
 
@@ -23,10 +23,7 @@ def exact_uv(height, uv, view, *, scale: float, samples: int = 2048, bisections:
     uv : (..., 2) float64, depth : (...) float64
     """
     where = "exact_uv"
-    H = check_height(height, where)
-    uv = check_uv_points(uv, where)
-    V = check_directions(view, uv.shape[:-1], where)
-    scale = check_scale(scale, where)
+    H, uv, V, scale = check_view_ray(height, uv, view, scale, where)
     m = check_layers(samples, "samples", where=where)
     shape = uv.shape[:-1]
     u0, v0 = uv[..., 0].ravel(), uv[..., 1].ravel()

@@ -128,9 +128,7 @@ def brick_sample(codes, table, origin, spacing: float, band_voxels: float, shape
     if np.any(table >= len(codes)) or np.any(table < EMPTY_INSIDE):
         raise MeshError(f"{where}: table entries must be -2, -1 or a row of codes (0..{len(codes) - 1})")
     origin = as_array(origin, "origin", shape=(3,), where=where)
-    spacing = check_float(spacing, "spacing", where=where)
-    if spacing <= 0:
-        raise MeshError(f"{where}: spacing must be > 0, got {spacing}")
+    spacing = check_float(spacing, "spacing", positive=True, where=where)
     r = _band(band_voxels, spacing, where)
     shape = np.asarray(shape, np.int64).ravel()
     if shape.shape != (3,) or np.any(shape < 2) or np.any(-(-(shape - 1) // 7) != table.shape):

@@ -122,9 +122,7 @@ def bvh_closest(
     P = as_points(P, where)
     upper = np.inf
     if band is not None:
-        band = check_float(band, "band", where=where)
-        if band <= 0:
-            raise MeshError(f"{where}: band must be > 0, got {band}")
+        band = check_float(band, "band", positive=True, where=where)
         upper = band * band
     from . import kernels
 

@@ -80,13 +80,9 @@ def soft_shadow(
     phi = as_field(sdf, where)
     P = as_points(P, where)
     c = as_array(light_center, "light_center", shape=(3,), where=where)
-    R = check_float(light_radius, "light_radius", where=where)
-    if R <= 0:
-        raise MeshError(f"{where}: light_radius must be > 0, got {R}")
+    R = check_float(light_radius, "light_radius", positive=True, where=where)
     max_steps = check_int(max_steps, "max_steps", minimum=1, where=where)
-    eps = check_float(eps, "eps", where=where)
-    if eps <= 0:
-        raise MeshError(f"{where}: eps must be > 0, got {eps}")
+    eps = check_float(eps, "eps", positive=True, where=where)
     Lv = c - P
     Dist = np.linalg.norm(Lv, axis=1)
     if np.any(Dist <= R):
@@ -147,9 +143,7 @@ def ambient_occlusion(sdf, P, N, *, taps: int = 5, delta: float = 0.05) -> np.nd
     P = as_points(P, where)
     N = as_array(N, "N", shape=(len(P), 3), where=where)
     taps = check_int(taps, "taps", minimum=1, maximum=64, where=where)
-    delta = check_float(delta, "delta", where=where)
-    if delta <= 0:
-        raise MeshError(f"{where}: delta must be > 0, got {delta}")
+    delta = check_float(delta, "delta", positive=True, where=where)
     # BEGIN SOLUTION: Task 9 (soft shadows): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)
     i = np.arange(1, taps + 1)
     w = 0.5**i / np.sum(0.5**i)

@@ -8,43 +8,19 @@ Tasks, in order:
 4. the greedy loop: :func:`greedy_collapse`, used by :func:`qem_simplify`.
 """
 
-from .contraction import (
-    SimplifyState,
-    check_contractions,
-    contract_pair,
-    contract_pairs,
-    edge_faces,
-    flips_normal,
-    link_condition,
-    make_state,
-    neighbors,
-    state_mesh,
-)
-from .greedy import candidate_pairs, greedy_collapse, pair_costs
-from .placement import optimal_contraction
-from .quadrics import boundary_quadrics, face_planes, face_quadrics, quadric_error, vertex_quadrics
-from .simplify import SimplificationWarning, qem_simplify
+# ruff: noqa: F403 (the package re-exports what its modules export)
+from . import contraction, greedy, placement, quadrics, simplify
+from .contraction import *
+from .greedy import *
+from .placement import *
+from .quadrics import *
+from .simplify import *
 
+#: Exported by their modules for the lab's other modules (input checks and the like), not by the lab.
+_MODULE_ONLY = {"SINGULAR_RCOND", "refresh_boundary"}
 __all__ = [
-    "face_planes",
-    "face_quadrics",
-    "boundary_quadrics",
-    "vertex_quadrics",
-    "quadric_error",
-    "optimal_contraction",
-    "SimplifyState",
-    "make_state",
-    "neighbors",
-    "edge_faces",
-    "state_mesh",
-    "link_condition",
-    "flips_normal",
-    "contract_pair",
-    "check_contractions",
-    "contract_pairs",
-    "candidate_pairs",
-    "pair_costs",
-    "greedy_collapse",
-    "qem_simplify",
-    "SimplificationWarning",
+    name
+    for module in (quadrics, placement, contraction, greedy, simplify)
+    for name in module.__all__
+    if name not in _MODULE_ONLY
 ]

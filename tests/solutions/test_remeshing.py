@@ -15,7 +15,7 @@ from geomlib import datasets, topology
 from geomlib.geometry import dihedral_angles
 from solutions import remeshing as R
 from solutions.remeshing import kernels as K
-from solutions.remeshing import remesh as M
+from solutions.remeshing import state as M
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -53,7 +53,7 @@ def test_every_kernel_edit_keeps_the_state_consistent():
         kind = rng.integers(0, 3)
         a, b = K.org(S.F, h), K.dst(S.F, h)
         if kind == 0:
-            if K.split(*M._args(S), h, 0.5 * (S.V[a] + S.V[b])) == K.FULL:
+            if K.split(*S.args(), h, 0.5 * (S.V[a] + S.V[b])) == K.FULL:
                 S.grow()
                 continue
         elif kind == 1:
@@ -62,9 +62,9 @@ def test_every_kernel_edit_keeps_the_state_consistent():
             K.flip(S.V, S.F, S.T, S.VH, S.val, S.feat, h)
         else:
             p = 0.5 * (S.V[a] + S.V[b])
-            if K.collapse_check(*M._args(S)[:7], h, p, np.inf, hes, n1, n2) != K.OK:
+            if K.collapse_check(*S.args()[:7], h, p, np.inf, hes, n1, n2) != K.OK:
                 continue
-            K.collapse(*M._args(S)[:8], h, p, hes)
+            K.collapse(*S.args()[:8], h, p, hes)
         edits += 1
         if edits % 25 == 0:
             S.compact()  # drops dead rows: the same mesh, renumbered

@@ -119,6 +119,10 @@ def test_parameters():
         check_float(2.0, "lam", maximum=1.0)
     with pytest.raises(MeshError, match="lam must be finite"):
         check_float(np.nan, "lam")
+    assert check_float(0.5, "radius", positive=True) == 0.5
+    for bad in (0, -1.0):
+        with pytest.raises(MeshError, match=r"sd_sphere: radius must be > 0, got -?[01]\.0"):
+            check_float(bad, "radius", positive=True, where="sd_sphere")
     with pytest.raises(MeshError, match="weights must be one of 'warren', 'loop'; got 'cotan'"):
         check_choice("cotan", "weights", ("warren", "loop"))
 

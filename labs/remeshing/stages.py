@@ -1,0 +1,244 @@
+"""The stages of the loop (Tasks 4-9): split, collapse, flip, feature edges, tangential relaxation, projection.
+
+Stages 1-3 run the passes of :mod:`.kernels` (Tasks 4-6) on the state of :mod:`.state`; features
+(Task 7), relaxation (Task 8) and projection (Task 9) are vectorised NumPy.
+"""
+
+from __future__ import annotations
+
+import igl
+import numpy as np
+from scipy.spatial import cKDTree
+
+from geomlib import topology
+from geomlib.errors import MeshError
+from geomlib.geometry import closest_points
+from geomlib.validate import check_float, check_mesh
+
+from . import kernels as K
+from .state import RemeshState, make_state, state_mesh
+
+__all__ = [
+    "sharp_edges",
+    "split_long_edges",
+    "collapse_short_edges",
+    "equalize_valences",
+    "tangential_relaxation",
+    "project_to_surface",
+    "SurfaceProjector",
+]
+
+
+# --------------------------------------------------------------------------------------------
+# Task 7: features
+
+
+def sharp_edges(V, F, feature_angle):
+    """Edges whose dihedral angle (between the two face normals) exceeds ``feature_angle`` degrees.
+
+    Returns
+    -------
+    E : (k, 2) int64
+        Sorted vertex pairs, rows in lexicographic order.
+    """
+    where = "sharp_edges"
+    V, F = check_mesh(V, F, where=where, manifold=True)
+    angle = check_float(feature_angle, "feature_angle", where=where, minimum=0.0, maximum=180.0)
+    raise NotImplementedError('Task 7 (features): angle between the normals of the two faces of an interior edge > feature_angle')
+
+
+# --------------------------------------------------------------------------------------------
+# Tasks 4-6 and 8-9: the stages
+
+
+def _stage_input(V, F, feature_edges, where):
+    V, F = check_mesh(V, F, where=where, manifold=True)
+    if feature_edges is not None:
+        fe = np.asarray(feature_edges)
+        if fe.size and (fe.ndim != 2 or fe.shape[1] != 2 or fe.min() < 0 or fe.max() >= len(V)):
+            raise MeshError(f"{where}: feature_edges must be (k, 2) vertex indices below {len(V)}")
+    return V, F
+
+
+def _split_all(S: RemeshState) -> int:
+    total, h, stop = 0, 0, 3 * int(S.cnt[1])
+    while True:
+        done, h = K.split_pass(*S.args(), S.high, S.low, h, stop)
+        total += done
+        if h >= stop:
+            return total
+        S.grow()
+
+
+def split_long_edges(V, F, high, *, feature_edges=None, preserve_boundary=True):
+    """Split every edge longer than ``high`` at its midpoint, in one pass over the input's edges (stage 1).
+
+    Edges created by the pass are not split again in it (the next iteration of the loop sees
+    them); an edge longer than ``2 high`` therefore leaves two halves longer than ``high``.
+
+    Returns
+    -------
+    V, F : the refined mesh; the input vertices keep their indices and positions, new vertices follow.
+    """
+    where = "split_long_edges"
+    V, F = _stage_input(V, F, feature_edges, where)
+    high = check_float(high, "high", positive=True, where=where)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    S.high[:] = high
+    _split_all(S)
+    return state_mesh(S)
+
+
+def collapse_short_edges(V, F, low, high, *, feature_edges=None, preserve_boundary=True):
+    """Collapse edges shorter than ``low`` when the collapse is allowed (stage 2).
+
+    Constrained ends (boundary, feature lines, corners) keep their position; two free ends meet
+    at the midpoint. A collapse never creates an edge longer than ``high``.
+    """
+    where = "collapse_short_edges"
+    V, F = _stage_input(V, F, feature_edges, where)
+    low = check_float(low, "low", positive=True, where=where)
+    high = check_float(high, "high", positive=True, where=where)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    S.high[:], S.low[:] = high, low
+    while K.collapse_pass(*S.args(), S.high, S.low):
+        pass
+    return state_mesh(S)
+
+
+def equalize_valences(V, F, *, feature_edges=None):
+    """Flip edges while that lowers Σ|valence − target| (target 6 inside, 4 on the boundary) (stage 3).
+
+    On a tie in that sum, a flip that lowers Σ(valence − target)² is made too; a flip whose new faces
+    turn by more than 60° from the old ones is not (see :func:`.kernels.flip_check`).
+    """
+    where = "equalize_valences"
+    V, F = _stage_input(V, F, feature_edges, where)
+    S = make_state(V, F, feature_edges, preserve_boundary=True, where=where)
+    for _ in range(10):
+        if not K.flip_pass(*S.args()):
+            break
+    return state_mesh(S)
+
+
+def _line_tangents(V, E_feat, n):
+    """Unit tangent of the feature line at every vertex (principal direction of its feature edges)."""
+    d = V[E_feat[:, 1]] - V[E_feat[:, 0]]
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    M = np.zeros((n, 3, 3))
+    outer = d[:, :, None] * d[:, None, :]
+    np.add.at(M, E_feat[:, 0], outer)
+    np.add.at(M, E_feat[:, 1], outer)
+    t = np.zeros((n, 3))
+    on = np.unique(E_feat)  # only the line's vertices have a direction
+    t[on] = np.linalg.eigh(M[on])[1][:, :, 2]
+    return t
+
+
+def _relax(V, F, cls, E_feat, damping):
+    """Tangential relaxation on faces ``F`` of ``V`` (rows no face uses are left alone)."""
+    n = len(V)
+    raise NotImplementedError('Task 8 (tangential relaxation): p += λ (I - n nᵀ)(c - p), c = Σ A_f c_f / Σ A_f; feature vertices along their line')
+
+
+def tangential_relaxation(V, F, *, damping=0.5, feature_edges=None, preserve_boundary=True):
+    """Move every vertex toward the area-weighted centroid of its faces, within its tangent plane (stage 4).
+
+    ``p ← p + λ (I − n nᵀ)(c − p)`` with ``c = Σ A_f c_f / Σ A_f`` over the faces around ``p``
+    (``c_f`` centroids, ``A_f`` areas), ``n`` the area-weighted vertex normal, ``λ = damping``.
+    Vertices on a feature line or the preserved boundary move along it toward the midpoint of their
+    two line neighbours; corners stay.
+
+    Returns
+    -------
+    V : (n, 3) float
+    """
+    where = "tangential_relaxation"
+    V, F = _stage_input(V, F, feature_edges, where)
+    lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
+    S = make_state(V, F, feature_edges, preserve_boundary=preserve_boundary, where=where)
+    return _relax(V, F, S.cls[: len(V)], S.feature_edges(), lam)
+
+
+def _closest_on_segments(P, A, B, k=8, chunk=2048):
+    """Closest point of every row of ``P`` on the segments ``A[i]B[i]``.
+
+    The ``k`` segments with the nearest midpoints (a k-d tree) are measured exactly; the answer is
+    certain when the ``k``-th nearest midpoint is farther than the best distance plus the longest
+    half segment (no other segment can come closer). The other rows are measured against every
+    segment, in chunks.
+    """
+    out = np.empty_like(P)
+    if len(P) == 0:
+        return out
+    AB = B - A
+    L2 = np.maximum(np.einsum("ij,ij->i", AB, AB), 1e-300)
+
+    def nearest_of(Q, S):  # S (q, s) candidate segments per row
+        t = np.clip(np.einsum("qsj,qsj->qs", Q[:, None, :] - A[S], AB[S]) / L2[S], 0.0, 1.0)
+        X = A[S] + t[:, :, None] * AB[S]
+        d = ((X - Q[:, None, :]) ** 2).sum(axis=2)
+        j = d.argmin(axis=1)
+        r = np.arange(len(Q))
+        return X[r, j], np.sqrt(d[r, j])
+
+    k = min(k, len(A))
+    dmid, S = cKDTree(0.5 * (A + B)).query(P, k)
+    S, dmid = S.reshape(len(P), k), dmid.reshape(len(P), k)
+    out[:], best = nearest_of(P, S)
+    unsure = np.flatnonzero(dmid[:, -1] <= best + 0.5 * np.sqrt(L2.max())) if k < len(A) else []
+    step = max(1, chunk * 256 // len(A))
+    everything = np.arange(len(A))
+    for s in range(0, len(unsure), step):
+        rows = unsure[s : s + step]
+        out[rows] = nearest_of(P[rows], np.broadcast_to(everything, (len(rows), len(A))))[0]
+    return out
+
+
+class SurfaceProjector:
+    """Closest points on a fixed surface ``(V0, F0)``, its AABB tree built once (given).
+
+    :func:`geomlib.geometry.closest_points` builds libigl's tree at every call; the loop projects
+    onto the same input tens of times, and building the tree costs about four queries.
+    """
+
+    def __init__(self, V0, F0):
+        self.V0 = np.ascontiguousarray(V0, np.float64)
+        self.F0 = np.ascontiguousarray(F0, np.int64)
+        self.tree = igl.AABB()
+        self.tree.init(self.V0, self.F0)
+
+    def __call__(self, P) -> np.ndarray:
+        return self.closest(P)[1]
+
+    def closest(self, P) -> tuple[np.ndarray, np.ndarray]:
+        """Face of the input holding the closest point ``(k,)`` and the closest points ``(k, 3)``."""
+        if len(P) == 0:
+            return np.zeros(0, np.int64), np.zeros((0, 3))
+        _, face, C = self.tree.squared_distance(self.V0, self.F0, np.ascontiguousarray(P, np.float64))
+        return np.asarray(face, np.int64).ravel(), np.asarray(C)
+
+    def interpolate(self, values, face, C) -> np.ndarray:
+        """Per-vertex ``values`` of the input, linearly interpolated at points ``C`` of faces ``face``."""
+        A, B, D = (self.V0[self.F0[face, k]] for k in range(3))
+        e0, e1, e2 = B - A, D - A, C - A
+        d00, d01, d11 = (np.einsum("ij,ij->i", x, y) for x, y in ((e0, e0), (e0, e1), (e1, e1)))
+        d20, d21 = np.einsum("ij,ij->i", e2, e0), np.einsum("ij,ij->i", e2, e1)
+        det = np.maximum(d00 * d11 - d01 * d01, 1e-300)
+        v = np.clip((d11 * d20 - d01 * d21) / det, 0.0, 1.0)
+        w = np.clip((d00 * d21 - d01 * d20) / det, 0.0, 1.0 - v)
+        x = values[self.F0[face]]
+        return (1.0 - v - w) * x[:, 0] + v * x[:, 1] + w * x[:, 2]
+
+
+def project_to_surface(P, V0, F0):
+    """Closest point of every row of ``P`` on the input surface ``(V0, F0)`` (stage 5).
+
+    Uses :func:`geomlib.geometry.closest_points` (libigl's AABB tree), which the lab gives.
+    """
+    where = "project_to_surface"
+    V0, F0 = check_mesh(V0, F0, where=where, vname="V0", fname="F0")
+    P = np.asarray(P, dtype=np.float64)
+    if P.ndim != 2 or P.shape[1] != 3 or not np.isfinite(P).all():
+        raise MeshError(f"{where}: P must be a finite (k, 3) array, got shape {P.shape}")
+    raise NotImplementedError('Task 9 (projection): the closest point on the input surface')
