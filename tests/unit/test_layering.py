@@ -163,3 +163,37 @@ def test_a_planted_import_cycle_is_found(tmp_path):
     (pkg / "c.py").write_text("import pkg.a\nx = 1\n")
     (pkg / "d.py").write_text("def f():\n    from pkg import a  # lazy: no cycle\n")
     assert import_cycles(tmp_path, "pkg") == [["pkg.a", "pkg.b", "pkg.c"]]
+
+
+#: A module may be longer than this when its docstring says why (issue: "no module over ~600 lines
+#: without a reason stated in its docstring").
+LONG_MODULE_LINES = 650
+
+
+def long_modules_without_a_reason(root: Path, tops: tuple[str, ...]) -> list[str]:
+    """Modules over :data:`LONG_MODULE_LINES` whose docstring does not give their length and a reason
+    (a sentence with "lines" in it, e.g. "Longer than most modules (about 850 lines) on purpose: ...")."""
+    import ast
+
+    bad = []
+    for top in tops:
+        for p in sorted((root / top).rglob("*.py")):
+            text = p.read_text(encoding="utf-8")
+            n = text.count("\n")
+            if n <= LONG_MODULE_LINES:
+                continue
+            doc = ast.get_docstring(ast.parse(text)) or ""
+            if "lines" not in doc:
+                bad.append(f"{p.relative_to(root)} ({n} lines)")
+    return bad
+
+
+def test_long_modules_say_why_in_their_docstring():
+    assert long_modules_without_a_reason(ROOT, ("geomlib", "solutions", "bench")) == []
+
+
+def test_a_long_module_without_a_reason_is_found(tmp_path):
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "long.py").write_text('"""Short docstring."""\n' + "x = 1\n" * 700)
+    (tmp_path / "pkg" / "said.py").write_text('"""Long (about 700 lines): one table."""\n' + "x = 1\n" * 700)
+    assert long_modules_without_a_reason(tmp_path, ("pkg",)) == ["pkg/long.py (701 lines)"]
