@@ -8,6 +8,7 @@ import numpy as np
 
 from geomlib.grading import expect_raises
 from geomlib.grading.checks import Context, as_output_array, format_vec
+from geomlib.grading.errors import Mismatch
 
 
 def expect_rejected(lab, function: str, *args, match: str | None = None, label: str | None = None, **kwargs) -> None:
@@ -45,3 +46,9 @@ class SameRows:
             examples = ((missing, self.missing), (extra, self.extra))
             what = [f"{len(rows)} {words} (e.g. {format_vec(np.array(rows[0]))})" for rows, words in examples if rows]
             ctx.fail(f"{self.output}: {len(G)} distinct rows, expected {len(E)}; " + "; ".join(what))
+
+
+def expect_true(label: str, condition: bool, message: str) -> None:
+    """Fail with ``"<label>: <message>"`` unless ``condition`` holds."""
+    if not condition:
+        raise Mismatch(f"{label}: {message}")

@@ -20,7 +20,7 @@ from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 from geomlib.textures import rasterize_uv
 
-from ..common import expect_rejected
+from ..common import expect_rejected, expect_true
 from .cases import CASES
 from .support import (
     PYRAMID_F,
@@ -45,11 +45,6 @@ test_references = reference_tests(CASES)
 UP = np.array([0.0, 0.0, 1.0])
 
 
-def expect(label: str, ok: bool, message: str) -> None:
-    if not ok:
-        raise Mismatch(f"{label}: {message}")
-
-
 def noisy_cut(V, F, seed: int):
     """A noisy UV-cut mesh ``Vn``, its normals computed on the cut (the copies of a seam vertex get
     different normals) and the seam group of every vertex."""
@@ -60,7 +55,7 @@ def noisy_cut(V, F, seed: int):
 def expect_closed_seams(label: str, X, group, advice: str) -> None:
     """The copies of every seam vertex stay together in ``X`` (within 1e-12)."""
     spread = copy_spread(X, group)
-    expect(label, spread < 1e-12, f"seam copies are {spread:.3g} apart: {advice}")
+    expect_true(label, spread < 1e-12, f"seam copies are {spread:.3g} apart: {advice}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -203,7 +198,7 @@ def test_one_pass_cuts_the_mean_error(lab):
         Vn, N = noisy(V, F, 0.3, 0)
         before = surface_error(V, F, Vn).mean()
         after = surface_error(V, F, np.asarray(lab.denoise_vertices(Vn, F, N, 0.7, weld=False))).mean()
-        expect(
+        expect_true(
             f"denoise_vertices on a noisy {name}", after <= 0.6 * before,
             f"the mean distance to the clean surface went from {before:.3g} to {after:.3g} ({after / before:.2f}x); "
             "a correct pass reaches about 0.5x",
@@ -229,7 +224,7 @@ def test_bake_a_linear_function_by_hand(lab):
     for bits, dtype in ((16, np.uint16), (8, np.uint8)):
         image, bias, scale = lab.bake_offset_map(V, F, UV, s, 4, bits)
         label = f"bake_offset_map(size=4, bits={bits}) of s = u + 2v"
-        expect(
+        expect_true(
             label,
             isinstance(image, np.ndarray) and image.dtype == dtype,
             f"image should be a {np.dtype(dtype).name} array, got {getattr(image, 'dtype', type(image).__name__)}",
@@ -261,12 +256,12 @@ def test_bake_pads_beyond_the_charts(lab):
     img0, _, _ = lab.bake_offset_map(SPLIT_V, SPLIT_F, SPLIT_UV, s, 32, 16, padding=0)
     img, _, _ = lab.bake_offset_map(SPLIT_V, SPLIT_F, SPLIT_UV, s, 32, 16, padding=None)
     img0, img = np.asarray(img0), np.asarray(img)
-    expect("bake_offset_map(padding=0)", not img0[empty].any(), "texels outside every UV triangle should stay 0")
+    expect_true("bake_offset_map(padding=0)", not img0[empty].any(), "texels outside every UV triangle should stay 0")
     expect_close(
         "bake_offset_map(padding=None) on the covered texels", img[~empty], img0[~empty], atol=0.0, name="image"
     )
     zeros = int((img == 0).sum())
-    expect(
+    expect_true(
         "bake_offset_map(padding=None)", zeros <= int((img0[~empty] == 0).sum()),
         f"{zeros} texels are still 0: pad with geomlib.textures.dilate(h, covered, padding) before quantising",
     )  # fmt: skip
@@ -278,7 +273,7 @@ def test_constant_offsets_give_zero_scale(lab):
     V, F, UV = _uv_square()
     image, bias, scale = lab.bake_offset_map(V, F, UV, np.full(4, 0.25), 8, 16)
     expect_close("bake_offset_map with constant s", [bias, scale], [0.25, 0.0], atol=0.0, name="(bias, scale)")
-    expect(
+    expect_true(
         "bake_offset_map with constant s",
         not np.asarray(image).any(),
         "h = 0 everywhere when scale = 0 (do not divide by 0)",
@@ -389,7 +384,7 @@ def test_weld_by_hand(lab):
     if not isinstance(out, tuple | list) or len(out) != 3:
         raise Mismatch("weld_seams should return three values (Vw, Fw, group)")
     msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
-    expect("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
+    expect_true("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
 
 
 @graded(points=1, part="seam fix")
@@ -410,9 +405,9 @@ def test_welded_uv_sphere_is_closed(lab):
     """welding the UV sphere (16 x 32) leaves 2 poles + 15 rings of 32 vertices, a closed genus-0 mesh"""
     V, F, _ = datasets.uv_sphere(16, 32)
     Vw, Fw, group = lab.weld_seams(V, F)
-    expect("weld_seams on uv_sphere(16, 32)", len(Vw) == 482, f"expected 482 vertices, got {len(Vw)}")
+    expect_true("weld_seams on uv_sphere(16, 32)", len(Vw) == 482, f"expected 482 vertices, got {len(Vw)}")
     Fw = np.asarray(Fw)
-    expect(
+    expect_true(
         "weld_seams on uv_sphere(16, 32)", topology.is_closed(Fw) and topology.euler_characteristic(Fw) == 2,
         "the welded faces should close the sphere (every edge in two faces, V - E + F = 2); Fw = group[F]",
     )  # fmt: skip
@@ -455,7 +450,7 @@ def test_map_route_keeps_seams_closed(lab):
     image = random_map(32, 3)
     h = mean_edge_length(V, F)
     cracked = copy_spread(lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7, weld=False), group)
-    expect(
+    expect_true(
         "denoise_with_map(weld=False)", cracked > 1e-3 * h, "with weld=False the copies should read different texels"
     )
     expect_closed_seams(

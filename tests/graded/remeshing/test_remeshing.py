@@ -14,15 +14,11 @@ from geomlib import datasets, topology
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
 
+from ..common import expect_true
 from .cases import CASES
 from .support import OCTA_F, OCTA_V, SQUARE_F, SQUARE_V, TET_F, TET_V, edge_index, expect_refused, halfedges
 
 test_references = reference_tests(CASES)
-
-
-def expect_true(label: str, condition: bool, message: str) -> None:
-    if not condition:
-        raise Mismatch(f"{label}: {message}")
 
 
 def expect_valid(label: str, V, H) -> np.ndarray:

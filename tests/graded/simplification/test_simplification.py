@@ -13,7 +13,7 @@ from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import marked_picture
 
-from ..common import expect_rejected
+from ..common import expect_rejected, expect_true
 from .cases import CASES
 from .support import (
     FAN_F,
@@ -49,11 +49,6 @@ def expect_tilted_face_quadric(lab) -> None:
         np.sqrt(3) / 2 * np.outer(TILTED_P, TILTED_P),
         name="K[0]",
     )
-
-
-def expect_true(label: str, condition: bool, message: str) -> None:
-    if not condition:
-        raise Mismatch(f"{label}: {message}")
 
 
 # --------------------------------------------------------------------------------------------
