@@ -37,6 +37,19 @@ def run_geomlib(
     return p
 
 
+def user_cli(cwd: Path, *args: str, env: dict | None = None, timeout: float = 300) -> subprocess.CompletedProcess:
+    """Run ``python -m geomlib.cli *args`` in ``cwd`` the way a user does: no ``GEOMLIB_ROOT`` (the
+    course is the one ``cwd`` belongs to), ``env`` added to this process's environment. Fails with
+    the command's output unless it exits 0."""
+    e = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
+    e.update(env or {})
+    p = subprocess.run(
+        [sys.executable, "-m", "geomlib.cli", *args], cwd=cwd, env=e, capture_output=True, text=True, timeout=timeout
+    )
+    assert p.returncode == 0, f"geomlib {' '.join(args)} failed ({p.returncode}):\n{p.stdout}{p.stderr}"
+    return p
+
+
 def grade(root: Path, impl: str, *extra: str, env: dict | None = None, python: str | None = None) -> dict:
     results = root / "results" / f"{Path(impl).name}.json"
     run_geomlib(root, "grade", "--impl", impl, "--results", str(results), *extra, env=env, python=python)

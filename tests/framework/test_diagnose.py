@@ -43,6 +43,14 @@ def _message(lab: str, folder: Path, case_id: str) -> str:
     return str(e.value)
 
 
+#: A sample_surface 1 % off, planted in the vdm lab (by the naive and the full bake).
+SCALED_SAMPLES = """
+        _true_sample_surface = sample_surface
+
+        def sample_surface(V, F, UV, uv_points):
+            return 1.01 * _true_sample_surface(V, F, UV, uv_points)
+        """
+
 # lab, module, planted source, composite case, words the message must contain
 PLANTS = {
     "subdivision-even-weight-at-valence-6": (
@@ -123,24 +131,14 @@ PLANTS = {
     "vdm-sampling": (
         "vdm",
         "sampling",
-        """
-        _true_sample_surface = sample_surface
-
-        def sample_surface(V, F, UV, uv_points):
-            return 1.01 * _true_sample_surface(V, F, UV, uv_points)
-        """,
+        SCALED_SAMPLES,
         "naive-box-12",
         ["naive_vdm is off because sample_surface (Task 2:"],
     ),
     "vdm-bake-sampling": (
         "vdm",
         "sampling",
-        """
-        _true_sample_surface = sample_surface
-
-        def sample_surface(V, F, UV, uv_points):
-            return 1.01 * _true_sample_surface(V, F, UV, uv_points)
-        """,
+        SCALED_SAMPLES,
         "bake-box-6-12",
         ["bake_vdm is off because sample_surface (Task 2:"],
     ),

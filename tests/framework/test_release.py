@@ -18,7 +18,7 @@ import pytest
 
 from geomlib.grading.results import validate_results
 
-from .course import run_geomlib
+from .course import run_geomlib, user_cli
 
 
 @pytest.fixture(scope="module")
@@ -50,17 +50,8 @@ def test_student_bundle_has_no_solutions_and_no_hidden_material(release, sample_
 
 def test_student_bundle_grades_its_stubs_to_zero_without_errors(release):
     student = release / "student"
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    env.update(PYTHONPATH=str(student), GEOMLIB_NO_FEEDBACK_PICTURES="1")
-    p = subprocess.run(
-        [sys.executable, "-m", "geomlib.cli", "grade", "--results", "r.json"],
-        cwd=student,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert p.returncode == 0, p.stdout + p.stderr
+    env = {"PYTHONPATH": str(student), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
+    p = user_cli(student, "grade", "--results", "r.json", env=env)
     r = json.loads((student / "r.json").read_text())
     validate_results(r)
     assert r["score"] == 0 and r["tests"]

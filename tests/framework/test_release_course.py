@@ -237,9 +237,8 @@ def test_hostile_submission_gains_nothing(autograder):
     assert after == before, "the submission changed the autograder's source"
 
 
-LOOKUP = """
-
-
+#: A case's key in the look-up table: its function and the shapes of its arguments.
+KEY = """
 def _key(name, values):
     import numpy as np
 
@@ -251,7 +250,12 @@ def _key(name, values):
             except ValueError:
                 shapes.append(["ragged", len(v)])
     return name + repr(shapes)
+"""
 
+LOOKUP = (
+    "\n\n"
+    + KEY
+    + """
 
 def _lookup(_name, _args):
     import json
@@ -268,23 +272,14 @@ def _lookup(_name, _args):
         out = [z[name] for name in index[key][1]]
     return out[0] if len(out) == 1 else tuple(out)
 """
+)
 
 #: Builds the look-up table from what students get (the bundle's public cases and references): a
 #: case is found again by its function and the shapes of its arguments (all a task body can see once
 #: the course's given validation has run); keys shared by cases with different outputs are dropped.
-BUILD_LOOKUP = """
-def _key(name, values):
-    import numpy as np
-
-    shapes = []
-    for v in values:
-        if hasattr(v, "__len__") and not isinstance(v, str | dict):
-            try:
-                shapes.append(list(np.shape(v)))
-            except ValueError:
-                shapes.append(["ragged", len(v)])
-    return name + repr(shapes)
-
+BUILD_LOOKUP = (
+    KEY
+    + """
 import inspect, json, pathlib, shutil, sys
 import numpy as np
 from geomlib.grading.cases import load_cases, reference_path
@@ -307,6 +302,7 @@ for key in clash:
 (out / "index.json").write_text(json.dumps(index))
 print(sum(points.values()))
 """
+)
 
 
 def _lookup_submission(student: Path, sub: Path) -> float:

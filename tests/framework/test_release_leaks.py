@@ -6,10 +6,7 @@ ships anyway (the library and the stubs' given code): see ``geomlib.grading.rele
 
 from __future__ import annotations
 
-import os
 import shutil
-import subprocess
-import sys
 import tempfile
 import zipfile
 from pathlib import Path
@@ -17,6 +14,8 @@ from pathlib import Path
 import pytest
 
 from geomlib.grading import release as rel
+
+from .course import user_cli
 
 ROOT = Path(__file__).resolve().parents[2]
 SECRETS = rel.secret_lines(ROOT) if (ROOT / "solutions").is_dir() else {}
@@ -26,16 +25,7 @@ LABS = sorted(p.name for p in (ROOT / "solutions").iterdir() if (p / "__init__.p
 @pytest.fixture(scope="module")
 def bundle():
     out = Path(tempfile.mkdtemp(prefix="geomlib-course-leaks-"))
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    p = subprocess.run(
-        [sys.executable, "-m", "geomlib.cli", "release", str(out)],
-        cwd=ROOT,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert p.returncode == 0, p.stdout + p.stderr
+    user_cli(ROOT, "release", str(out))
     texts = {}
     for f in (out / "student").rglob("*"):
         if f.is_file() and f.suffix in (".py", ".md", ".ipynb", ".txt", ".toml", ".json"):
@@ -70,16 +60,7 @@ def test_release_writes_one_autograder_per_lab_and_only_public_material(bundle):
 
 
 def test_a_lab_release_holds_that_lab_only(tmp_path):
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    p = subprocess.run(
-        [sys.executable, "-m", "geomlib.cli", "release", str(tmp_path / "d"), "--lab", "maps", "--lab", "denoise"],
-        cwd=ROOT,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert p.returncode == 0, p.stderr
+    user_cli(ROOT, "release", str(tmp_path / "d"), "--lab", "maps", "--lab", "denoise")
     d = tmp_path / "d"
     assert sorted(p.name for p in d.iterdir()) == [
         "autograder-denoise.zip",

@@ -20,8 +20,10 @@ Independent references used here:
 
 from __future__ import annotations
 
+import igl
 import numpy as np
 import pytest
+import trimesh
 
 from geomlib import camera, datasets
 from geomlib.geometry import ray_cast, vertex_normals
@@ -40,10 +42,6 @@ from solutions.maps import (
     tangent_frames,
     welded_vertex_normals,
 )
-
-igl = pytest.importorskip("igl")
-trimesh = pytest.importorskip("trimesh")
-
 
 # --------------------------------------------------------------------------- closed forms
 

@@ -16,9 +16,11 @@ Independent references:
 
 from __future__ import annotations
 
+import igl
 import numpy as np
 import pytest
 import scipy.sparse as sp
+import trimesh
 from scipy.spatial import cKDTree
 
 from geomlib import topology
@@ -31,9 +33,6 @@ from solutions.subdivision import (
     loop_subdivide,
     loop_weight,
 )
-
-igl = pytest.importorskip("igl")
-trimesh = pytest.importorskip("trimesh")
 
 # --------------------------------------------------------------------------- meshes
 

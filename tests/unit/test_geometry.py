@@ -245,11 +245,16 @@ def test_ray_cast_does_not_trust_a_wrong_bound(monkeypatch):
     assert hit[0] and t[0] == pytest.approx(2.0) and face[0] == 1
 
 
+def rays_at_the_origin(n: int, seed: int):
+    """``n`` seeded rays from around radius 3, aimed near the origin (origins ``O``, directions ``D``)."""
+    rng = np.random.default_rng(seed)
+    O = rng.normal(size=(n, 3)) * 3
+    return O, -O + rng.normal(size=O.shape)
+
+
 def test_ray_cast_igl_method_agrees_on_generic_rays(sphere4):
     V, F = sphere4
-    rng = np.random.default_rng(5)
-    O = rng.normal(size=(300, 3)) * 3
-    D = -O + rng.normal(size=O.shape)
+    O, D = rays_at_the_origin(300, seed=5)
     exact = geometry.ray_cast(V, F, O, D)
     fast = geometry.ray_cast(V, F, O, D, method="igl")
     np.testing.assert_array_equal(exact[0], fast[0])
@@ -259,9 +264,7 @@ def test_ray_cast_igl_method_agrees_on_generic_rays(sphere4):
 
 def test_ray_cast_small_chunks_give_the_same_answer(sphere4):
     V, F = sphere4
-    rng = np.random.default_rng(6)
-    O = rng.normal(size=(100, 3)) * 3
-    D = -O + rng.normal(size=O.shape)
+    O, D = rays_at_the_origin(100, seed=6)
     a = geometry.ray_cast(V, F, O, D)
     b = geometry.ray_cast(V, F, O, D, chunk=7)
     for x, y in zip(a, b):

@@ -276,22 +276,8 @@ def test_culling(cull, front_drawn, back_drawn):
 def test_cull_back_on_a_closed_mesh_keeps_the_visible_side():
     # A cube seen from a corner: with or without back-face culling the picture is the same.
     V = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
-    F = np.array(
-        [
-            [0, 1, 3],
-            [0, 3, 2],
-            [4, 6, 7],
-            [4, 7, 5],
-            [0, 4, 5],
-            [0, 5, 1],
-            [2, 3, 7],
-            [2, 7, 6],
-            [0, 2, 6],
-            [0, 6, 4],
-            [1, 5, 7],
-            [1, 7, 3],
-        ]
-    )
+    Q = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]]  # outward quads
+    F = np.array([t for a, b, c, d in Q for t in ((a, b, c), (a, c, d))])
     M = perspective(45, 1.0, 0.5, 20) @ look_at((3, 2.5, 4), (0, 0, 0))
     g, gb = rasterize(V, F, M, 48, 48), rasterize(V, F, M, 48, 48, cull="back")
     np.testing.assert_array_equal(g.face_id, gb.face_id)

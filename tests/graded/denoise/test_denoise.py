@@ -13,13 +13,14 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import mean_edge_length, vertex_normals
-from geomlib.grading import expect_close, expect_raises, graded, reference_tests
+from geomlib.grading import expect_close, graded, reference_tests
 from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 from geomlib.textures import rasterize_uv
 
+from ..common import expect_rejected, expect_true
 from .cases import CASES
 from .support import (
     PYRAMID_F,
@@ -44,9 +45,17 @@ test_references = reference_tests(CASES)
 UP = np.array([0.0, 0.0, 1.0])
 
 
-def expect(label: str, ok: bool, message: str) -> None:
-    if not ok:
-        raise Mismatch(f"{label}: {message}")
+def noisy_cut(V, F, seed: int):
+    """A noisy UV-cut mesh ``Vn``, its normals computed on the cut (the copies of a seam vertex get
+    different normals) and the seam group of every vertex."""
+    Vn, _ = noisy(V, F, 0.3, seed)
+    return Vn, vertex_normals(Vn, F), seam_groups(V)
+
+
+def expect_closed_seams(label: str, X, group, advice: str) -> None:
+    """The copies of every seam vertex stay together in ``X`` (within 1e-12)."""
+    spread = copy_spread(X, group)
+    expect_true(label, spread < 1e-12, f"seam copies are {spread:.3g} apart: {advice}")
 
 
 # --------------------------------------------------------------------------------------------
@@ -86,14 +95,8 @@ def test_regular_tetrahedron_cotan_equals_uniform(lab):
     for w in ("uniform", "cotan"):
         d = lab.laplacian_offsets(REG_TET_V, REG_TET_F, w, weld=False)
         # the vertices sum to 0, so the mean of the other three is -p_i / 3
-        expect_close(
-            f"laplacian_offsets(weights={w!r}) on a regular tetrahedron",
-            d,
-            4 / 3 * REG_TET_V,
-            atol=1e-12,
-            name="delta",
-            mesh=(REG_TET_V, REG_TET_F),
-        )
+        label = f"laplacian_offsets(weights={w!r}) on a regular tetrahedron"
+        expect_close(label, d, 4 / 3 * REG_TET_V, atol=1e-12, name="delta", mesh=(REG_TET_V, REG_TET_F))
 
 
 @graded(points=1, part="offsets")
@@ -160,14 +163,8 @@ def test_lambda_zero_changes_nothing(lab):
     """lambda = 0 returns the input positions"""
     V, F = datasets.icosphere(2)
     Vn, N = noisy(V, F, 0.3, 1)
-    expect_close(
-        "denoise_vertices(lam=0)",
-        lab.denoise_vertices(Vn, F, N, 0.0, weld=False),
-        Vn,
-        atol=0.0,
-        name="V'",
-        mesh=(Vn, F),
-    )
+    X = lab.denoise_vertices(Vn, F, N, 0.0, weld=False)
+    expect_close("denoise_vertices(lam=0)", X, Vn, atol=0.0, name="V'", mesh=(Vn, F))
 
 
 @graded(points=1, part="direct denoising")
@@ -201,7 +198,7 @@ def test_one_pass_cuts_the_mean_error(lab):
         Vn, N = noisy(V, F, 0.3, 0)
         before = surface_error(V, F, Vn).mean()
         after = surface_error(V, F, np.asarray(lab.denoise_vertices(Vn, F, N, 0.7, weld=False))).mean()
-        expect(
+        expect_true(
             f"denoise_vertices on a noisy {name}", after <= 0.6 * before,
             f"the mean distance to the clean surface went from {before:.3g} to {after:.3g} ({after / before:.2f}x); "
             "a correct pass reaches about 0.5x",
@@ -227,7 +224,7 @@ def test_bake_a_linear_function_by_hand(lab):
     for bits, dtype in ((16, np.uint16), (8, np.uint8)):
         image, bias, scale = lab.bake_offset_map(V, F, UV, s, 4, bits)
         label = f"bake_offset_map(size=4, bits={bits}) of s = u + 2v"
-        expect(
+        expect_true(
             label,
             isinstance(image, np.ndarray) and image.dtype == dtype,
             f"image should be a {np.dtype(dtype).name} array, got {getattr(image, 'dtype', type(image).__name__)}",
@@ -259,12 +256,12 @@ def test_bake_pads_beyond_the_charts(lab):
     img0, _, _ = lab.bake_offset_map(SPLIT_V, SPLIT_F, SPLIT_UV, s, 32, 16, padding=0)
     img, _, _ = lab.bake_offset_map(SPLIT_V, SPLIT_F, SPLIT_UV, s, 32, 16, padding=None)
     img0, img = np.asarray(img0), np.asarray(img)
-    expect("bake_offset_map(padding=0)", not img0[empty].any(), "texels outside every UV triangle should stay 0")
+    expect_true("bake_offset_map(padding=0)", not img0[empty].any(), "texels outside every UV triangle should stay 0")
     expect_close(
         "bake_offset_map(padding=None) on the covered texels", img[~empty], img0[~empty], atol=0.0, name="image"
     )
     zeros = int((img == 0).sum())
-    expect(
+    expect_true(
         "bake_offset_map(padding=None)", zeros <= int((img0[~empty] == 0).sum()),
         f"{zeros} texels are still 0: pad with geomlib.textures.dilate(h, covered, padding) before quantising",
     )  # fmt: skip
@@ -276,7 +273,7 @@ def test_constant_offsets_give_zero_scale(lab):
     V, F, UV = _uv_square()
     image, bias, scale = lab.bake_offset_map(V, F, UV, np.full(4, 0.25), 8, 16)
     expect_close("bake_offset_map with constant s", [bias, scale], [0.25, 0.0], atol=0.0, name="(bias, scale)")
-    expect(
+    expect_true(
         "bake_offset_map with constant s",
         not np.asarray(image).any(),
         "h = 0 everywhere when scale = 0 (do not divide by 0)",
@@ -387,7 +384,7 @@ def test_weld_by_hand(lab):
     if not isinstance(out, tuple | list) or len(out) != 3:
         raise Mismatch("weld_seams should return three values (Vw, Fw, group)")
     msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
-    expect("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
+    expect_true("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
 
 
 @graded(points=1, part="seam fix")
@@ -408,9 +405,9 @@ def test_welded_uv_sphere_is_closed(lab):
     """welding the UV sphere (16 x 32) leaves 2 poles + 15 rings of 32 vertices, a closed genus-0 mesh"""
     V, F, _ = datasets.uv_sphere(16, 32)
     Vw, Fw, group = lab.weld_seams(V, F)
-    expect("weld_seams on uv_sphere(16, 32)", len(Vw) == 482, f"expected 482 vertices, got {len(Vw)}")
+    expect_true("weld_seams on uv_sphere(16, 32)", len(Vw) == 482, f"expected 482 vertices, got {len(Vw)}")
     Fw = np.asarray(Fw)
-    expect(
+    expect_true(
         "weld_seams on uv_sphere(16, 32)", topology.is_closed(Fw) and topology.euler_characteristic(Fw) == 2,
         "the welded faces should close the sphere (every edge in two faces, V - E + F = 2); Fw = group[F]",
     )  # fmt: skip
@@ -438,14 +435,10 @@ def test_welded_offsets_match_the_seamless_torus(lab):
 def test_direct_route_keeps_seams_closed(lab):
     """denoise_vertices(weld=True) moves the copies of every seam vertex identically (needs Task 3)"""
     V, F, _ = datasets.uv_sphere(12, 24)
-    Vn, _ = noisy(V, F, 0.3, 1)
-    N = vertex_normals(Vn, F)  # computed on the cut mesh: the copies of a seam vertex get different normals
-    group = seam_groups(V)
-    spread = copy_spread(lab.denoise_vertices(Vn, F, N, 0.7), group)
-    expect(
-        "denoise_vertices(weld=True) on a UV sphere", spread < 1e-12,
-        f"seam copies are {spread:.3g} apart: the seam cracks (weld for the offsets, and move every copy along the "
-        "mean normal of its group)",
+    Vn, N, group = noisy_cut(V, F, 1)
+    expect_closed_seams(
+        "denoise_vertices(weld=True) on a UV sphere", lab.denoise_vertices(Vn, F, N, 0.7), group,
+        "the seam cracks (weld for the offsets, and move every copy along the mean normal of its group)",
     )  # fmt: skip
 
 
@@ -453,19 +446,16 @@ def test_direct_route_keeps_seams_closed(lab):
 def test_map_route_keeps_seams_closed(lab):
     """denoise_with_map(weld=True) moves the copies identically although they read different texels (needs Task 5)"""
     V, F, UV = datasets.uv_torus(24, 12)
-    Vn, _ = noisy(V, F, 0.3, 2)
-    N = vertex_normals(Vn, F)  # computed on the cut mesh: the copies of a seam vertex get different normals
-    group = seam_groups(V)
+    Vn, N, group = noisy_cut(V, F, 2)
     image = random_map(32, 3)
     h = mean_edge_length(V, F)
     cracked = copy_spread(lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7, weld=False), group)
-    expect(
+    expect_true(
         "denoise_with_map(weld=False)", cracked > 1e-3 * h, "with weld=False the copies should read different texels"
     )
-    spread = copy_spread(lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7), group)
-    expect(
-        "denoise_with_map(weld=True) on a UV torus", spread < 1e-12,
-        f"seam copies are {spread:.3g} apart: give all copies the mean offset (seam_mean) and the mean normal (normalised)",
+    expect_closed_seams(
+        "denoise_with_map(weld=True) on a UV torus", lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7), group,
+        "give all copies the mean offset (seam_mean) and the mean normal (normalised)",
     )  # fmt: skip
 
 
@@ -476,20 +466,15 @@ def test_map_route_keeps_seams_closed(lab):
 @graded(points=0, part="bad input")
 def test_rejects_unknown_weights(lab):
     """an unknown weights option is rejected with the allowed values"""
-    expect_raises(
-        lambda: lab.laplacian_offsets(PYRAMID_V, PYRAMID_F, "cot"),
-        "MeshError",
-        match="uniform",
-        label="laplacian_offsets(weights='cot')",
+    expect_rejected(
+        lab, "laplacian_offsets", PYRAMID_V, PYRAMID_F, "cot", match="uniform", label="laplacian_offsets(weights='cot')"
     )
 
 
 @graded(points=0, part="bad input")
 def test_rejects_out_of_range_faces(lab):
     """a face index beyond the vertices is rejected with the face named"""
-    expect_raises(
-        lambda: lab.laplacian_offsets(PYRAMID_V, [[0, 1, 7]]), "MeshError", match="face 0", label="laplacian_offsets"
-    )
+    expect_rejected(lab, "laplacian_offsets", PYRAMID_V, [[0, 1, 7]], match="face 0")
 
 
 @graded(points=0, part="bad input")
@@ -497,20 +482,15 @@ def test_rejects_zero_normals(lab):
     """a zero normal is rejected with its row"""
     N = np.tile(UP, (5, 1))
     N[3] = 0
-    expect_raises(
-        lambda: lab.denoise_vertices(PYRAMID_V, PYRAMID_F, N, 0.5), "MeshError", match="row 3", label="denoise_vertices"
-    )
+    expect_rejected(lab, "denoise_vertices", PYRAMID_V, PYRAMID_F, N, 0.5, match="row 3")
 
 
 @graded(points=0, part="bad input")
 def test_rejects_lambda_out_of_range(lab):
     """lambda outside [0, 1] is rejected"""
     N = np.tile(UP, (5, 1))
-    expect_raises(
-        lambda: lab.denoise_vertices(PYRAMID_V, PYRAMID_F, N, 1.5),
-        "MeshError",
-        match="lam",
-        label="denoise_vertices(lam=1.5)",
+    expect_rejected(
+        lab, "denoise_vertices", PYRAMID_V, PYRAMID_F, N, 1.5, match="lam", label="denoise_vertices(lam=1.5)"
     )
 
 
@@ -518,15 +498,10 @@ def test_rejects_lambda_out_of_range(lab):
 def test_rejects_bad_bits_and_uvs(lab):
     """bits other than 8/16 and UVs outside the unit square are rejected"""
     V, F, UV = _uv_square()
-    expect_raises(
-        lambda: lab.bake_offset_map(V, F, UV, np.zeros(4), 8, 12),
-        "MeshError",
-        match="bits",
-        label="bake_offset_map(bits=12)",
+    expect_rejected(
+        lab, "bake_offset_map", V, F, UV, np.zeros(4), 8, 12, match="bits", label="bake_offset_map(bits=12)"
     )
-    expect_raises(
-        lambda: lab.bake_offset_map(V, F, UV + 1, np.zeros(4), 8), "MeshError", match="outside", label="bake_offset_map"
-    )
+    expect_rejected(lab, "bake_offset_map", V, F, UV + 1, np.zeros(4), 8, match="outside")
 
 
 @graded(points=0, part="bad input")
@@ -534,15 +509,5 @@ def test_rejects_non_square_maps(lab):
     """an offset map that is not square and single-channel is rejected"""
     V, F, UV = _five_points()
     N = np.tile(UP, (5, 1))
-    expect_raises(
-        lambda: lab.denoise_with_map(V, F, UV, N, np.zeros((4, 8)), 0, 1, 0.5),
-        "MeshError",
-        match="square",
-        label="denoise_with_map",
-    )
-    expect_raises(
-        lambda: lab.denoise_with_map(V, F, UV, N, np.zeros((4, 4, 3)), 0, 1, 0.5),
-        "MeshError",
-        match="single-channel",
-        label="denoise_with_map",
-    )
+    expect_rejected(lab, "denoise_with_map", V, F, UV, N, np.zeros((4, 8)), 0, 1, 0.5, match="square")
+    expect_rejected(lab, "denoise_with_map", V, F, UV, N, np.zeros((4, 4, 3)), 0, 1, 0.5, match="single-channel")

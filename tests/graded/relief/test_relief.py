@@ -13,6 +13,7 @@ from geomlib.grading.cases import load_reference
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
+from ..common import expect_rejected
 from .cases import CASES, SCALE, direction, pixel_uv, texel_uv
 
 test_references = reference_tests(CASES)
@@ -189,34 +190,28 @@ def test_glsl_shadow(lab):
 # ------------------------------------------------------------------------------ bad input (given validation)
 
 
+def expect_uv_rejected(
+    lab, function: str, label: str, match: str, heights=None, view=(0, 0, 1.0), scale=0.1, **kwargs
+) -> None:
+    """``function(heights, pixel_uv(2), view, scale=scale, **kwargs)`` must raise a MeshError (default
+    ``heights``: a flat 8 x 8 map; default ``view``: straight down)."""
+    H = np.zeros((8, 8)) if heights is None else heights
+    expect_rejected(lab, function, H, pixel_uv(2), view, scale=scale, match=match, label=label, **kwargs)
+
+
 @graded(points=0, part="bad input")
 def test_view_below_the_polygon_is_rejected(lab):
-    expect_raises(
-        lambda: lab.relief_uv(np.zeros((8, 8)), pixel_uv(2), (0.3, 0.0, -0.5), scale=0.1),
-        "MeshError",
-        match="z <= 0",
-        label="relief_uv(view with z < 0)",
-    )
+    expect_uv_rejected(lab, "relief_uv", "relief_uv(view with z < 0)", "z <= 0", view=(0.3, 0.0, -0.5))
 
 
 @graded(points=0, part="bad input")
 def test_unknown_refinement_is_rejected(lab):
-    expect_raises(
-        lambda: lab.relief_uv(np.zeros((8, 8)), pixel_uv(2), (0, 0, 1.0), scale=0.1, refine="newton"),
-        "MeshError",
-        match="refine",
-        label="relief_uv(refine='newton')",
-    )
+    expect_uv_rejected(lab, "relief_uv", "relief_uv(refine='newton')", "refine", refine="newton")
 
 
 @graded(points=0, part="bad input")
 def test_bad_height_maps_are_rejected(lab):
-    expect_raises(
-        lambda: lab.parallax_uv(np.zeros((8, 6)), pixel_uv(2), (0, 0, 1.0), scale=0.1),
-        "MeshError",
-        match="square",
-        label="parallax_uv(8x6 height map)",
-    )
+    expect_uv_rejected(lab, "parallax_uv", "parallax_uv(8x6 height map)", "square", heights=np.zeros((8, 6)))
     expect_raises(
         lambda: lab.bump_normal(np.full((8, 8), 1.5), pixel_uv(2), strength=0.1),
         "MeshError",
@@ -225,31 +220,16 @@ def test_bad_height_maps_are_rejected(lab):
     )
     H = np.zeros((8, 8))
     H[2, 3] = np.nan
-    expect_raises(
-        lambda: lab.relief_uv(H, pixel_uv(2), (0, 0, 1.0), scale=0.1),
-        "MeshError",
-        match="NaN|finite",
-        label="relief_uv(NaN height)",
-    )
+    expect_uv_rejected(lab, "relief_uv", "relief_uv(NaN height)", "NaN|finite", heights=H)
 
 
 @graded(points=0, part="bad input")
 def test_bad_parameters_are_rejected(lab):
-    expect_raises(
-        lambda: lab.relief_uv(np.zeros((8, 8)), pixel_uv(2), (0, 0, 1.0), scale=0.1, min_layers=16, max_layers=8),
-        "MeshError",
-        match="max_layers",
-        label="relief_uv(min_layers > max_layers)",
+    label = "relief_uv(min_layers > max_layers)"
+    expect_uv_rejected(lab, "relief_uv", label, "max_layers", min_layers=16, max_layers=8)
+    label = "relief_shadow(depth of the wrong shape)"
+    H, uv = np.zeros((8, 8)), pixel_uv(2)
+    expect_rejected(
+        lab, "relief_shadow", H, uv, np.zeros(3), (0, 0, 1.0), scale=0.1, match="depth has shape", label=label
     )
-    expect_raises(
-        lambda: lab.relief_shadow(np.zeros((8, 8)), pixel_uv(2), np.zeros(3), (0, 0, 1.0), scale=0.1),
-        "MeshError",
-        match="depth has shape",
-        label="relief_shadow(depth of the wrong shape)",
-    )
-    expect_raises(
-        lambda: lab.parallax_uv(np.zeros((8, 8)), pixel_uv(2), (0, 0, 1.0), scale=-0.1),
-        "MeshError",
-        match="scale",
-        label="parallax_uv(scale < 0)",
-    )
+    expect_uv_rejected(lab, "parallax_uv", "parallax_uv(scale < 0)", "scale", scale=-0.1)

@@ -11,7 +11,7 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import mesh_distance, triangle_quality
-from geomlib.grading import checks
+from geomlib.grading import checks, expect_raises
 
 #: Unit square of two triangles, diagonal 0-2, facing +z.
 SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
@@ -21,9 +21,20 @@ SQUARE_F = np.array([[0, 1, 2], [0, 2, 3]])
 TET_V = np.array([[1.0, 1.0, 1.0], [1.0, -1.0, -1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0]])
 TET_F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
 
+#: Octahedron of the unit axis points (+x, -x, +y, -y, +z, -z), outward oriented; face 0 is (+x, +y, +z).
+OCTA_V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+OCTA_F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+
 
 def halfedges(V, F):
     return topology.halfedge_mesh(np.asarray(F), len(V), manifold=True)
+
+
+def expect_refused(operation, V, F, edge, match: str) -> None:
+    """``operation(V, H, e)`` on edge ``edge`` (an index, or its two end vertices) must raise a MeshError."""
+    H = halfedges(V, F)
+    e = edge_index(H, *edge) if isinstance(edge, tuple) else edge
+    expect_raises(lambda: operation(V, H, e), "MeshError", match=match)
 
 
 def edge_index(H, a, b) -> int:

@@ -1,10 +1,4 @@
-"""Diagnosis table of the shadows lab (see ``geomlib.grading.diagnose`` and ``geomlib.grading.tasks``).
-
-``TASKS``, ``TITLES`` and ``COMPOSITES`` declare which task each function belongs to (the stubs'
-"Task N" markers vanish as students fill them in; ``tests/framework/test_diagnose.py`` checks this
-table against the solutions). When a composite case fails, the grader runs the student's building
-blocks on this lab's graded cases of them, in task order, and names the first that is wrong.
-"""
+"""Task table of the shadows lab: the task of each function (docs/adding-a-lab.md, "Tasks and diagnosis")."""
 
 from __future__ import annotations
 
@@ -33,71 +27,34 @@ TITLES = {
     7: "PCF",
     8: "cube map",
 }
+#: The shadow test of one receiver point, in task order.
+_VISIBILITY = (
+    "compare_depth",
+    "light_uvz",
+    "receiver_depth_gradient",
+    "shadow_bias",
+    "outside_frustum",
+    "pcf_visibility",
+)
+#: Every building block of a full shadowed render, in task order.
+_ALL = (
+    "directional_light_matrix",
+    "spot_light_matrix",
+    "depth_map",
+    *_VISIBILITY[:4],
+    "cull_faces",
+    *_VISIBILITY[4:],
+    "cube_face_index",
+    "cube_light_matrices",
+    "point_shadow_visibility",
+)
 COMPOSITES = {
     "cube_depth_maps": ("depth_map", "cull_faces", "cube_light_matrices"),
-    "point_shadow_visibility": (
-        "compare_depth",
-        "light_uvz",
-        "receiver_depth_gradient",
-        "shadow_bias",
-        "outside_frustum",
-        "pcf_visibility",
-        "cube_face_index",
-        "cube_light_matrices",
-    ),
+    "point_shadow_visibility": (*_VISIBILITY, "cube_face_index", "cube_light_matrices"),
     "depth_map": ("cull_faces",),
-    "shadow_visibility": (
-        "compare_depth",
-        "light_uvz",
-        "receiver_depth_gradient",
-        "shadow_bias",
-        "outside_frustum",
-        "pcf_visibility",
-    ),
+    "shadow_visibility": _VISIBILITY,
     "light_setup": ("directional_light_matrix", "spot_light_matrix", "cube_light_matrices"),
-    "light_visibility": (
-        "directional_light_matrix",
-        "spot_light_matrix",
-        "depth_map",
-        "compare_depth",
-        "light_uvz",
-        "receiver_depth_gradient",
-        "shadow_bias",
-        "cull_faces",
-        "outside_frustum",
-        "pcf_visibility",
-        "cube_face_index",
-        "cube_light_matrices",
-        "point_shadow_visibility",
-    ),
-    "render_with_shadows": (
-        "directional_light_matrix",
-        "spot_light_matrix",
-        "depth_map",
-        "compare_depth",
-        "light_uvz",
-        "receiver_depth_gradient",
-        "shadow_bias",
-        "cull_faces",
-        "outside_frustum",
-        "pcf_visibility",
-        "cube_face_index",
-        "cube_light_matrices",
-        "point_shadow_visibility",
-    ),
-    "shadow_report": (
-        "directional_light_matrix",
-        "spot_light_matrix",
-        "depth_map",
-        "compare_depth",
-        "light_uvz",
-        "receiver_depth_gradient",
-        "shadow_bias",
-        "cull_faces",
-        "outside_frustum",
-        "pcf_visibility",
-        "cube_face_index",
-        "cube_light_matrices",
-        "point_shadow_visibility",
-    ),
+    "light_visibility": _ALL,
+    "render_with_shadows": _ALL,
+    "shadow_report": _ALL,
 }

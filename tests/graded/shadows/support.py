@@ -13,6 +13,8 @@ import numpy as np
 from geomlib import camera, datasets
 from geomlib.grading.checks import Context, as_output_array, format_vec
 
+from .. import common
+
 # --------------------------------------------------------------------------------- scenes
 
 
@@ -133,25 +135,11 @@ class MapClose:
 
 
 @dataclass
-class SameRows:
-    """The same set of rows (faces) as expected, in any order; names a missing or extra row."""
+class SameRows(common.SameRows):
+    """The same set of faces as expected, in any order (each face's corner order counts)."""
 
-    output: str
-
-    def __call__(self, expected: dict, got: dict, ctx: Context) -> None:
-        e = np.asarray(expected[self.output])
-        g = as_output_array(got.get(self.output), self.output, ctx)
-        if g.ndim != 2 or g.shape[1] != e.shape[1]:
-            ctx.fail(f"{self.output} has shape {g.shape}, expected (k, {e.shape[1]})")
-        se, sg = {tuple(r) for r in e.tolist()}, {tuple(r) for r in g.tolist()}
-        if se != sg:
-            missing, extra = sorted(se - sg), sorted(sg - se)
-            what = []
-            if missing:
-                what.append(f"{len(missing)} expected faces are missing, e.g. {missing[0]}")
-            if extra:
-                what.append(f"{len(extra)} faces should have been culled, e.g. {extra[0]}")
-            ctx.fail(f"{self.output}: {'; '.join(what)} (kept {len(g)}, expected {len(e)})")
+    missing: str = "expected faces are missing"
+    extra: str = "faces should have been culled"
 
 
 @dataclass

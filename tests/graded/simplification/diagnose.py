@@ -1,10 +1,4 @@
-"""Diagnosis table of the simplification lab (see ``geomlib.grading.diagnose`` and ``geomlib.grading.tasks``).
-
-``TASKS``, ``TITLES`` and ``COMPOSITES`` declare which task each function belongs to (the stubs'
-"Task N" markers vanish as students fill them in; ``tests/framework/test_diagnose.py`` checks this
-table against the solutions). When a composite case fails, the grader runs the student's building
-blocks on this lab's graded cases of them, in task order, and names the first that is wrong.
-"""
+"""Task table of the simplification lab: the task of each function (docs/adding-a-lab.md, "Tasks and diagnosis")."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from geomlib import datasets
 from geomlib.grading import Case, checks
 
-from .cases import BOUNDARY_HINT, CC_HINT, EVEN_HINT, FACES_HINT, LEVELS_HINT, ODD_HINT, plane
+from .cases import BOUNDARY_HINT, CC_HINT, EVEN_HINT, FACES_HINT, LEVELS_HINT, ODD_HINT, no_vertices, plane
 from .support import faces_check, matrix_check, quad_grid
 
 
@@ -27,15 +27,6 @@ def open_quads():
 def quad_torus():
     V, Q = datasets.quad_torus(n_major=12, n_minor=8)
     return {"V": datasets.add_noise(V, 0.02, seed=5), "faces": Q}
-
-
-def no_vertices(make):
-    def inputs():
-        d = make()
-        del d["V"]
-        return d
-
-    return inputs
 
 
 H = "hidden"

@@ -8,16 +8,16 @@ cases, with references stored by ``geomlib refs build``, run only to explain a w
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from geomlib import topology
-from geomlib.grading import Case, checks
+from geomlib.grading import Case
 
 from .cases import (
     BOUNDARY_HINT,
     EVEN_HINT,
-    FACES_HINT,
-    ODD_HINT,
     bumpy_cube,
     cage,
     height_field,
@@ -26,7 +26,8 @@ from .cases import (
     torus,
     with_face_points,
 )
-from .support import faces_check, matrix_check, matrix_picture, wrong_rows
+from .cases import CASES as GRADED_CASES
+from .support import matrix_picture, wrong_rows
 
 TASKS = {
     "loop_odd_matrix": (1, 4),
@@ -63,92 +64,33 @@ COMPOSITES = {
 }
 
 
-def _odd(id, inputs, hint=ODD_HINT):
-    return Case(
-        id=id,
-        function="loop_odd_matrix",
-        inputs=inputs,
-        outputs=("S_odd",),
-        check=matrix_check("S_odd", what_row="row (edge)"),
-        part="diagnosis",
-        points=0,
-        hint=hint,
-    )
+_GRADED = {case.id: case for case in GRADED_CASES}
 
 
-def _even(id, inputs, weights, hint=EVEN_HINT):
-    return Case(
-        id=id,
-        function="loop_even_matrix",
-        inputs=inputs,
-        params={"weights": weights},
-        outputs=("S_even",),
-        check=matrix_check("S_even", what_row="row (vertex)"),
-        part="diagnosis",
-        points=0,
-        hint=hint,
-    )
+def _probe(graded_id: str, id: str, inputs, **changes) -> Case:
+    """Graded case ``graded_id``'s call, outputs and check on another input: zero points, never graded."""
+    return replace(_GRADED[graded_id], id=id, inputs=inputs, part="diagnosis", points=0, **changes)
 
 
-def _faces(id, inputs):
-    return Case(
-        id=id,
-        function="loop_faces",
-        inputs=no_vertices(inputs),
-        outputs=("F",),
-        check=faces_check("F"),
-        part="diagnosis",
-        points=0,
-        hint=FACES_HINT,
-    )
-
-
-def _cc(id, function, inputs, outputs, check, hint):
-    return Case(
-        id=id, function=function, inputs=inputs, outputs=outputs, check=check, part="diagnosis", points=0, hint=hint
-    )
-
+EDGE_POINT_HINT = "edge point = (a + b + FP[f0] + FP[f1]) / 4"
 
 CASES = [
-    _odd("probe-odd-icosahedron", ico(0)),
-    _even("probe-even-icosahedron-warren", ico(0), "warren"),
-    _faces("probe-faces-icosahedron", ico(0)),
-    _odd("probe-odd-torus", torus),
-    _even("probe-even-torus-loop", torus, "loop"),
-    _even("probe-even-height-field-loop", height_field, "loop", EVEN_HINT + "; " + BOUNDARY_HINT),
-    _faces("probe-faces-height-field", height_field),
-    _cc(
-        "probe-cc-faces-cube",
-        "cc_face_points",
-        bumpy_cube,
-        ("FP",),
-        checks.Allclose(),
-        "face point = mean of the corners",
-    ),
-    _cc(
-        "probe-cc-edges-cube",
-        "cc_edge_points",
-        with_face_points(bumpy_cube, "cube"),
-        ("EP",),
-        checks.Allclose(),
-        "edge point = (a + b + FP[f0] + FP[f1]) / 4",
-    ),
-    _cc(
+    _probe("odd-icosphere-1", "probe-odd-icosahedron", ico(0)),
+    _probe("even-icosphere-1-warren", "probe-even-icosahedron-warren", ico(0)),
+    _probe("faces-icosphere-1", "probe-faces-icosahedron", no_vertices(ico(0))),
+    _probe("odd-icosphere-1", "probe-odd-torus", torus),
+    _probe("even-icosphere-1-loop", "probe-even-torus-loop", torus),
+    _probe("even-icosphere-1-loop", "probe-even-height-field-loop", height_field, hint=f"{EVEN_HINT}; {BOUNDARY_HINT}"),
+    _probe("faces-icosphere-1", "probe-faces-height-field", no_vertices(height_field)),
+    _probe("cc-faces-quad-torus", "probe-cc-faces-cube", bumpy_cube, hint="face point = mean of the corners"),
+    _probe("cc-edges-quad-torus", "probe-cc-edges-cube", with_face_points(bumpy_cube, "cube"), hint=EDGE_POINT_HINT),
+    _probe(
+        "cc-quads-cage",
         "probe-cc-quads-cube",
-        "cc_quads",
         no_vertices(bumpy_cube),
-        ("Q",),
-        faces_check("Q"),
-        "one quad per corner j: (idx[j], n + he_edge[j], n + e + he_face[j], n + he_edge[prv[j]])",
+        hint="one quad per corner j: (idx[j], n + he_edge[j], n + e + he_face[j], n + he_edge[prv[j]])",
     ),
-    _cc(
-        "probe-cc-edges-cage",
-        "cc_edge_points",
-        with_face_points(cage, "cage"),
-        ("EP",),
-        checks.Allclose(),
-        "edge point = (a + b + FP[f0] + FP[f1]) / 4",
-    ),
+    _probe("cc-edges-quad-torus", "probe-cc-edges-cage", with_face_points(cage, "cage"), hint=EDGE_POINT_HINT),
 ]
 
 #: Probes on the composite case's own input, tried first.

@@ -1,9 +1,7 @@
-"""Graded tests of the subdivision lab.
-
-Two kinds: ``test_references`` compares with stored reference outputs on realistic meshes (see
-``cases.py``); the tests below use tiny meshes whose answers are worked out by hand in the
-docstrings and comments, identities that any correct implementation satisfies, and bad input.
-Expected values never come from running a solution at test time.
+"""Graded tests of the subdivision lab: ``test_references`` runs ``cases.py``; the tests below check the matrix
+rows, connectivity and boundary rules of Loop and Catmull-Clark on a triangle, a square, a quad, a tetrahedron
+and an octahedron, level counts and errors (answers worked out by hand in each docstring; see
+``tests/graded/__init__.py``).
 """
 
 from __future__ import annotations
@@ -15,6 +13,7 @@ from geomlib.grading import expect_close, expect_raises, graded, reference_tests
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import marked_picture, picture_context
 
+from ..common import expect_rejected
 from .cases import CASES
 from .support import (
     OCTA_F,
@@ -197,26 +196,14 @@ def test_square_interior_edge_between_boundary_vertices(lab):
 def test_one_quad_boundary_points(lab):
     """one quad: Catmull-Clark edge points are the midpoints, vertex points 3/4 P + 1/8 (two neighbours)"""
     fp = centroids(QUAD_V, QUAD_F)
-    EP = lab.cc_edge_points(QUAD_V, QUAD_F, fp)
-    # edges (0,1), (0,3), (1,2), (2,3)
-    expect_close(
-        "cc_edge_points on one quad",
-        EP,
-        [[1, 0, 0], [0, 1, 0], [2, 1, 0], [1, 2, 0]],
-        atol=1e-12,
-        name="edge points",
-        mesh=(QUAD_V, QUAD_F),
-    )
-    VP = lab.cc_vertex_points(QUAD_V, QUAD_F, fp)
+    # edges (0,1), (0,3), (1,2), (2,3): their midpoints.
     # vertex 0 = (0,0): 1/8 ((2,0) + (0,2)) = (0.25, 0.25); the others by symmetry
-    expect_close(
-        "cc_vertex_points on one quad",
-        VP,
-        [[0.25, 0.25, 0], [1.75, 0.25, 0], [1.75, 1.75, 0], [0.25, 1.75, 0]],
-        atol=1e-12,
-        name="vertex points",
-        mesh=(QUAD_V, QUAD_F),
-    )
+    for function, name, expected in (
+        ("cc_edge_points", "edge points", [[1, 0, 0], [0, 1, 0], [2, 1, 0], [1, 2, 0]]),
+        ("cc_vertex_points", "vertex points", [[0.25, 0.25, 0], [1.75, 0.25, 0], [1.75, 1.75, 0], [0.25, 1.75, 0]]),
+    ):
+        got = getattr(lab, function)(QUAD_V, QUAD_F, fp)
+        expect_close(f"{function} on one quad", got, expected, atol=1e-12, name=name, mesh=(QUAD_V, QUAD_F))
 
 
 # --------------------------------------------------------------------------------------------
@@ -407,7 +394,7 @@ def test_cage_counts_and_extraordinary_vertices(lab):
 def test_rejects_quads_for_loop(lab):
     """Loop subdivision rejects quads with a message about triangles"""
     V, Q = datasets.quad_cube()
-    expect_raises(lambda: lab.loop_subdivide(V, Q), "MeshError", match="triangles", label="loop_subdivide(quads)")
+    expect_rejected(lab, "loop_subdivide", V, Q, match="triangles", label="loop_subdivide(quads)")
 
 
 @graded(points=0, part="bad input")
@@ -425,26 +412,19 @@ def test_rejects_non_manifold(lab):
 def test_rejects_bad_levels(lab):
     """levels must be an integer >= 0"""
     V, F = datasets.icosphere(0)
-    expect_raises(lambda: lab.loop_subdivide(V, F, -1), "MeshError", match=">= 0", label="loop_subdivide(levels=-1)")
-    expect_raises(
-        lambda: lab.loop_subdivide(V, F, 1.5), "MeshError", match="integer", label="loop_subdivide(levels=1.5)"
-    )
-    expect_raises(lambda: lab.catmull_clark(V, F, "2"), "MeshError", match="integer", label="catmull_clark(levels='2')")
+    expect_rejected(lab, "loop_subdivide", V, F, -1, match=">= 0", label="loop_subdivide(levels=-1)")
+    expect_rejected(lab, "loop_subdivide", V, F, 1.5, match="integer", label="loop_subdivide(levels=1.5)")
+    expect_rejected(lab, "catmull_clark", V, F, "2", match="integer", label="catmull_clark(levels='2')")
 
 
 @graded(points=0, part="bad input")
 def test_rejects_unknown_weights_and_nan(lab):
     """unknown weight rule and NaN coordinates are rejected with a message naming them"""
     V, F = datasets.icosphere(0)
-    expect_raises(
-        lambda: lab.loop_subdivide(V, F, 1, "butterfly"),
-        "MeshError",
-        match="weights",
-        label="loop_subdivide(weights='butterfly')",
+    expect_rejected(
+        lab, "loop_subdivide", V, F, 1, "butterfly", match="weights", label="loop_subdivide(weights='butterfly')"
     )
     Vn = V.copy()
     Vn[3, 0] = np.nan
-    expect_raises(lambda: lab.loop_subdivide(Vn, F), "MeshError", match="row 3", label="loop_subdivide(V with NaN)")
-    expect_raises(
-        lambda: lab.catmull_clark(V, [[0, 1, 2], [2, 3]]), "MeshError", match="face 1", label="catmull_clark(2-gon)"
-    )
+    expect_rejected(lab, "loop_subdivide", Vn, F, match="row 3", label="loop_subdivide(V with NaN)")
+    expect_rejected(lab, "catmull_clark", V, [[0, 1, 2], [2, 3]], match="face 1", label="catmull_clark(2-gon)")

@@ -23,33 +23,16 @@ from geomlib.grading import Case, checks
 from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context, as_output_array, format_vec
 
+from .. import common
+
 # ------------------------------------------------------------------------------------- checks
 
 
 @dataclass
-class SameRows:
-    """The same set of rows (e.g. edges as vertex pairs, corners), in any order."""
+class SameRows(common.SameRows):
+    """The same set of rows (edges as unordered vertex pairs, corners), in any order."""
 
-    output: str
     sort_within: bool = True
-
-    def __call__(self, expected: dict, got: dict, ctx: Context) -> None:
-        e = np.asarray(expected[self.output]).astype(np.int64)
-        g = as_output_array(got.get(self.output), self.output, ctx).astype(np.int64)
-        if g.ndim != e.ndim or (e.ndim == 2 and g.shape[1:] != e.shape[1:]):
-            ctx.fail(f"{self.output} has shape {g.shape}, expected {e.shape}")
-        if e.ndim == 2 and self.sort_within:
-            e, g = np.sort(e, axis=1), np.sort(g, axis=1)
-        E = {tuple(np.atleast_1d(r).tolist()) for r in e}
-        G = {tuple(np.atleast_1d(r).tolist()) for r in g}
-        if E != G:
-            missing, extra = sorted(E - G), sorted(G - E)
-            what = []
-            if missing:
-                what.append(f"{len(missing)} expected entries missing (e.g. {format_vec(np.array(missing[0]))})")
-            if extra:
-                what.append(f"{len(extra)} unexpected entries (e.g. {format_vec(np.array(extra[0]))})")
-            ctx.fail(f"{self.output}: expected {len(E)} entries, got {len(G)}; " + "; ".join(what))
 
 
 @dataclass
