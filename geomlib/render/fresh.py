@@ -41,16 +41,8 @@ def render_in_fresh_process(entry: str, V, F, options, overrides: dict) -> np.nd
     V, F, options, overrides
         Its arguments, as given to it (they must pickle: arrays, lists, option objects do).
 
-    Returns
-    -------
-    (height, width, 3) uint8
-        The image.
-
-    Raises
-    ------
-    Exception
-        What the entry point raised there (a ``MeshError`` for a bad mesh, ...), or a
-        ``RuntimeError`` naming the failure when the fresh process itself failed.
+    Returns and raises what the entry point does there (the image; a ``MeshError`` for a bad mesh,
+    ...), or a ``RuntimeError`` naming the failure when the fresh process itself failed.
     """
     payload = pickle.dumps((entry, V, F, options, overrides), protocol=pickle.HIGHEST_PROTOCOL)
     # The fresh interpreter sees the modules this one sees (a course root added to sys.path, ...).
