@@ -88,31 +88,42 @@ def _cmd_render(a) -> int:
 def _cmd_refs(a) -> int:
     from geomlib.grading import refs
 
-    labs = [a.lab] if a.lab else None
-    if a.action == "build":
-        t = time.time()
-        files = refs.build(labs)
-        print(f"wrote {len(files)} reference files in {time.time() - t:.1f} s")
-        return 0
-    problems = refs.check(labs)
-    for p in problems:
-        print(f"FAIL {p.lab}/{p.case}: {p.message}")
-    print("references OK" if not problems else f"{len(problems)} reference problem(s)")
-    return 1 if problems else 0
+    return _build_or_check(
+        a,
+        refs,
+        built=lambda files, seconds: f"wrote {len(files)} reference files in {seconds:.1f} s",
+        problem=lambda p: f"FAIL {p.lab}/{p.case}: {p.message}",
+        ok="references OK",
+        stale=lambda n: f"{n} reference problem(s)",
+    )
 
 
 def _cmd_stubs(a) -> int:
     from geomlib.grading import stubs
 
+    return _build_or_check(
+        a,
+        stubs,
+        built=lambda files, seconds: f"{len(files)} stub files up to date in labs/",
+        problem=lambda p: f"STALE {p}",
+        ok="labs/ is up to date",
+        stale=lambda n: "labs/ is stale: run `geomlib stubs build`",
+    )
+
+
+def _build_or_check(a, tool, *, built, problem, ok: str, stale) -> int:
+    """``build``: regenerate what ``tool`` (refs or stubs) makes from solutions/; ``check``: print each
+    difference and exit 1 if there is any. ``built``, ``problem`` and ``stale`` word the report."""
     labs = [a.lab] if a.lab else None
     if a.action == "build":
-        files = stubs.build(labs)
-        print(f"{len(files)} stub files up to date in labs/")
+        t = time.time()
+        files = tool.build(labs)
+        print(built(files, time.time() - t))
         return 0
-    problems = stubs.check(labs)
+    problems = tool.check(labs)
     for p in problems:
-        print(f"STALE {p}")
-    print("labs/ is up to date" if not problems else "labs/ is stale: run `geomlib stubs build`")
+        print(problem(p))
+    print(stale(len(problems)) if problems else ok)
     return 1 if problems else 0
 
 
