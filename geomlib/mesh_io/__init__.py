@@ -94,7 +94,8 @@ def read_mesh(path: PathLike, *, triangulate: bool = False) -> tuple[np.ndarray,
     FileNotFoundError
         The file does not exist.
     MeshError
-        Unsupported extension or malformed file (the message names the line).
+        Unsupported extension or malformed file: the message names the file, the line (text
+        formats) and the problem.
     """
     where = "read_mesh"
     ext = _ext(path)

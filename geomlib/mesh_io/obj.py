@@ -88,10 +88,8 @@ def read_obj(path: PathLike, *, triangulate: bool = False) -> ObjData:
 
     Raises
     ------
-    FileNotFoundError
-        The file does not exist.
-    MeshError
-        Malformed file; the message gives the line number and the problem.
+    FileNotFoundError, MeshError
+        As in :func:`~geomlib.mesh_io.read_mesh`.
     """
     return _read_obj(path, "read_obj", triangulate)
 

@@ -44,10 +44,8 @@ def read_off(path: PathLike) -> tuple[np.ndarray, Faces]:
 
     Raises
     ------
-    FileNotFoundError
-        The file does not exist.
-    MeshError
-        Malformed file; the message gives the line number and the problem.
+    FileNotFoundError, MeshError
+        As in :func:`~geomlib.mesh_io.read_mesh`.
     """
     return _read_off(path, "read_off")
 
