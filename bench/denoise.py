@@ -33,21 +33,15 @@ real meshes in ``../shared/data/meshes``.
 from __future__ import annotations
 
 import argparse
-import sys
-import time
-import tracemalloc
 from pathlib import Path
 
+import igl
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import igl  # noqa: E402
-
-from geomlib import datasets, mesh_io  # noqa: E402
-from geomlib.textures import rasterize_uv, triangle_atlas  # noqa: E402
-from solutions.denoise import (  # noqa: E402
+from bench.measure import SHARED, best_of, peak_mib
+from geomlib import datasets, mesh_io
+from geomlib.textures import rasterize_uv, triangle_atlas
+from solutions.denoise import (
     bake_offset_map,
     denoise_vertices,
     denoise_with_map,
@@ -58,7 +52,6 @@ from solutions.denoise import (  # noqa: E402
     weld_seams,
 )
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 REAL = ["spot_triangulated.obj", "cow.off", "fandisk.obj", "rocker-arm.obj", "camelhead.off", "mountain.obj",
         "bunny_hr.obj", "armadillo.obj", "igea.ply"]  # fmt: skip
 REAL_QUICK = ["spot_triangulated.obj", "fandisk.obj"]
@@ -105,27 +98,6 @@ def mesh_names(quick: bool) -> list[str]:
     else:
         print(f"(no shared meshes at {SHARED}; built-in meshes only)")
     return names
-
-
-# --------------------------------------------------------------------------------------------
-# timing helpers
-
-
-def best_of(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
-
-
-def peak_mib(fn) -> float:
-    tracemalloc.start()
-    fn()
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    return peak / 2**20
 
 
 def row(name: str, ours: float, mem: float, anchors: list[tuple[str, float]]) -> None:
@@ -211,37 +183,42 @@ def time_mesh(name: str, repeat: int, baker) -> None:
     V, F, UV = load(name)
     Vn, N = make_noisy(V, F, 0.3, 0)
     print(f"{name}: {len(V):,} vertices, {len(F):,} faces{'' if UV is None else ', with UVs'}")
-    t = best_of(lambda: laplacian_offsets(Vn, F, weld=False), repeat)
+    t = best_of(lambda: laplacian_offsets(Vn, F, weld=False), repeat).wall
     mem = peak_mib(lambda: laplacian_offsets(Vn, F, weld=False))
-    anchors = [("igl adjacency", best_of(lambda: igl_uniform(Vn, F), repeat)),
-               ("trimesh laplacian", best_of(lambda: trimesh_uniform(Vn, F), repeat))]  # fmt: skip
+    anchors = [("igl adjacency", best_of(lambda: igl_uniform(Vn, F), repeat).wall),
+               ("trimesh laplacian", best_of(lambda: trimesh_uniform(Vn, F), repeat).wall)]  # fmt: skip
     row("offsets uniform (weld=False)", t, mem, anchors)
-    t = best_of(lambda: laplacian_offsets(Vn, F), repeat)
+    t = best_of(lambda: laplacian_offsets(Vn, F), repeat).wall
     row("offsets uniform (weld=True)", t, peak_mib(lambda: laplacian_offsets(Vn, F)), anchors)
-    t = best_of(lambda: laplacian_offsets(Vn, F, "cotan", weld=False), repeat)
+    t = best_of(lambda: laplacian_offsets(Vn, F, "cotan", weld=False), repeat).wall
     mem = peak_mib(lambda: laplacian_offsets(Vn, F, "cotan", weld=False))
-    row("offsets cotan (weld=False)", t, mem, [("igl cotmatrix", best_of(lambda: igl_cotan(Vn, F), repeat))])
-    t = best_of(lambda: denoise_vertices(Vn, F, N, 0.7), repeat)
+    row("offsets cotan (weld=False)", t, mem, [("igl cotmatrix", best_of(lambda: igl_cotan(Vn, F), repeat).wall)])
+    t = best_of(lambda: denoise_vertices(Vn, F, N, 0.7), repeat).wall
     mem = peak_mib(lambda: denoise_vertices(Vn, F, N, 0.7))
-    anchors = [("trimesh filter_laplacian", best_of(lambda: trimesh_filter(Vn, F, 0.7), repeat)),
-               ("VTK smooth (pyvista)", best_of(lambda: vtk_smooth(Vn, F, 0.7), repeat))]  # fmt: skip
+    anchors = [("trimesh filter_laplacian", best_of(lambda: trimesh_filter(Vn, F, 0.7), repeat).wall),
+               ("VTK smooth (pyvista)", best_of(lambda: vtk_smooth(Vn, F, 0.7), repeat).wall)]  # fmt: skip
     row("denoise_vertices (1 pass)", t, mem, anchors)
     if UV is None:
         return
     s = normal_offsets(laplacian_offsets(Vn, F), N)
-    t = best_of(lambda: bake_offset_map(Vn, F, UV, s, 1024), repeat)
+    t = best_of(lambda: bake_offset_map(Vn, F, UV, s, 1024), repeat).wall
     mem = peak_mib(lambda: bake_offset_map(Vn, F, UV, s, 1024))
-    t_r = best_of(lambda: rasterize_uv(F, UV, 1024), repeat)
+    t_r = best_of(lambda: rasterize_uv(F, UV, 1024), repeat).wall
     if baker is not None:
         baker(F, UV, s)  # warm: shaders, buffers
-        row("bake_offset_map 1024^2", t, mem, [("pyrender UV draw 1024^2", best_of(lambda: baker(F, UV, s), repeat))])
+        row(
+            "bake_offset_map 1024^2",
+            t,
+            mem,
+            [("pyrender UV draw 1024^2", best_of(lambda: baker(F, UV, s), repeat).wall)],
+        )
     else:
         print(f"  bake_offset_map 1024^2 {t:7.3f} s  peak {mem:7.1f} MiB")
     print(f"  {'':<30} (of which the given geomlib.textures.rasterize_uv: {t_r:.3f} s)")
     img, bias, scale = bake_offset_map(Vn, F, UV, s, 1024)
-    t = best_of(lambda: denoise_with_map(Vn, F, UV, N, img, bias, scale, 0.7), repeat)
+    t = best_of(lambda: denoise_with_map(Vn, F, UV, N, img, bias, scale, 0.7), repeat).wall
     mem = peak_mib(lambda: denoise_with_map(Vn, F, UV, N, img, bias, scale, 0.7))
-    t_sc = best_of(lambda: scipy_map_route(Vn, UV, N, img, bias, scale, 0.7), repeat)
+    t_sc = best_of(lambda: scipy_map_route(Vn, UV, N, img, bias, scale, 0.7), repeat).wall
     row("denoise_with_map", t, mem, [("scipy map_coordinates", t_sc)])
 
 

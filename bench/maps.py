@@ -21,22 +21,17 @@ tracemalloc peak of one call (NumPy allocations), in MiB.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-import tracemalloc
-from pathlib import Path
 
+import igl
 import numpy as np
+from igl.embree import line_mesh_intersection
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import igl  # noqa: E402
-from igl.embree import line_mesh_intersection  # noqa: E402
-
-from geomlib import camera, datasets  # noqa: E402
-from geomlib.textures import rasterize_uv, triangle_atlas  # noqa: E402
-from solutions.maps import (  # noqa: E402
+from bench.anchors import pyrender_normal_mapped_mesh
+from bench.measure import SHARED, best_of, peak_mib
+from geomlib import camera, datasets
+from geomlib.textures import rasterize_uv, triangle_atlas
+from solutions.maps import (
     bake_normal_map,
     displace,
     encode_normal_map,
@@ -48,33 +43,15 @@ from solutions.maps import (  # noqa: E402
     welded_vertex_normals,
 )
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
-
-
 CPU: dict[str, float] = {}
 
 
-def best_of(fn, repeat: int, key: str | None = None) -> float:
-    """Best wall time of ``repeat`` calls; the CPU time of that best call goes to ``CPU[key]``."""
-    times, cpus = [], []
-    for _ in range(repeat):
-        c = time.process_time()
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-        cpus.append(time.process_time() - c)
+def timed(fn, key: str | None = None) -> float:
+    """Wall time of one call; its CPU time goes to ``CPU[key]`` (the least seen), which :func:`row` prints."""
+    t = best_of(fn, 1)
     if key is not None:
-        i = int(np.argmin(times))
-        CPU[key] = min(CPU.get(key, np.inf), cpus[i])
-    return min(times)
-
-
-def peak_mib(fn) -> float:
-    tracemalloc.start()
-    fn()
-    _, peak = tracemalloc.get_traced_memory()
-    tracemalloc.stop()
-    return peak / 2**20
+        CPU[key] = min(CPU.get(key, np.inf), t.cpu)
+    return t.wall
 
 
 def bumps(s: int, seed: int = 0) -> np.ndarray:
@@ -102,8 +79,8 @@ def bench_tangents(quick: bool, repeat: int) -> None:
     print(f"tangent_frames: uv_torus, {len(F):,} faces, {len(V):,} vertices")
     t_ours, t_igl = [], []
     for _ in range(repeat):
-        t_ours.append(best_of(lambda: tangent_frames(V, F, UV), 1, "tangent_frames"))
-        t_igl.append(best_of(lambda: igl.per_vertex_normals(V, F, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA), 1))
+        t_ours.append(timed(lambda: tangent_frames(V, F, UV), "tangent_frames"))
+        t_igl.append(timed(lambda: igl.per_vertex_normals(V, F, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)))
     mem = peak_mib(lambda: tangent_frames(V, F, UV))
     target = "target <= 1 s at 1M faces" + ("" if not quick else " (quick: 250k faces)")
     row("tangent_frames", min(t_ours), min(t_igl), "igl.per_vertex_normals", mem, target)
@@ -124,22 +101,8 @@ def pyrender_frame(V, F, UV, N, tangents, nmap, view, size: int):
     from geomlib import render as grender
 
     pyrender = grender.import_pyrender()
-    mat = pyrender.MetallicRoughnessMaterial(
-        baseColorFactor=[0.8, 0.7, 0.6, 1.0],
-        metallicFactor=0.0,
-        roughnessFactor=0.6,
-        normalTexture=pyrender.Texture(source=nmap, source_channels="RGB"),
-    )
-    prim = pyrender.Primitive(
-        positions=V.astype(np.float32),
-        normals=N.astype(np.float32),
-        texcoord_0=UV.astype(np.float32),
-        tangents=tangents.astype(np.float32),
-        indices=F.astype(np.uint32),
-        material=mat,
-    )
     scene = pyrender.Scene(bg_color=[1.0, 1.0, 1.0, 1.0], ambient_light=[0.1] * 3)
-    scene.add(pyrender.Mesh([prim]))
+    scene.add(pyrender_normal_mapped_mesh(V, F, UV, N, tangents, nmap, base_color=(0.8, 0.7, 0.6), roughness=0.6))
     scene.add(
         pyrender.PerspectiveCamera(yfov=np.radians(40), aspectRatio=1.0, znear=0.5, zfar=10.0), pose=np.linalg.inv(view)
     )
@@ -169,9 +132,9 @@ def bench_shade(quick: bool, repeat: int) -> None:
         renderer = None
     t_ours, t_pr = [], []
     for _ in range(repeat):
-        t_ours.append(best_of(lambda: shade(g, lights, eye, (0.8, 0.7, 0.6), nmap), 1, "shade (normal map)"))
+        t_ours.append(timed(lambda: shade(g, lights, eye, (0.8, 0.7, 0.6), nmap), "shade (normal map)"))
         if renderer is not None:
-            t_pr.append(best_of(lambda: renderer.render(scene), 1))
+            t_pr.append(timed(lambda: renderer.render(scene)))
     mem = peak_mib(lambda: shade(g, lights, eye, (0.8, 0.7, 0.6), nmap))
     target = "target <= 0.5 s at 1024^2" + (" (quick: 512^2)" if quick else "")
     if renderer is not None:
@@ -203,8 +166,8 @@ def bench_bake_case(name: str, Vh, Fh, Vl, Fl, UVl, size: int, repeat: int) -> N
     t_ours, t_emb = [], []
     CPU.pop("bake_normal_map", None)
     for _ in range(repeat):
-        t_ours.append(best_of(lambda: bake_normal_map(Vh, Fh, Vl, Fl, UVl, size), 1, "bake_normal_map"))
-        t_emb.append(best_of(lambda: line_mesh_intersection(P, D, Vh, Fh), 1))
+        t_ours.append(timed(lambda: bake_normal_map(Vh, Fh, Vl, Fl, UVl, size), "bake_normal_map"))
+        t_emb.append(timed(lambda: line_mesh_intersection(P, D, Vh, Fh)))
     mem = peak_mib(lambda: bake_normal_map(Vh, Fh, Vl, Fl, UVl, size))
     row(
         "bake_normal_map",

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
-import tracemalloc
 
 import numpy as np
 import trimesh
 
+from bench.measure import best_of, peak_mib
 from geomlib.camera import camera_presets, look_at, perspective
 from geomlib.raster import rasterize
 from geomlib.render import import_pyrender  # headless platform + the project's one NumPy-2 shim for pyrender
@@ -62,24 +61,6 @@ def camera_for(V: np.ndarray, preset: str) -> tuple[np.ndarray, np.ndarray, floa
     return look_at(eye, target, up), perspective(FOV, 1.0, near, far), near, far
 
 
-def best_of(fn, repeat: int) -> tuple[float, float, object]:
-    """Best wall time, best CPU time of this process (all threads), last result."""
-    best, best_cpu, out = np.inf, np.inf, None
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.process_time()
-        out = fn()
-        best, best_cpu = min(best, time.perf_counter() - t), min(best_cpu, time.process_time() - c)
-    return best, best_cpu, out
-
-
-def peak_mem(fn) -> float:
-    tracemalloc.start()
-    fn()
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    return peak / 2**20
-
-
 class PyrenderScene:
     def __init__(self, V, F, view, near, far, size):
         self.scene = pyrender.Scene(bg_color=[0, 0, 0, 0], ambient_light=[1.0, 1.0, 1.0])
@@ -114,7 +95,7 @@ def run(name, V, F, size, depth_only, preset, repeat):
     else:
         ours = lambda: rasterize(V, F, M, size, size, attributes={"position": V})
     t_ours, c_ours, g = best_of(ours, repeat)
-    mem = peak_mem(ours)
+    mem = peak_mib(ours)
     pr = PyrenderScene(V, F, view, near, far, size)
     try:
         t_first, _, _ = best_of(pr.depth if depth_only else pr.color_depth, 1)

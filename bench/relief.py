@@ -19,18 +19,13 @@ tracemalloc peak of one NumPy frame (NumPy allocations), in MiB.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-import tracemalloc
-from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from geomlib import gl  # noqa: E402
-from solutions.relief import (  # noqa: E402
+from bench.measure import peak_mib
+from geomlib import gl
+from solutions.relief import (
     REFINEMENTS,
     bricks,
     bumps,
@@ -86,10 +81,7 @@ def timing(p: int, repeat: int) -> None:
         t0 = time.perf_counter()
         hit_g, vis_g = glsl_frame(H, uv, V)
         t_gl.append(time.perf_counter() - t0)
-    tracemalloc.start()
-    numpy_frame(H, uv, V)
-    peak = tracemalloc.get_traced_memory()[1] / 2**20
-    tracemalloc.stop()
+    peak = peak_mib(lambda: numpy_frame(H, uv, V))
     i = int(np.argmin(t_np))
     err = uv_error_texels(hit_n, hit_g, 256)
     print(f"  NumPy  {min(t_np) * 1e3:7.1f} ms (CPU {cpu_np[i] * 1e3:.1f} ms), peak {peak:.0f} MiB")

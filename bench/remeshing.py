@@ -37,15 +37,13 @@ from pathlib import Path
 import igl
 import numpy as np
 
+from bench.measure import SHARED
+from geomlib import datasets
+from geomlib.geometry import mesh_distance
+from solutions.remeshing import isotropic_remesh
+from solutions.remeshing.figures import quality as mesh_quality
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from geomlib import datasets  # noqa: E402
-from geomlib.geometry import mesh_distance  # noqa: E402
-from solutions.remeshing import isotropic_remesh  # noqa: E402
-from solutions.remeshing.figures import quality as mesh_quality  # noqa: E402
-
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 
 # Each tool runs in the throwaway environment: it reads in.npz (V, F, h, its, feature_edges or the
 # feature angle) and writes out.npz (V, F, t = best time of 2, timed inside that process).

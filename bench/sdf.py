@@ -33,20 +33,16 @@ import subprocess
 import sys
 import tempfile
 import time
-import tracemalloc
 from pathlib import Path
 
+import igl
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import igl  # noqa: E402
-
-from geomlib import camera, datasets  # noqa: E402
-from geomlib.geometry import bbox_diagonal  # noqa: E402
-from geomlib.mesh_io import read_mesh  # noqa: E402
-from solutions.sdf import (  # noqa: E402
+from bench.measure import SHARED, best_of, medians, peak_mib
+from geomlib import camera, datasets
+from geomlib.geometry import bbox_diagonal
+from geomlib.mesh_io import read_mesh
+from solutions.sdf import (
     compress_bricks,
     gradient_central,
     gradient_tetra,
@@ -56,22 +52,13 @@ from solutions.sdf import (  # noqa: E402
     soft_shadow,
     sphere_trace,
 )
-from solutions.sdf.trace import camera_rays  # noqa: E402
+from solutions.sdf.trace import camera_rays
 
-MESHES = ROOT.parent / "shared" / "data" / "meshes"
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def rss_mib() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def best(fn, repeat: int):
-    times, out = [], None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), out
 
 
 def bumpy_torus(faces: int = 100_000):
@@ -119,19 +106,19 @@ def grids(name, V, F, resolutions, repeat):
     for res in resolutions:
         origin, h = grid_box(V, res, 0.1)
         P = grid_points(origin, h, (res, res, res))
-        t_igl, ref = best(
+        t_igl, _, ref = best_of(
             lambda P=P: igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)[0], repeat
         )
-        t_ours, g = best(lambda res=res: sdf_grid(V, F, res), repeat)
+        t_ours, _, g = best_of(lambda res=res: sdf_grid(V, F, res), repeat)
         err = np.abs(g.values.ravel() - ref).max() / diag
         r = 4 * h
-        t_igl_b, _ = best(
+        t_igl_b, _, _ = best_of(
             lambda P=P, r=r: igl.signed_distance(
                 P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL, lower_bound=-r, upper_bound=r
             ),
             repeat,
         )
-        t_band, gb = best(lambda res=res: sdf_grid(V, F, res, band=4), repeat)
+        t_band, _, gb = best_of(lambda res=res: sdf_grid(V, F, res, band=4), repeat)
         err_b = np.abs(gb.values.ravel() - np.clip(ref, -r, r)).max() / diag
         print(
             f"   {res:>3}^3 full: ours {t_ours:6.2f} s  igl {t_igl:6.2f} s  ratio {t_ours / t_igl:5.2f}  "
@@ -143,10 +130,7 @@ def grids(name, V, F, resolutions, repeat):
         )
         if res == max(resolutions):
             field128 = g
-    tracemalloc.start()
-    sdf_grid(V, F, min(resolutions))
-    peak = tracemalloc.get_traced_memory()[1] / 2**20
-    tracemalloc.stop()
+    peak = peak_mib(lambda: sdf_grid(V, F, min(resolutions)))
     print(f"   tracemalloc peak of one {min(resolutions)}^3 grid call (NumPy side): {peak:.0f} MiB")
     return field128
 
@@ -176,20 +160,6 @@ def bricks(g):
     )
 
 
-def medians(fn, repeat: int):
-    """Median wall-clock and CPU (``time.process_time``) seconds of ``repeat`` runs, and the last result.
-
-    On a shared machine the CPU time is the steadier number: wall time also counts waiting for a core.
-    """
-    wall, cpu, out = [], [], None
-    for _ in range(repeat):
-        t, c = time.perf_counter(), time.process_time()
-        out = fn()
-        wall.append(time.perf_counter() - t)
-        cpu.append(time.process_time() - c)
-    return float(np.median(wall)), float(np.median(cpu)), out
-
-
 def tracing(g, V, repeat):
     c = (V.min(0) + V.max(0)) / 2
     R = 0.5 * np.linalg.norm(V.max(0) - V.min(0))
@@ -199,8 +169,8 @@ def tracing(g, V, repeat):
     runs = max(repeat, 5)
     w_tr, c_tr, (t, hit, steps) = medians(lambda: sphere_trace(g, O, D, max_steps=64, eps=1e-4 * R, t_max=6 * R), runs)
     X = O[hit] + t[hit, None] * D[hit]
-    t6, _ = best(lambda: gradient_central(g, X, 0.5 * g.spacing), repeat)
-    t4, N = best(lambda: gradient_tetra(g, X, 0.5 * g.spacing), repeat)
+    t6, _, _ = best_of(lambda: gradient_central(g, X, 0.5 * g.spacing), repeat)
+    t4, _, N = best_of(lambda: gradient_tetra(g, X, 0.5 * g.spacing), repeat)
     light = c + R * np.array([1.5, -1.0, 3.0])
     Ps = X + 2 * g.spacing * N
     w_sh, c_sh, vis = medians(lambda: soft_shadow(g, Ps, light, 0.3 * R, max_steps=32), runs)
@@ -214,7 +184,7 @@ def tracing(g, V, repeat):
 
 
 def fandisk_signs():
-    path = MESHES / "fandisk.obj"
+    path = SHARED / "fandisk.obj"
     if not path.is_file():
         print("\n5. fandisk: ../shared/data/meshes/fandisk.obj not found, skipped")
         return
@@ -241,8 +211,8 @@ def main() -> None:
     sdf_grid(*datasets.icosphere(1), 8)  # load the kernels before any clock starts
     sdf_grid(*datasets.icosphere(1), 8, band=2)
     meshes = [("bumpy torus", bumpy_torus())]
-    if (MESHES / "armadillo.obj").is_file():
-        meshes.append(("armadillo", read_mesh(MESHES / "armadillo.obj")[:2]))
+    if (SHARED / "armadillo.obj").is_file():
+        meshes.append(("armadillo", read_mesh(SHARED / "armadillo.obj")[:2]))
     for name, (V, F) in meshes:
         g = grids(name, V, F, resolutions, repeat)
         bricks(g)

@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import argparse
 import time
-import tracemalloc
 from pathlib import Path
 
 import numpy as np
 
+from bench.measure import SHARED, best_of, peak_mib
 from geomlib.mesh_io import read_mesh
 from solutions.shadows import (
     CLASSIC_CAMERA,
@@ -45,7 +45,6 @@ from solutions.shadows import (
     torus_scene,
 )
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 TORUS_CAMERA = (np.array([0.0, -5.5, 3.2]), np.array([0.0, 0.0, 1.2]))
 TORUS_LIGHT = {"type": "directional", "direction": np.array([0.5, 0.3, -0.8])}
 
@@ -61,36 +60,19 @@ def mesh_on_floor(path: Path):
     return scene, (np.array([3.5, -5.5, 3.0]), np.array([0.0, 0.0, 0.9])), TORUS_LIGHT
 
 
-def best_of(fn, repeat: int):
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t)
-    return best, out
-
-
-def peak_mb(fn) -> float:
-    tracemalloc.start()
-    fn()
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    return peak / 2**20
-
-
 def bench_scene(name, scene, camera, light, *, frame: int, repeat: int, quality: int | None) -> dict:
     M = light_setup(scene, light).matrices[0]
-    t_map, _ = best_of(lambda: depth_map(scene.V, scene.F, M, 1024), repeat)
-    t_frame, _ = best_of(
+    t_map, _, _ = best_of(lambda: depth_map(scene.V, scene.F, M, 1024), repeat)
+    t_frame, _, _ = best_of(
         lambda: render_with_shadows(scene, camera, light, size=(frame, frame), map_size=1024, pcf=3), repeat
     )
-    mem = peak_mb(lambda: render_with_shadows(scene, camera, light, size=(frame, frame), map_size=1024, pcf=3))
-    t_build, (ps, rend, pyrender) = best_of(
+    mem = peak_mib(lambda: render_with_shadows(scene, camera, light, size=(frame, frame), map_size=1024, pcf=3))
+    t_build, _, (ps, rend, pyrender) = best_of(
         lambda: pyrender_scene(scene, camera, light, size=(frame, frame)), 1
     )  # scene upload happens in the first render
     flags = pyrender.RenderFlags.SHADOWS_DIRECTIONAL
-    t_first, _ = best_of(lambda: rend.render(ps, flags=flags), 1)
-    t_py, _ = best_of(lambda: rend.render(ps, flags=flags), max(repeat, 3))
+    t_first, _, _ = best_of(lambda: rend.render(ps, flags=flags), 1)
+    t_py, _, _ = best_of(lambda: rend.render(ps, flags=flags), max(repeat, 3))
     row = {"scene": name, "faces": len(scene.F), "map": t_map, "frame": t_frame, "py": t_py, "mem": mem}
     row["py_first"] = t_build + t_first
     if quality:

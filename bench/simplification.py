@@ -46,20 +46,18 @@ import tracemalloc
 import warnings
 from pathlib import Path
 
+import fast_simplification
+import igl
 import numpy as np
+import pyvista as pv
+
+from bench.measure import SHARED
+from geomlib import datasets, topology
+from geomlib.geometry import closest_points, face_normals, mesh_distance
+from solutions.simplification import qem_simplify
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
-import fast_simplification  # noqa: E402
-import igl  # noqa: E402
-import pyvista as pv  # noqa: E402
-
-from geomlib import datasets, topology  # noqa: E402
-from geomlib.geometry import closest_points, face_normals, mesh_distance  # noqa: E402
-from solutions.simplification import qem_simplify  # noqa: E402
-
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 GREEDY_MAX_FACES = 25_000
 
 

@@ -19,25 +19,19 @@ arrays.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 import tracemalloc
-from pathlib import Path
 
+import igl
 import numpy as np
+import pyvista as pv
+import trimesh
+from scipy.spatial import cKDTree
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from bench.measure import SHARED
+from geomlib import topology
+from solutions.subdivision import catmull_clark, loop_subdivide
 
-import igl  # noqa: E402
-import pyvista as pv  # noqa: E402
-import trimesh  # noqa: E402
-from scipy.spatial import cKDTree  # noqa: E402
-
-from geomlib import topology  # noqa: E402
-from solutions.subdivision import catmull_clark, loop_subdivide  # noqa: E402
-
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 # Issue 4's measurements on this machine, used only to translate Catmull-Clark times into an
 # estimated ratio to pymeshlab: igl.loop on the 327,680-face sphere 0.41 s, pymeshlab
 # Catmull-Clark on the 80,000-quad torus 0.75 s. igl.loop is timed in the same run as calibration.

@@ -25,22 +25,19 @@ from __future__ import annotations
 import argparse
 import multiprocessing as mp
 import resource
-import sys
 import time
 import tracemalloc
 from pathlib import Path
 
+import igl
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import igl  # noqa: E402
-
-from geomlib import datasets  # noqa: E402
-from geomlib.geometry import mesh_distance  # noqa: E402
-from geomlib.mesh_io import read_mesh  # noqa: E402
-from solutions.vdm import (  # noqa: E402
+from bench.anchors import pixel_centres, pot_transport_map
+from bench.measure import SHARED, best_of, peak_mib
+from geomlib import datasets
+from geomlib.geometry import mesh_distance
+from geomlib.mesh_io import read_mesh
+from solutions.vdm import (
     align_to_features,
     area_density,
     bake_vdm,
@@ -56,32 +53,14 @@ from solutions.vdm import (  # noqa: E402
     vdm_to_mesh,
     vertex_importance,
 )
-from solutions.vdm.transport import bfm_potentials, soft_legendre_map  # noqa: E402
+from solutions.vdm.transport import bfm_potentials, soft_legendre_map
 
-SHARED = Path(__file__).resolve().parents[2] / "shared" / "data" / "meshes"
 STAGES = {
     "naive": dict(optimize=False, align=False, diagonals=False),
     "+density": dict(optimize=True, align=False, diagonals=False),
     "+alignment": dict(optimize=True, align=True, diagonals=False),
     "+diagonals": dict(optimize=True, align=True, diagonals=True),
 }
-
-
-def best_of(fn, repeat: int = 3):
-    times, out = [], None
-    for _ in range(repeat):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), out
-
-
-def traced_peak_mb(fn) -> float:
-    tracemalloc.start()
-    fn()
-    peak = tracemalloc.get_traced_memory()[1]
-    tracemalloc.stop()
-    return peak / 2**20
 
 
 def shared_meshes() -> dict:
@@ -148,11 +127,11 @@ def anchors_parameterization(meshes: dict) -> None:
     print("\n== Anchor: parameterization (ours vs libigl with the same boundary) ==")
     for name, (V, F) in meshes.items():
         _, _, loop = check_disk(V, F)
-        t_ours, UV = best_of(lambda V=V, F=F: parameterize_square(V, F, "harmonic"))
+        t_ours, _, UV = best_of(lambda V=V, F=F: parameterize_square(V, F, "harmonic"))
         bnd = UV[loop]
-        t_igl, _ = best_of(lambda V=V, F=F, loop=loop, bnd=bnd: igl.harmonic(V, F, loop, bnd, 1))
-        t_lscm, _ = best_of(lambda V=V, F=F: parameterize_square(V, F, "lscm"), 1)
-        t_igl_lscm, _ = best_of(lambda V=V, F=F, loop=loop, bnd=bnd: igl.lscm(V, F, loop, bnd), 1)
+        t_igl, _, _ = best_of(lambda V=V, F=F, loop=loop, bnd=bnd: igl.harmonic(V, F, loop, bnd, 1))
+        t_lscm, _, _ = best_of(lambda V=V, F=F: parameterize_square(V, F, "lscm"), 1)
+        t_igl_lscm, _, _ = best_of(lambda V=V, F=F, loop=loop, bnd=bnd: igl.lscm(V, F, loop, bnd), 1)
         print(
             f"{name:<12} {len(F):>7} faces: harmonic ours {t_ours:.3f} s / igl.harmonic {t_igl:.3f} s "
             f"(x{t_ours / t_igl:.2f}, ours adds disk checks + corner choice); lscm (sliding boundary) {t_lscm:.3f} s / "
@@ -169,14 +148,14 @@ def anchors_sampling(meshes: dict, k: int) -> None:
     X = rng.random((k, 2))
     for name, (V, F) in meshes.items():
         UV = parameterize_square(V, F)
-        t_ours, P = best_of(lambda V=V, F=F, UV=UV: sample_surface(V, F, UV, X))
-        peak = traced_peak_mb(lambda V=V, F=F, UV=UV: sample_surface(V, F, UV, X))
+        t_ours, _, P = best_of(lambda V=V, F=F, UV=UV: sample_surface(V, F, UV, X))
+        peak = peak_mib(lambda V=V, F=F, UV=UV: sample_surface(V, F, UV, X))
 
         def mpl(V=V, F=F, UV=UV):
             tri = Triangulation(UV[:, 0], UV[:, 1], F)
             return np.stack([np.asarray(LinearTriInterpolator(tri, V[:, c])(X[:, 0], X[:, 1])) for c in range(3)], 1)
 
-        t_mpl, Q = best_of(mpl, 1)
+        t_mpl, _, Q = best_of(mpl, 1)
         print(
             f"{name:<12} {len(F):>7} faces: ours {t_ours:.3f} s (peak {peak:.0f} MB) / matplotlib {t_mpl:.3f} s "
             f"(x{t_ours / t_mpl:.2f}); max |difference| {np.nanmax(np.abs(P - Q)):.1e}",
@@ -186,7 +165,7 @@ def anchors_sampling(meshes: dict, k: int) -> None:
 
 def _child(queue, which: str, field: np.ndarray, res: int) -> None:
     """Run one transport contender in a fresh process; report time, peak RSS above baseline and output."""
-    import ot  # imported before the clock starts
+    import ot  # noqa: F401  (imported before the clock starts)
 
     n = field.shape[0]
     base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
@@ -198,15 +177,7 @@ def _child(queue, which: str, field: np.ndarray, res: int) -> None:
         out = soft_legendre_map(phi, tt, tt, 1.0 / n**2).reshape(-1, 2)
         extra = 2 * info["dual"]
     else:
-        c = (np.arange(n) + 0.5) / n
-        y, x = np.meshgrid(c, c, indexing="ij")
-        X = np.c_[x.ravel(), y.ravel()]
-        a = np.full(n * n, 1.0 / n**2)
-        b = field.ravel() / field.sum()
-        M = ot.dist(X, X)
-        plan = ot.emd(a, b, M, numItermax=10**7)
-        out = plan @ X / a[:, None]
-        extra = float((plan * M).sum())
+        out, extra = pot_transport_map(field)
     dt = time.perf_counter() - t
     traced = tracemalloc.get_traced_memory()[1] / 2**20
     tracemalloc.stop()
@@ -235,19 +206,13 @@ def anchors_transport(sizes: list[int]) -> None:
         t_ours, m_ours, T_ours, w_ours = run_child("ours", field, 0)  # map at the n^2 pixel centres
         t_pot, m_pot, T_pot, w_pot = run_child("pot", field, 0)
         err = np.linalg.norm(T_ours - T_pot, axis=1) * n
-        cost_ours = float(np.mean(np.sum((T_ours - _centres(n)) ** 2, axis=1)))
+        cost_ours = float(np.mean(np.sum((T_ours - pixel_centres(n)) ** 2, axis=1)))
         print(
             f"{n}x{n} ({n * n} points): ours {t_ours:.2f} s, peak +{m_ours:.0f} MB | POT ot.emd {t_pot:.2f} s, "
             f"peak +{m_pot:.0f} MB | time ratio ours/POT x{t_ours / t_pot:.3f} | W2^2 POT {w_pot:.5f}, ours (dual) "
             f"{w_ours:.5f}, ours (map) {cost_ours:.5f} | map difference mean {err.mean():.2f} px, max {err.max():.2f} px",
             flush=True,
         )
-
-
-def _centres(n: int) -> np.ndarray:
-    c = (np.arange(n) + 0.5) / n
-    y, x = np.meshgrid(c, c, indexing="ij")
-    return np.c_[x.ravel(), y.ravel()]
 
 
 def main(argv=None) -> int:

@@ -8,6 +8,7 @@ Anyone:        geomlib info mesh.obj | geomlib view mesh.obj [--html out.html] |
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 import time
 from pathlib import Path
@@ -85,34 +86,40 @@ def _cmd_render(a) -> int:
     return 0
 
 
-def _cmd_refs(a) -> int:
-    from geomlib.grading import refs
+#: The files ``geomlib refs|stubs build|check`` make from solutions/ (a module of geomlib.grading with
+#: ``build(labs)`` and ``check(labs)``), and how their reports read: ``built`` with ``{n}`` files and
+#: ``{seconds}``, ``problem`` with one problem ``{p}``, ``stale`` with ``{n}`` problems.
+_GENERATED = {
+    "refs": dict(
+        built="wrote {n} reference files in {seconds:.1f} s",
+        problem="FAIL {p.lab}/{p.case}: {p.message}",
+        ok="references OK",
+        stale="{n} reference problem(s)",
+    ),
+    "stubs": dict(
+        built="{n} stub files up to date in labs/",
+        problem="STALE {p}",
+        ok="labs/ is up to date",
+        stale="labs/ is stale: run `geomlib stubs build`",
+    ),
+}
 
+
+def _cmd_generated(a) -> int:
+    """``build``: regenerate what ``a.command`` makes from solutions/; ``check``: print each difference
+    and exit 1 if there is any."""
+    tool = importlib.import_module(f"geomlib.grading.{a.command}")
+    report = _GENERATED[a.command]
     labs = [a.lab] if a.lab else None
     if a.action == "build":
         t = time.time()
-        files = refs.build(labs)
-        print(f"wrote {len(files)} reference files in {time.time() - t:.1f} s")
+        files = tool.build(labs)
+        print(report["built"].format(n=len(files), seconds=time.time() - t))
         return 0
-    problems = refs.check(labs)
+    problems = tool.check(labs)
     for p in problems:
-        print(f"FAIL {p.lab}/{p.case}: {p.message}")
-    print("references OK" if not problems else f"{len(problems)} reference problem(s)")
-    return 1 if problems else 0
-
-
-def _cmd_stubs(a) -> int:
-    from geomlib.grading import stubs
-
-    labs = [a.lab] if a.lab else None
-    if a.action == "build":
-        files = stubs.build(labs)
-        print(f"{len(files)} stub files up to date in labs/")
-        return 0
-    problems = stubs.check(labs)
-    for p in problems:
-        print(f"STALE {p}")
-    print("labs/ is up to date" if not problems else "labs/ is stale: run `geomlib stubs build`")
+        print(report["problem"].format(p=p))
+    print(report["stale"].format(n=len(problems)) if problems else report["ok"])
     return 1 if problems else 0
 
 
@@ -223,12 +230,12 @@ def build_parser() -> argparse.ArgumentParser:
     rf = sub.add_parser("refs", help="reference outputs: build from solutions/, or check they are reproduced")
     rf.add_argument("action", choices=["build", "check"])
     rf.add_argument("--lab")
-    rf.set_defaults(func=_cmd_refs)
+    rf.set_defaults(func=_cmd_generated)
 
     st = sub.add_parser("stubs", help="regenerate labs/ from solutions/, or check labs/ is up to date")
     st.add_argument("action", choices=["build", "check"])
     st.add_argument("--lab")
-    st.set_defaults(func=_cmd_stubs)
+    st.set_defaults(func=_cmd_generated)
 
     g = sub.add_parser("grade", help="run the graded tests on an implementation; print scores, write results.json")
     g.add_argument(

@@ -94,7 +94,8 @@ def read_mesh(path: PathLike, *, triangulate: bool = False) -> tuple[np.ndarray,
     FileNotFoundError
         The file does not exist.
     MeshError
-        Unsupported extension or malformed file (the message names the line).
+        Unsupported extension or malformed file: the message names the file, the line (text
+        formats) and the problem.
     """
     where = "read_mesh"
     ext = _ext(path)
@@ -124,10 +125,17 @@ def write_mesh(path: PathLike, V, F, **options) -> None:
     V : (n, 3) array_like of float
         Vertex positions.
     F : (m, k) array_like of int, or list of index sequences
-        0-based faces (triangles, quads or mixed polygons).
+        0-based faces (triangles, quads or mixed polygons, any sizes >= 3).
     **options
         Passed to :func:`write_obj`, :func:`write_off` or :func:`write_ply`
-        (e.g. ``UV=``, ``N=``, ``precision=``, ``format="ascii"``).
+        (e.g. ``UV=``, ``N=``, ``precision=``, ``format="ascii"``). Every writer takes
+        ``precision`` (int, optional): significant digits of the numbers written; default the
+        shortest text that reads back exactly.
+
+    Raises
+    ------
+    MeshError
+        Unsupported extension, or bad arrays (the message names the argument and the problem).
     """
     ext = _ext(path)
     if ext == ".obj":

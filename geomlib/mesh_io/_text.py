@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import topology
-from geomlib.validate import MeshError, as_array
+from geomlib.validate import MeshError, as_array, as_vertices, check_int
 
 PathLike = str | os.PathLike
 Faces = np.ndarray | list[np.ndarray]
@@ -298,6 +298,35 @@ def _faces_for_writing(F, n: int, *, name: str, where: str, target: str = "V") -
         )
         raise MeshError(f"{where}: {name}: face {f} uses {what} (valid indices 0..{n - 1})")
     return idx, off
+
+
+def _writer_inputs(V, F, precision: int | None, where: str, *, faces_optional: bool = False):
+    """What every writer checks first: ``(V, indices, offsets, precision)``, faces as ragged lists.
+
+    ``F=None`` is an error unless ``faces_optional`` (a PLY point cloud: no faces).
+    """
+    V = as_vertices(V, where=where)
+    if F is None and faces_optional:
+        idx, off = np.zeros(0, np.int64), np.zeros(1, np.int64)
+    else:
+        idx, off = _faces_for_writing(F, len(V), name="F", where=where)
+    if precision is not None:
+        precision = check_int(precision, "precision", minimum=1, maximum=17, where=where)
+    return V, idx, off, precision
+
+
+def _counted_face_lines(idx: np.ndarray, off: np.ndarray) -> str:
+    """Faces as text lines ``k i_1 ... i_k`` (the face records of OFF and ASCII PLY)."""
+    lens = np.diff(off)
+    if len(lens) and (lens == lens[0]).all():  # one format string for all faces
+        k = int(lens[0])
+        rows = np.hstack([np.full((len(lens), 1), k), idx.reshape(-1, k)])
+        return (("%d" + " %d" * k + "\n") * len(lens)) % tuple(rows.ravel().tolist())
+    il = idx.tolist()
+    return "".join(
+        f"{b - a} " + " ".join(map(str, il[a:b])) + "\n"
+        for a, b in zip(off[:-1].tolist(), off[1:].tolist(), strict=True)
+    )
 
 
 def _float_strings(A: np.ndarray, precision: int | None) -> list[str]:

@@ -25,8 +25,9 @@ from geomlib.mesh_io._text import (
     _token_layout,
     _triangulate,
     _write_text,
+    _writer_inputs,
 )
-from geomlib.validate import MeshError, as_array, as_vertices, check_int
+from geomlib.validate import MeshError, as_array, as_vertices
 
 # --------------------------------------------------------------------------------------------
 # OBJ
@@ -87,10 +88,8 @@ def read_obj(path: PathLike, *, triangulate: bool = False) -> ObjData:
 
     Raises
     ------
-    FileNotFoundError
-        The file does not exist.
-    MeshError
-        Malformed file; the message gives the line number and the problem.
+    FileNotFoundError, MeshError
+        As in :func:`~geomlib.mesh_io.read_mesh`.
     """
     return _read_obj(path, "read_obj", triangulate)
 
@@ -284,12 +283,8 @@ def write_obj(
 
     Parameters
     ----------
-    path : str or path-like
-        Output ``.obj`` file.
-    V : (n, 3) array_like of float
-        Vertex positions.
-    F : (m, k) array_like of int, or list of index sequences
-        0-based faces (any polygon sizes >= 3).
+    path, V, F
+        As in :func:`~geomlib.mesh_io.write_mesh`.
     UV : (t, 2) array_like of float, optional
         Texture coordinates, written as ``vt`` lines.
     N : (r, 3) array_like of float, optional
@@ -299,8 +294,8 @@ def write_obj(
         has one row per vertex, the vertex indices are used (per-vertex attributes).
     colors : (n, 3) array_like of float, optional
         Per-vertex colours appended to the ``v`` lines (``v x y z r g b``).
-    precision : int, optional
-        Significant digits for numbers; default: the shortest text that reads back exactly.
+    precision
+        As in :func:`~geomlib.mesh_io.write_mesh`.
 
     Raises
     ------
@@ -308,11 +303,8 @@ def write_obj(
         Wrong shapes, out-of-range indices, or attribute indices that do not match ``F``.
     """
     where = "write_obj"
-    V = as_vertices(V, where=where)
+    V, idx, off, precision = _writer_inputs(V, F, precision, where)
     n = len(V)
-    idx, off = _faces_for_writing(F, n, name="F", where=where)
-    if precision is not None:
-        precision = check_int(precision, "precision", minimum=1, maximum=17, where=where)
     if colors is not None:
         colors = as_array(colors, "colors", shape=(n, 3), where=where)
 

@@ -8,7 +8,7 @@ from geomlib.mesh_io._text import (
     Faces,
     PathLike,
     _check_finite_rows,
-    _faces_for_writing,
+    _counted_face_lines,
     _float_strings,
     _parse_float_lines,
     _ragged_to_faces,
@@ -17,8 +17,8 @@ from geomlib.mesh_io._text import (
     _take_columns,
     _TextFile,
     _write_text,
+    _writer_inputs,
 )
-from geomlib.validate import as_vertices, check_int
 
 # --------------------------------------------------------------------------------------------
 # OFF
@@ -44,10 +44,8 @@ def read_off(path: PathLike) -> tuple[np.ndarray, Faces]:
 
     Raises
     ------
-    FileNotFoundError
-        The file does not exist.
-    MeshError
-        Malformed file; the message gives the line number and the problem.
+    FileNotFoundError, MeshError
+        As in :func:`~geomlib.mesh_io.read_mesh`.
     """
     return _read_off(path, "read_off")
 
@@ -137,30 +135,11 @@ def write_off(path: PathLike, V, F, *, precision: int | None = None) -> None:
 
     Parameters
     ----------
-    path : str or path-like
-        Output ``.off`` file.
-    V : (n, 3) array_like of float
-        Vertex positions.
-    F : (m, k) array_like of int, or list of index sequences
-        0-based faces (any polygon sizes >= 3).
-    precision : int, optional
-        Significant digits; default: the shortest text that reads back exactly.
+    path, V, F, precision
+        As in :func:`~geomlib.mesh_io.write_mesh`.
     """
-    where = "write_off"
-    V = as_vertices(V, where=where)
-    idx, off = _faces_for_writing(F, len(V), name="F", where=where)
-    if precision is not None:
-        precision = check_int(precision, "precision", minimum=1, maximum=17, where=where)
-    lens = np.diff(off)
-    out = [f"OFF\n{len(V)} {len(lens)} 0\n", ("%s %s %s\n" * len(V)) % tuple(_float_strings(V, precision))]
-    if len(lens) and (lens == lens[0]).all():
-        k = int(lens[0])
-        rows = np.hstack([np.full((len(lens), 1), k), idx.reshape(-1, k)])
-        out.append((("%d" + " %d" * k + "\n") * len(lens)) % tuple(rows.ravel().tolist()))
-    else:
-        il = idx.tolist()
-        out.extend(
-            f"{b - a} " + " ".join(map(str, il[a:b])) + "\n"
-            for a, b in zip(off[:-1].tolist(), off[1:].tolist(), strict=True)
-        )
-    _write_text(path, "".join(out))
+    V, idx, off, precision = _writer_inputs(V, F, precision, "write_off")
+    head = f"OFF\n{len(V)} {len(off) - 1} 0\n"
+    _write_text(
+        path, head + ("%s %s %s\n" * len(V)) % tuple(_float_strings(V, precision)) + _counted_face_lines(idx, off)
+    )

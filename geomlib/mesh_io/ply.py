@@ -16,7 +16,7 @@ from geomlib.mesh_io._text import (
     Faces,
     PathLike,
     _check_finite_rows,
-    _faces_for_writing,
+    _counted_face_lines,
     _float_strings,
     _parse_float_lines,
     _ragged_to_faces,
@@ -25,8 +25,9 @@ from geomlib.mesh_io._text import (
     _Source,
     _TextFile,
     _write_text,
+    _writer_inputs,
 )
-from geomlib.validate import MeshError, as_array, as_vertices, check_choice, check_int
+from geomlib.validate import MeshError, as_array, as_vertices, check_choice
 
 # --------------------------------------------------------------------------------------------
 # PLY
@@ -510,10 +511,8 @@ def write_ply(
 
     Parameters
     ----------
-    path : str or path-like
-        Output ``.ply`` file.
-    V : (n, 3) array_like of float
-        Vertex positions.
+    path, V
+        As in :func:`~geomlib.mesh_io.write_mesh`.
     F : (m, k) array_like of int, or list of index sequences, optional
         0-based faces, written as ``element face`` with ``property list uchar int vertex_indices``
         (``int`` list lengths if a face has more than 255 corners). None writes a point cloud.
@@ -528,19 +527,13 @@ def write_ply(
     vertex_type : {"double", "float"}
         Type of the vertex properties (``float`` halves the size but rounds to float32).
     precision : int, optional
-        ASCII only: significant digits; default the shortest exact text.
+        ASCII only; as in :func:`~geomlib.mesh_io.write_mesh`.
     """
     where = "write_ply"
-    V = as_vertices(V, where=where)
+    V, idx, off, precision = _writer_inputs(V, F, precision, where, faces_optional=True)
     n = len(V)
     check_choice(format, "format", _PLY_FORMATS, where=where)
     check_choice(vertex_type, "vertex_type", ("double", "float"), where=where)
-    if precision is not None:
-        precision = check_int(precision, "precision", minimum=1, maximum=17, where=where)
-    if F is None:
-        idx, off = np.zeros(0, np.int64), np.zeros(1, np.int64)
-    else:
-        idx, off = _faces_for_writing(F, n, name="F", where=where)
     if n > 2**31 - 1:
         raise MeshError(f"{where}: {n} vertices: indices above 2^31 - 1 do not fit PLY 'int'")
     cols: list[tuple[str, np.ndarray]] = [(c, V[:, j]) for j, c in enumerate("xyz")]
@@ -587,16 +580,7 @@ def write_ply(
         per = len(cols) + ncol
         out.append(((" ".join(["%s"] * per) + "\n") * n) % tuple(strs))
         if F is not None:
-            if m and (lens == lens[0]).all():
-                k = int(lens[0])
-                rows = np.hstack([np.full((m, 1), k), idx.reshape(-1, k)])
-                out.append((("%d" + " %d" * k + "\n") * m) % tuple(rows.ravel().tolist()))
-            else:
-                il = idx.tolist()
-                out.extend(
-                    f"{b - a} " + " ".join(map(str, il[a:b])) + "\n"
-                    for a, b in zip(off[:-1].tolist(), off[1:].tolist(), strict=True)
-                )
+            out.append(_counted_face_lines(idx, off))
         _write_text(path, "".join(out))
         return
 

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from bench.anchors import pyrender_normal_mapped_mesh
 from geomlib import camera, datasets
 from geomlib.geometry import ray_cast, vertex_normals
 from geomlib.textures import rasterize_uv, triangle_atlas, weld_by_position
@@ -390,22 +391,9 @@ def _pyrender_plane(enc, UV, tangents, eye, light_dir, size):
     pyrender = grender.import_pyrender()  # chooses the headless platform and applies the project's one shim
     V, F, _ = datasets.uv_grid(1)
     V = V - [0.5, 0.5, 0.0]
-    mat = pyrender.MetallicRoughnessMaterial(
-        baseColorFactor=[0.8, 0.8, 0.8, 1.0],
-        metallicFactor=0.0,
-        roughnessFactor=1.0,
-        normalTexture=pyrender.Texture(source=enc, source_channels="RGB"),
-    )
-    prim = pyrender.Primitive(
-        positions=V.astype(np.float32),
-        normals=np.tile([0, 0, 1], (4, 1)).astype(np.float32),
-        texcoord_0=UV.astype(np.float32),
-        tangents=tangents.astype(np.float32),
-        indices=F.astype(np.uint32),
-        material=mat,
-    )
+    N = np.tile([0.0, 0.0, 1.0], (len(V), 1))
     scene = pyrender.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[0.0, 0.0, 0.0])
-    scene.add(pyrender.Mesh([prim]))
+    scene.add(pyrender_normal_mapped_mesh(V, F, UV, N, tangents, enc, base_color=(0.8, 0.8, 0.8), roughness=1.0))
     view = camera.look_at(eye, (0, 0, 0))
     scene.add(
         pyrender.PerspectiveCamera(yfov=np.radians(40), aspectRatio=1.0, znear=0.5, zfar=5.0), pose=np.linalg.inv(view)

@@ -13,6 +13,7 @@ import igl
 import numpy as np
 import pytest
 
+from bench.anchors import pixel_centres, pot_transport_map
 from geomlib import datasets
 from geomlib.geometry import mesh_distance
 from geomlib.image_io import read_image
@@ -324,21 +325,15 @@ def _field(kind, n=32):
 
 @pytest.mark.parametrize("kind", ["blob", "line"])
 def test_transport_matches_pot_exact_ot(kind):
-    ot = pytest.importorskip("ot")
+    pytest.importorskip("ot")
     from solutions.vdm.transport import soft_legendre_map
 
     n = 32
     nu = _field(kind, n)
     phi, _, info = bfm_potentials(nu, 20)
     t = (np.arange(n) + 0.5) / n
-    y, x = np.meshgrid(t, t, indexing="ij")
-    X = np.c_[x.ravel(), y.ravel()]
-    a = np.full(n * n, 1 / n**2)
-    b = nu.ravel() / nu.sum()
-    M = ot.dist(X, X)
-    plan = ot.emd(a, b, M, numItermax=10**7)
-    cost = float((plan * M).sum())
-    T_pot = plan @ X / a[:, None]  # barycentric projection of the exact plan
+    X = pixel_centres(n)
+    T_pot, cost = pot_transport_map(nu)  # barycentric projection of the exact plan
     T = soft_legendre_map(phi, t, t, 1.0 / n**2).reshape(-1, 2)
     assert 2 * info["dual"] == pytest.approx(cost, rel=0.02)  # dual value = W2^2 / 2
     assert np.mean(np.sum((T - X) ** 2, axis=1)) == pytest.approx(cost, rel=0.06)
