@@ -64,18 +64,25 @@ class _Measured:
 _CACHE: dict = {}
 
 
-def _measured(L, name: str, scene_fn, camera, light, size) -> _Measured:
-    """One :class:`_Measured` per view and size, shared by the figures of one run."""
-    key = (name, size)
+def _panel_size(quick: bool) -> tuple[int, int]:
+    """The (width, height) of every rendered panel."""
+    return (240, 180) if quick else (400, 300)
+
+
+def _measured(L, view: str, quick: bool) -> _Measured:
+    """The classic scene under its light, seen from the course's camera (``view="classic"``) or from
+    closer (``"zoom"``): one :class:`_Measured` per view and size, shared by the figures of one run."""
+    size = _panel_size(quick)
+    key = (view, size)
     if key not in _CACHE:
-        _CACHE[key] = _Measured(L, scene_fn(), camera, light, size)
+        camera = {"classic": L.CLASSIC_CAMERA, "zoom": ZOOM_CAMERA}[view]
+        _CACHE[key] = _Measured(L, L.classic_scene(), camera, L.CLASSIC_LIGHT, size)
     return _CACHE[key]
 
 
 @figure_name("shadows_bias")
 def fig_bias(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "classic", quick)
     ms = 1024
     rows = [
         meas.panel("no bias, no culling: acne", map_size=ms, bias=0.0, slope_bias=0.0, cull="none", pcf=1),
@@ -100,9 +107,8 @@ def fig_bias(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("shadows_frustum")
 def fig_frustum(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
     B = np.array([[-1.5, -1.5, 0.0], [1.5, 1.5, 2.1]])  # the map covers the middle of the floor only
-    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "classic", quick)
     off = meas.panel("frustum fix off: border texels repeat, far side dark", map_size=1024, bounds=B, frustum_fix=False)
     on = meas.panel("fix on: outside is lit (the sphere's shadow too)", map_size=1024, bounds=B, frustum_fix=True)
     full = meas.panel("map fitted to the whole scene", map_size=1024)
@@ -118,8 +124,7 @@ def fig_frustum(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("shadows_resolution")
 def fig_resolution(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "zoom", quick)
     sizes = (256, 1024, 2048) if quick else (256, 1024, 4096)
     rows = []
     for s in sizes:
@@ -140,8 +145,7 @@ def fig_resolution(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("shadows_pcf")
 def fig_pcf(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "zoom", quick)
     rows = [meas.panel(f"PCF {k} x {k}, 512² map", map_size=512, pcf=k) for k in (1, 3, 5)]
     rows.append(meas.panel("Poisson disk: 16 samples, radius 2.5 texels", map_size=512, pcf=5, pcf_sampling="poisson"))
     page = panels([r[0] for r in rows], [r[1] for r in rows], ncols=2, title="Percentage-closer filtering")
@@ -157,7 +161,7 @@ def fig_pcf(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("shadows_pyrender")
 def fig_pyrender(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
+    size = _panel_size(quick)
     scene = L.torus_scene(125, 50) if quick else L.torus_scene()
     meas = _Measured(L, scene, TORUS_CAMERA, TORUS_LIGHT, size)
     vis, _ = L.light_visibility(scene, meas.eb, TORUS_LIGHT, map_size=2048, pcf=3)
@@ -213,7 +217,7 @@ def fig_pyrender(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("shadows_lights")
 def fig_lights(out: Path, L, quick: bool) -> Drawn:
-    size = (240, 180) if quick else (400, 300)
+    size = _panel_size(quick)
     scene = L.classic_scene()
     ms = 512 if quick else 1024
     spot = _u8(L.render_with_shadows(scene, L.CLASSIC_CAMERA, SPOT_LIGHT, size=size, map_size=ms))
