@@ -187,8 +187,9 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
 def figure_name(name: str):
     """Decorator: the file name (without suffix) a figure builder writes.
 
-    :func:`figures_or_placeholders` writes a builder's "Task N not implemented yet" picture to
-    ``<name>.png``, so a student's unfinished figure sits where the finished one will be.
+    :func:`figures_or_placeholders` writes the :class:`Drawn` picture the builder returns to
+    ``<name>.png``, and before its task is done a "Task N not implemented yet" picture under the same
+    name, so a student's unfinished figure sits where the finished one will be.
 
     Examples
     --------
