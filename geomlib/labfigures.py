@@ -1,7 +1,8 @@
 """How a lab's figures are assembled: builders, placeholders for missing tasks, the 3D view.
 
 Every lab's ``figures.py`` holds figure *builders*, one function per figure, named with
-:func:`figure_name`, and a view builder returning a :class:`MeshView`. Its last statement,
+:func:`figure_name` and returning what they drew as a :class:`Drawn` (the framework writes it to
+``<figure_name>.png``), and a view builder returning a :class:`MeshView`. Its last statement,
 
     make_figures, make_view = lab_figure_makers(LAB, __name__, (fig_a, fig_b), fig_view, quick="...")
 
@@ -18,6 +19,7 @@ The pictures themselves are composed with :mod:`geomlib.plot`; the pages are wri
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +28,7 @@ from geomlib.plot import Figure, _font, panels, save_png
 from geomlib.validate import MeshError
 
 __all__ = [
+    "Drawn",
     "MeshView",
     "figure_name",
     "lab_figure_makers",
@@ -34,6 +37,27 @@ __all__ = [
     "missing_task_figure",
     "partial_figure",
 ]
+
+
+@dataclass(frozen=True)
+class Drawn:
+    """What a figure builder drew: the composed picture and its caption, not yet written.
+
+    A builder named with :func:`figure_name` returns one; :func:`figures_or_placeholders` writes
+    ``image`` to ``<figure_name>.png`` with :func:`geomlib.plot.save_png` and records it as a
+    :class:`geomlib.plot.Figure` of the lab, so the file name is spelled once, in the decorator.
+    A builder that writes several files returns its :class:`~geomlib.plot.Figure` records instead.
+
+    Attributes
+    ----------
+    image : array_like
+        The whole picture, usually :func:`geomlib.plot.panels` (anything ``save_png`` accepts).
+    caption : str
+        One or two sentences saying what the figure shows.
+    """
+
+    image: object
+    caption: str
 
 
 class MeshView:
@@ -119,9 +143,10 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
     Parameters
     ----------
     builders : sequence of callables
-        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them. The placeholder
-        goes to ``out_dir / "<name>.png"``, where ``<name>`` is the builder's ``figure_name``
-        attribute or its name without the ``fig_`` / ``_fig_`` / ``_`` prefix.
+        ``build(out_dir, *args)`` returning a :class:`Drawn` (written here to ``out_dir / "<name>.png"``),
+        one :class:`Figure` or a list of them. ``<name>`` is the builder's ``figure_name`` attribute or
+        its name without the ``fig_`` / ``_fig_`` / ``_`` prefix; a builder stopped by a missing task
+        gets its placeholder under the same name.
     out_dir : Path
     lab_name : str
     *args
@@ -135,20 +160,36 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
     """
     figures: list[Figure] = []
     for build in builders:
+        name = getattr(build, "figure_name", None) or build.__name__.removeprefix("_").removeprefix("fig_")
+        path = Path(out_dir) / f"{name}.png"
         try:
             out = build(out_dir, *args)
         except NotImplementedError as e:
-            name = getattr(build, "figure_name", None) or build.__name__.removeprefix("_").removeprefix("fig_")
-            out = missing_task_figure(Path(out_dir) / f"{name}.png", e, lab_name)
-        figures.extend(out if isinstance(out, list) else [out])
+            out = missing_task_figure(path, e, lab_name)
+        items = out if isinstance(out, list) else [out]
+        if len(items) > 1 and any(isinstance(item, Drawn) for item in items):
+            raise MeshError(
+                f"figure builder {build.__name__} returned several pictures as Drawn; only one can be "
+                f"written under its figure_name ({name}.png): return Figure records for the others"
+            )
+        for item in items:
+            if isinstance(item, Drawn):
+                item = Figure(save_png(path, item.image), item.caption, lab_name)
+            elif not isinstance(item, Figure):
+                raise MeshError(
+                    f"figure builder {build.__name__} returned {type(item).__name__}; "
+                    "expected a Drawn (image and caption), a Figure or a list of Figures"
+                )
+            figures.append(item)
     return figures
 
 
 def figure_name(name: str):
     """Decorator: the file name (without suffix) a figure builder writes.
 
-    :func:`figures_or_placeholders` writes a builder's "Task N not implemented yet" picture to
-    ``<name>.png``, so a student's unfinished figure sits where the finished one will be.
+    :func:`figures_or_placeholders` writes the :class:`Drawn` picture the builder returns to
+    ``<name>.png``, and before its task is done a "Task N not implemented yet" picture under the same
+    name, so a student's unfinished figure sits where the finished one will be.
 
     Examples
     --------
@@ -177,23 +218,24 @@ def partial_figure(build, missing: list[str]):
     Parameters
     ----------
     build : callable
-        ``build(out_dir, *args)`` returning one :class:`Figure` or a list of them.
+        ``build(out_dir, *args)`` returning a :class:`Drawn`, one :class:`Figure` or a list of them.
     missing : list of str
         The list the builder's stand-in panels append to.
 
     Returns
     -------
     callable
-        ``drawn(out_dir, *args) -> list of Figure``, with ``build``'s ``figure_name`` and name.
+        ``drawn(out_dir, *args)`` returning what ``build`` returns (as a list), captions amended, with
+        ``build``'s ``figure_name`` and name.
     """
 
-    def drawn(out_dir, *args) -> list[Figure]:
+    def drawn(out_dir, *args) -> list:
         missing.clear()
         out = build(out_dir, *args)
         figs = out if isinstance(out, list) else [out]
         if missing:
             head = f"Task {missing[0]} not implemented yet; the other panels show: "
-            figs = [Figure(f.path, head + f.caption, f.lab) for f in figs]
+            figs = [replace(f, caption=head + f.caption) for f in figs]
         return figs
 
     drawn.__name__ = build.__name__
@@ -265,7 +307,8 @@ def lab_figure_makers(
         functions say they live, and whose package is the default ``lab``.
     builders : sequence of callables
         The figures, in order: ``build(out_dir, L, quick)`` with ``L`` the lab module (or
-        ``build(out_dir, quick)`` when ``draws_lab`` is False), returning a :class:`Figure` or a list.
+        ``build(out_dir, quick)`` when ``draws_lab`` is False), returning a :class:`Drawn` (written to
+        ``<figure_name>.png``), a :class:`Figure` or a list of Figures.
     view : callable
         The interactive 3D page: ``view(L, quick)`` (or ``view(quick)``) returning a :class:`MeshView`,
         written to ``<figure_name>.html`` (:func:`figure_name`; default ``<lab>_3d``).

@@ -14,8 +14,8 @@ import numpy as np
 
 from geomlib import datasets
 from geomlib.geometry import vertex_normals
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, heat_colors, heatmap_image, line_plot, panels, save_png, with_colorbar
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, heat_colors, heatmap_image, line_plot, panels, with_colorbar
 from geomlib.render import camera_pose, render
 
 __all__ = ["make_figures", "make_view"]
@@ -48,7 +48,7 @@ def _seam_normals(X: np.ndarray, F: np.ndarray, group: np.ndarray) -> np.ndarray
 
 
 @figure_name("lambda_sequence")
-def fig_lambda_sequence(out: Path, L, quick: bool) -> Figure:
+def fig_lambda_sequence(out: Path, L, quick: bool) -> Drawn:
     size = (180, 125) if quick else (190, 134)
     V, F = datasets.torus(n_major=64, n_minor=32) if quick else datasets.torus(n_major=96, n_minor=48)
     lams = (0.3, 0.7, 1.0)
@@ -74,17 +74,15 @@ def fig_lambda_sequence(out: Path, L, quick: bool) -> Figure:
         images.append(colorbar(0.0, hi, CMAP, label="dist / diag", height=size[1]))
         captions.append("")
     img = panels(images, captions, ncols=5, title="Laplacian denoising along clean normals, one pass (torus)")
-    path = save_png(out / "lambda_sequence.png", img)
     hi_r, lo_r = ratios[0.3], ratios[LOW_NOISE]
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "Noisy torus (Gaussian noise of 0.3 mean edge lengths h along random directions) and one denoising pass "
         "p' = p − λ ⟨δ, n⟩ n with λ = 0.3, 0.7, 1 (top), with each vertex's distance to the clean "
         "surface and the mean error relative to the noisy input (middle): it falls to "
         f"{hi_r[0]:.2f}x, {hi_r[1]:.2f}x and {hi_r[2]:.2f}x. Bottom: the same at low noise ({LOW_NOISE} h), where "
         f"λ = 0.3, 0.7, 1 end at {lo_r[0]:.2f}x, {lo_r[1]:.2f}x and {lo_r[2]:.2f}x: the curvature part of δ "
         "shrinks the whole torus, most on its outer rim where the mean curvature is largest.",
-        LAB,
     )
 
 
@@ -109,7 +107,7 @@ def _error_curves(L, V, F, sigma: float, iterations: int):
 
 
 @figure_name("error_vs_iterations")
-def fig_iterations(out: Path, L, quick: bool) -> Figure:
+def fig_iterations(out: Path, L, quick: bool) -> Drawn:
     V, F = datasets.torus(n_major=64, n_minor=32) if quick else datasets.torus(n_major=96, n_minor=48)
     iterations = 3 if quick else 5
     size = (460, 340) if quick else (560, 400)
@@ -125,17 +123,15 @@ def fig_iterations(out: Path, L, quick: bool) -> Figure:
         i = int(np.argmin([y.min() for y in ys]))
         best[sigma] = (labels[i], int(np.argmin(ys[i])), float(ys[i].min()))
     img = panels(plots, ["high noise", "low noise"], ncols=2, title="Mean distance to the clean torus vs iterations")
-    path = save_png(out / "error_vs_iterations.png", img)
     (b_hi, it_hi, r_hi), (b_lo, it_lo, r_lo) = best[0.3], best[LOW_NOISE]
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "Mean vertex distance to the clean surface after 0 to "
         f"{iterations} passes, relative to the noisy input (log scale), for uniform and cotangent weights. Every pass "
         "removes part of the noise but also shrinks the surface by the curvature part of δ, so each curve has a "
         f"best iteration count. At high noise the best here is {b_hi} after {_passes(it_hi)} ({r_hi:.2f}x); at low "
         f"noise it is {b_lo} after {_passes(it_lo)} ({r_lo:.2f}x), and large λ or many passes make it worse than "
         "doing nothing.",
-        LAB,
     )
 
 
@@ -144,7 +140,7 @@ def fig_iterations(out: Path, L, quick: bool) -> Figure:
 
 
 @figure_name("offset_map")
-def fig_offset_map(out: Path, L, quick: bool) -> Figure:
+def fig_offset_map(out: Path, L, quick: bool) -> Drawn:
     V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
     s = np.asarray(L.normal_offsets(L.laplacian_offsets(Vn, F), N))
@@ -169,16 +165,14 @@ def fig_offset_map(out: Path, L, quick: bool) -> Figure:
         "the noisy sphere",
         "its offset map on the surface",
     ]
-    path = save_png(out / "offset_map.png", panels(images, captions, ncols=2, title="Offset map of a noisy UV sphere"))
-    return Figure(
-        path,
+    return Drawn(
+        panels(images, captions, ncols=2, title="Offset map of a noisy UV sphere"),
         "The normal offsets s = ⟨δ, n⟩ of a noisy latitude-longitude sphere baked into a 16-bit offset map: "
         "u runs once around the sphere, v from the south pole (bottom row of the image) to the north pole (top). "
         f"bias = {bias:.4f} and scale = {scale:.4f} map the offsets onto [0, 1]. Bottom: the noisy sphere and the "
         "decoded map drawn on it as a texture: red vertices stick out of their neighbourhood, blue ones sink in "
         "(red dominates: the sphere's curvature adds about h²/(2R) to every offset); inside each triangle the map "
         "interpolates the three corner offsets linearly.",
-        LAB,
     )
 
 
@@ -187,7 +181,7 @@ def fig_offset_map(out: Path, L, quick: bool) -> Figure:
 
 
 @figure_name("seam_crack")
-def fig_seam(out: Path, L, quick: bool) -> Figure:
+def fig_seam(out: Path, L, quick: bool) -> Drawn:
     V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
     _, _, group = L.weld_seams(V, F)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
@@ -229,16 +223,14 @@ def fig_seam(out: Path, L, quick: bool) -> Figure:
             side = "from the u = 1 side" if j == 0 else "from the u = 0 side"
             captions.append(f"{title}, {side}" + (f"\nwidest gap {gap:.1e} (radius 1)" if j == 0 else ""))
     img = panels(images, captions, ncols=3, title="UV seam of a denoised sphere (map route, λ = 0.7)")
-    path = save_png(out / "seam_crack.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "The latitude-longitude sphere is cut along the meridian u = 0 = 1 (left: the whole sphere, the seam in blue; "
         "middle and right: close-ups of the seam's middle from either side). Every vertex on the seam exists twice (and the "
         "poles once per triangle). Without the fix (top) each copy sees only its own side's neighbours and reads its "
         "own texels, so the copies move apart and the back faces (red) show through the crack (blue dots: the seam's "
         "vertices). Welding by position "
         "for the Laplacian and giving all copies the mean offset and normal (bottom) closes it exactly.",
-        LAB,
     )
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import Figure, panels, save_png
 from geomlib.textures import triangle_atlas
 
@@ -128,7 +128,7 @@ def _fig_mapped_vs_displaced(out: Path, L, quick: bool) -> list[Figure]:
 
 
 @figure_name("bias_scale")
-def _fig_bias_scale(out: Path, L, quick: bool) -> Figure:
+def _fig_bias_scale(out: Path, L, quick: bool) -> Drawn:
     from geomlib.render import render
 
     size, s = (160, 128) if quick else (300, 256)
@@ -147,13 +147,11 @@ def _fig_bias_scale(out: Path, L, quick: bool) -> Figure:
             f"(bias, scale) = ({bias:g}, {scale:g}): offsets λ·[{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
         )
     img = panels(imgs, caps, ncols=4, title="Displacement P' = P + λ (bias + scale h) n, λ = 0.12")
-    path = save_png(out / "bias_scale.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "One displacement map applied to a UV sphere with three (bias, scale) pairs: (0, 1) only pushes outwards, "
         "(-1, 2) maps mid-grey to no offset so the surface moves both ways, (-1, 5) exaggerates the peaks. "
         "Seam copies are welded, so the sphere stays closed.",
-        LAB,
     )
 
 

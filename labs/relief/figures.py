@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers, partial_figure
 from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
 
@@ -171,7 +171,7 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
 
 
 @figure_name("uv_error")
-def _fig_errors(out: Path, quick: bool) -> Figure:
+def _fig_errors(out: Path, quick: bool) -> Drawn:
     size = 96 if quick else 200
     H = bricks(256)
     mask, uv, view, _, _ = quad_gbuffer(size)
@@ -197,18 +197,17 @@ def _fig_errors(out: Path, quick: bool) -> Figure:
     rows.append(colorbar(0, vmax, "inferno", label="uv error (texels, clipped at 2)"))
     caps.append("")
     img = panels(rows, caps, ncols=3, title="uv error against the exact intersection, bricks (256 x 256 map)")
-    return Figure(
-        save_png(out / "uv_error.png", img),
+    return Drawn(
+        img,
         "Per-pixel distance (in texels) between each method's uv and the exact ray / height-field hit on the bricks. "
         "Parallax is off by many texels everywhere but straight down; steep parallax by up to a layer; linear POM "
         "errs along the bevels; after secant or binary refinement only isolated pixels on the bevels stay off "
         "(the secant step can stall on a bevel's kink; bisection cannot).",
-        LAB,
     )
 
 
 @figure_name("error_vs_angle")
-def _fig_error_vs_angle(out: Path, quick: bool) -> Figure:
+def _fig_error_vs_angle(out: Path, quick: bool) -> Drawn:
     p = 48 if quick else 128
     t = (np.arange(p) + 0.5) / p
     uv = np.stack(np.meshgrid(t, t[::-1]), axis=-1)
@@ -246,17 +245,16 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Figure:
             logy=True,
             size=(900, 560),
         )
-    return Figure(
-        save_png(out / "error_vs_angle.png", img),
+    return Drawn(
+        img,
         "p99 uv error (log scale) of each method against the exact intersection as the view tilts. Every error grows "
         "with the angle; on the smooth bumps the secant refinement is exact to round-off, on the bricks' sharp steps "
         "it is not and binary search is the more reliable refinement.",
-        LAB,
     )
 
 
 @figure_name("steps")
-def _fig_steps(out: Path, quick: bool) -> Figure:
+def _fig_steps(out: Path, quick: bool) -> Drawn:
     size = 120 if quick else 220
     H = bricks(256)
     mask, uv, view, _, _ = quad_gbuffer(size)
@@ -282,11 +280,10 @@ def _fig_steps(out: Path, quick: bool) -> Figure:
             ["layer count n (more at grazing angles)", "layers marched to the hit", ""],
             title="Layers of the march (bricks)",
         )
-    return Figure(
-        save_png(out / "steps.png", img),
+    return Drawn(
+        img,
         "Left: the layer count n = floor(8 + 24 (1 - view_z) + 1/2) per pixel grows towards the far, grazing part "
         "of the quad. Right: the layer where the march stopped; the deep mortar joints take the most layers.",
-        LAB,
     )
 
 
@@ -333,7 +330,7 @@ def _arc_shade(H, mask, uv, normal_ts):
 
 
 @figure_name("silhouette")
-def _fig_silhouette(out: Path, quick: bool) -> Figure:
+def _fig_silhouette(out: Path, quick: bool) -> Drawn:
     size = 160 if quick else 300
     H = bumps(128 if quick else 256)
     mask, uv = _arc_render(size, 64)
@@ -379,15 +376,14 @@ def _fig_silhouette(out: Path, quick: bool) -> Figure:
         ],
         title="Silhouette on a curved mesh: relief mapping cannot change the outline",
     )
-    return Figure(
-        save_png(out / "silhouette.png", img),
+    return Drawn(
+        img,
         "Smooth bumps, up to 0.08 deep, on a half cylinder of radius 0.5 seen from the side: the far top edge is "
         "the silhouette. Relief mapping only moves the texture inside the triangles that are drawn, so its "
         "outline stays the straight top line of the cylinder, while the truly displaced surface dips between the "
         "bumps and its outline is wavy (red: pixels POM draws that are empty in reality). Discarding uv outside "
         "[0, 1] carves only at the patch's ends (blue: the displaced surface is there, POM discarded the pixels). "
         "Shell mapping would give the relief a volume.",
-        LAB,
     )
 
 

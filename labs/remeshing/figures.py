@@ -20,8 +20,8 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, heat_colors, line_plot, panels
 from geomlib.render import render
 
 __all__ = [
@@ -207,7 +207,7 @@ def _mesh(result):
 
 
 @figure_name("before_after")
-def fig_before_after(out: Path, R, quick: bool) -> Figure:
+def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     n = 48 if quick else 64
     bunny, decimated = metaball_bunny(n), decimated_bunny(800 if quick else 1200, n)
     L = 0.08 if quick else 0.06
@@ -231,9 +231,8 @@ def fig_before_after(out: Path, R, quick: bool) -> Figure:
         imgs.append(_histogram(meshes, ["input", "remeshed"][: len(meshes)], hist_size, "angles (60° = equilateral)"))
         caps.append(f"corner angles of the {name.split(' (')[0]}")
     img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {VALENCE_TITLE}")
-    path = save_png(out / "before_after.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         _todo(missing)
         + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
         f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
@@ -241,12 +240,11 @@ def fig_before_after(out: Path, R, quick: bool) -> Figure:
         "Vertices are coloured by valence (blue below 6, grey 6, red above); the captions give the faces, the "
         "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6; the "
         "plots the distribution of the corner angles, which remeshing gathers around 60°.",
-        LAB,
     )
 
 
 @figure_name("iterations")
-def fig_iterations(out: Path, R, quick: bool) -> Figure:
+def fig_iterations(out: Path, R, quick: bool) -> Drawn:
     n = 48 if quick else 64
     V, F = decimated_bunny(800 if quick else 1200, n)
     L = 0.08 if quick else 0.06
@@ -259,13 +257,11 @@ def fig_iterations(out: Path, R, quick: bool) -> Figure:
         imgs.append(render(U, G, colors=valence_colors(U, G), **kw))
         caps.append(f"{its} iteration{'' if its == 1 else 's'}: {_summary(quality(U, G))}")
     img = panels(imgs, caps, ncols=3, title=f"The decimated bunny after 0 to 5 iterations (L = {L}); {VALENCE_TITLE}")
-    path = save_png(out / "iterations.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         f"isotropic_remesh(V, F, {L}, iterations=k) of the QEM-decimated bunny for k = 0 (the input) to 5, "
         "vertices coloured by valence (blue below 6, grey 6, red above); each caption gives the faces, the "
         "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6.",
-        LAB,
     )
 
 
@@ -280,7 +276,7 @@ def _bar_beside_row(grid: np.ndarray, bar: np.ndarray, row: np.ndarray, pad: int
 
 
 @figure_name("features")
-def fig_features(out: Path, R, quick: bool) -> Figure:
+def fig_features(out: Path, R, quick: bool) -> Drawn:
     V, F = curved_block(4)
     L, angle = (0.14, 45.0) if quick else (0.1, 45.0)
     its = 5 if quick else 10
@@ -317,9 +313,8 @@ def fig_features(out: Path, R, quick: bool) -> Figure:
     if any(e is not None for e in errs):  # the bar of the heat maps, when there are any
         bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
         grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
-    path = save_png(out / "features.png", grid)
-    return Figure(
-        path,
+    return Drawn(
+        grid,
         _todo(missing)
         + "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
         f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
@@ -328,7 +323,6 @@ def fig_features(out: Path, R, quick: bool) -> Figure:
         "the right). With the features kept, the corners stay put and the vertices of the sharp edges on the "
         "input's edges, so what is left is the sag of flat faces under the curved top; without, the faces cut "
         "across the sharp edges and round the corners.",
-        LAB,
     )
 
 
@@ -343,7 +337,7 @@ def _boundary_offset(U, G, A, B) -> tuple[int, float, float]:
 
 
 @figure_name("boundary")
-def fig_boundary(out: Path, R, quick: bool) -> Figure:
+def fig_boundary(out: Path, R, quick: bool) -> Drawn:
     V, F = bunny_head(48 if quick else 64)
     L = 0.06 if quick else 0.045
     its = 5 if quick else 10
@@ -373,9 +367,8 @@ def fig_boundary(out: Path, R, quick: bool) -> Figure:
         )
     title = f"An open surface remeshed to L = {L}; valence: blue below the target (6, on the boundary 4), grey at it, red above"
     img = panels(imgs, caps, ncols=3, title=title)
-    path = save_png(out / "boundary.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         _todo(missing)
         + "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
         f"jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
@@ -384,7 +377,6 @@ def fig_boundary(out: Path, R, quick: bool) -> Figure:
         "vertices are from the input's boundary line and the boundary's length: preserved, the boundary stays on "
         "that line and is only respaced; not preserved, it is relaxed like the interior, leaves the line and "
         "the opening shrinks.",
-        LAB,
     )
 
 
@@ -395,7 +387,7 @@ def _new_edge_ends(G, F) -> np.ndarray:
 
 
 @figure_name("operations")
-def fig_operations(out: Path, R, quick: bool) -> Figure:
+def fig_operations(out: Path, R, quick: bool) -> Drawn:
     V, F = datasets.grid_patch(3)
     H = topology.halfedge_mesh(F, len(V), manifold=True)
     # the diagonal of the middle cell: both ends inside the patch
@@ -432,14 +424,12 @@ def fig_operations(out: Path, R, quick: bool) -> Figure:
     imgs.append(_blank(size) if W is None else render(np.asarray(W), F, **kw))
     caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
-    path = save_png(out / "operations.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         _todo(missing)
         + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
         "(both ends meet at the midpoint) and flipped to the other diagonal; a patch with jittered interior "
         "vertices before and after one tangential relaxation step (damping 0.5).",
-        LAB,
     )
 
 

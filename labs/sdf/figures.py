@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets, raster
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers, partial_figure
-from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.plot import colorbar, heatmap_image, panels
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
 from .bricks import EMPTY_INSIDE, compress_bricks
@@ -127,7 +127,7 @@ def _torus_grid(quick):
 
 
 @figure_name("sdf_csg")
-def fig_csg(out: Path, quick: bool) -> Figure:
+def fig_csg(out: Path, quick: bool) -> Drawn:
     size = (150, 220) if quick else (300, 440)
     M = _camera([0.4, -4.2, 2.4], [0.0, 0.0, 0.4], size)
 
@@ -154,17 +154,15 @@ def fig_csg(out: Path, quick: bool) -> Figure:
         ],
         title="Analytic SDFs and CSG",
     )
-    path = save_png(out / "sdf_csg.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "An analytic scene built with min (union), max(a, -b) (difference) and the smooth union, rendered by "
         "sphere tracing, and its field on the slice y = 0 with iso-lines every 0.1 and the zero line in black.",
-        LAB,
     )
 
 
 @figure_name("sdf_slices")
-def fig_slices(out: Path, quick: bool) -> Figure:
+def fig_slices(out: Path, quick: bool) -> Drawn:
     def make():
         V, F, g = _torus_grid(quick)
         r = 0.6
@@ -183,17 +181,15 @@ def fig_slices(out: Path, quick: bool) -> Figure:
         title = f"Mesh SDF of a torus (2,304 faces) on a {g.shape[0]}^3 grid"
     except NotImplementedError as e:
         imgs, caps, title = [_missing((200, 200), f"Tasks 2-4 ({str(e)[:50]})")], [""], "Mesh SDF"
-    path = save_png(out / "sdf_slices.png", panels(imgs, caps, title=title))
-    return Figure(
-        path,
+    return Drawn(
+        panels(imgs, caps, title=title),
         "The signed distance of a torus mesh (pseudonormal sign, BVH closest points), looked up trilinearly on "
         "two slices: red inside, blue outside, iso-lines every 0.1, the surface (zero line) in black.",
-        LAB,
     )
 
 
 @figure_name("sdf_bricks")
-def fig_bricks(out: Path, quick: bool) -> Figure:
+def fig_bricks(out: Path, quick: bool) -> Drawn:
     try:
         V, F, g = _torus_grid(quick)
         B = compress_bricks(g, band_voxels=4)
@@ -224,19 +220,17 @@ def fig_bricks(out: Path, quick: bool) -> Figure:
         )
     except NotImplementedError as e:
         imgs, caps, title = [_missing((200, 200), f"Tasks 2-6 ({str(e)[:50]})")], [""], "Bricks"
-    path = save_png(out / "sdf_bricks.png", panels(imgs, caps, title=title))
-    return Figure(
-        path,
+    return Drawn(
+        panels(imgs, caps, title=title),
         "Left: which bricks of one brick layer are stored and which are dropped (entirely more than r outside or "
         "inside). Right: the error of the bricked, 8-bit field at the grid samples inside the band, in "
         "quantisation steps 2r/255; it stays within half a step. The title gives the memory against a dense "
         "float32 grid.",
-        LAB,
     )
 
 
 @figure_name("sdf_normals")
-def fig_normals(out: Path, quick: bool) -> Figure:
+def fig_normals(out: Path, quick: bool) -> Drawn:
     size = (120, 160) if quick else (240, 320)
     try:
         n = 40 if quick else 64
@@ -268,19 +262,17 @@ def fig_normals(out: Path, quick: bool) -> Figure:
         title = f"Normals from a {n}^3 grid of a torus: angle to the true normal at the sphere-traced hits, h = half a voxel"
     except NotImplementedError as e:
         pics, caps, title = [_missing(size, f"Tasks 6-8 ({str(e)[:50]})")], [""], "Gradients"
-    path = save_png(out / "sdf_normals.png", panels(pics, caps, title=title))
-    return Figure(
-        path,
+    return Drawn(
+        panels(pics, caps, title=title),
         "The angle between the finite-difference normal of a sampled torus field and the exact normal, at every "
         "sphere-traced hit, same step h for both. The 4-tap tetrahedral stencil needs two thirds of the lookups "
         "but is only first-order accurate: its error is h times the mixed second derivatives of the field "
         "(largest where the torus curves diagonally to the grid axes), while central differences are second order.",
-        LAB,
     )
 
 
 @figure_name("sdf_trace")
-def fig_trace(out: Path, quick: bool) -> Figure:
+def fig_trace(out: Path, quick: bool) -> Drawn:
     size = (120, 160) if quick else (300, 400)
     try:
         V, F, g = _torus_grid(quick)
@@ -303,13 +295,11 @@ def fig_trace(out: Path, quick: bool) -> Figure:
         title = f"Sphere tracing the {g.shape[0]}^3 torus field"
     except NotImplementedError as e:
         pics, caps, title = [_missing(size, f"Tasks 2-8 ({str(e)[:50]})")], [""], "Sphere tracing"
-    path = save_png(out / "sdf_trace.png", panels(pics, caps, title=title))
-    return Figure(
-        path,
+    return Drawn(
+        panels(pics, caps, title=title),
         "Sphere tracing the sampled torus: the shaded image, the step-count heat map (the engine's view of where "
         "the time goes) and the hit mask against geomlib's rasterizer of the same mesh and camera, which differs "
         "only along silhouettes.",
-        LAB,
     )
 
 
@@ -324,7 +314,7 @@ def _shadow_setup(quick):
 
 
 @figure_name("sdf_soft_shadows")
-def fig_soft_shadows(out: Path, quick: bool) -> Figure:
+def fig_soft_shadows(out: Path, quick: bool) -> Drawn:
     try:
         S, SF, P, n = _shadow_setup(quick)
         gs = sdf_grid(S, SF, 32 if quick else 48, padding=0.6)
@@ -353,20 +343,18 @@ def fig_soft_shadows(out: Path, quick: bool) -> Figure:
         page = panels(pics, caps, ncols=4, title="Soft shadows of a sphere mesh on the ground, seen from above")
     except NotImplementedError as e:
         page = panels([_missing((200, 200), f"Tasks 2-9 ({str(e)[:50]})")], [""], title="Soft shadows")
-    path = save_png(out / "sdf_soft_shadows.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "Visibility of a spherical light of radius R (rows) on the ground under a sphere mesh, seen from above: "
         "the course formula min d/(t tan alpha), the improved variant, a Monte-Carlo area-light truth cast with "
         "geomlib's watertight rays, and the per-pixel error of the formula. The formula reaches 0 wherever the "
         "ray to the light's centre is blocked, so its umbra is the hard shadow of the centre and only the "
         "outer half of the true penumbra survives: the error is a ring on the inner penumbra that widens with R.",
-        LAB,
     )
 
 
 @figure_name("sdf_ao_push")
-def fig_ao_push(out: Path, quick: bool) -> Figure:
+def fig_ao_push(out: Path, quick: bool) -> Drawn:
     size = (120, 160) if quick else (260, 360)
     try:
         M = _camera([0.4, -4.2, 2.4], [0.0, 0.0, 0.4], size)
@@ -407,13 +395,11 @@ def fig_ao_push(out: Path, quick: bool) -> Figure:
         page = panels(pics, caps, title="Ambient occlusion and collision push-out")
     except NotImplementedError as e:
         page = panels([_missing(size, f"Tasks 1, 7-9 ({str(e)[:50]})")], [""], title="AO and push-out")
-    path = save_png(out / "sdf_ao_push.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "Left: ambient occlusion of the analytic scene from five field taps along the normal. Right: points "
         "inside the solids (red) pushed out along the 4-tap gradient until they clear the surface by 0.05 "
         "(blue), on the slice y = 0.",
-        LAB,
     )
 
 

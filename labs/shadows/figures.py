@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, heatmap_image, panels, save_png, with_colorbar
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, heatmap_image, panels, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
 
@@ -64,18 +64,25 @@ class _Measured:
 _CACHE: dict = {}
 
 
-def _measured(L, name: str, scene_fn, camera, light, size) -> _Measured:
-    """One :class:`_Measured` per view and size, shared by the figures of one run."""
-    key = (name, size)
+def _panel_size(quick: bool) -> tuple[int, int]:
+    """The (width, height) of every rendered panel."""
+    return (240, 180) if quick else (400, 300)
+
+
+def _measured(L, view: str, quick: bool) -> _Measured:
+    """The classic scene under its light, seen from the course's camera (``view="classic"``) or from
+    closer (``"zoom"``): one :class:`_Measured` per view and size, shared by the figures of one run."""
+    size = _panel_size(quick)
+    key = (view, size)
     if key not in _CACHE:
-        _CACHE[key] = _Measured(L, scene_fn(), camera, light, size)
+        camera = {"classic": L.CLASSIC_CAMERA, "zoom": ZOOM_CAMERA}[view]
+        _CACHE[key] = _Measured(L, L.classic_scene(), camera, L.CLASSIC_LIGHT, size)
     return _CACHE[key]
 
 
 @figure_name("shadows_bias")
-def fig_bias(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
+def fig_bias(out: Path, L, quick: bool) -> Drawn:
+    meas = _measured(L, "classic", quick)
     ms = 1024
     rows = [
         meas.panel("no bias, no culling: acne", map_size=ms, bias=0.0, slope_bias=0.0, cull="none", pcf=1),
@@ -88,42 +95,36 @@ def fig_bias(out: Path, L, quick: bool) -> Figure:
     page = panels(
         [r[0] for r in rows], [r[1] for r in rows], ncols=3, title="Shadow acne, bias and peter-panning (1024² map)"
     )
-    path = save_png(out / "shadows_bias.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "Bias against acne. Without bias, every lit surface shadows itself in stripes (acne); a constant bias "
         "fixes flat surfaces seen head-on but not slanted ones; a large bias lifts the shadows off their "
         "casters (peter-panning: contact shadows at the box bases vanish). The slope-scaled default and "
         "front-face culling remove acne. Numbers: acne = share of truly lit surface shaded dark, "
         "peter-panning = share of contact shadow lost, both against ray-cast shadows.",
-        LAB,
     )
 
 
 @figure_name("shadows_frustum")
-def fig_frustum(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
+def fig_frustum(out: Path, L, quick: bool) -> Drawn:
     B = np.array([[-1.5, -1.5, 0.0], [1.5, 1.5, 2.1]])  # the map covers the middle of the floor only
-    meas = _measured(L, "classic", L.classic_scene, L.CLASSIC_CAMERA, L.CLASSIC_LIGHT, size)
+    meas = _measured(L, "classic", quick)
     off = meas.panel("frustum fix off: border texels repeat, far side dark", map_size=1024, bounds=B, frustum_fix=False)
     on = meas.panel("fix on: outside is lit (the sphere's shadow too)", map_size=1024, bounds=B, frustum_fix=True)
     full = meas.panel("map fitted to the whole scene", map_size=1024)
     page = panels([off[0], on[0], full[0]], [off[1], on[1], full[1]], title="Points outside the light's frustum")
-    path = save_png(out / "shadows_frustum.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "A directional light whose map covers only the middle 3 x 3 of the floor. Points outside the map "
         "read clamped border texels (streaks) and points beyond its far plane (z > 1) always compare as "
         "shadowed; treating both as lit fixes it, but shadows that fall outside the map (the sphere's) are "
         "lost. Right: the map fitted tightly to the scene's bounds covers everything.",
-        LAB,
     )
 
 
 @figure_name("shadows_resolution")
-def fig_resolution(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
+def fig_resolution(out: Path, L, quick: bool) -> Drawn:
+    meas = _measured(L, "zoom", quick)
     sizes = (256, 1024, 2048) if quick else (256, 1024, 4096)
     rows = []
     for s in sizes:
@@ -133,39 +134,34 @@ def fig_resolution(out: Path, L, quick: bool) -> Figure:
         wrong = round((1.0 - m["agreement"]) * m["measured"])
         rows.append((img, f"{s}² map, PCF 1\n{wrong:,} pixels differ from ray casting"))
     page = panels([r[0] for r in rows], [r[1] for r in rows], title="Shadow-map resolution")
-    path = save_png(out / "shadows_resolution.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "The same view with shadow maps of increasing size (hard 0/1 comparison). A coarse map makes jagged, "
         "blocky shadow edges (each texel is a block of the floor). The count under each panel is the number of "
         "pixels whose lit/shadowed verdict differs from exact ray-cast shadows: all of them lie along the shadow "
         "edges, and there are fewer as the map grows.",
-        LAB,
     )
 
 
 @figure_name("shadows_pcf")
-def fig_pcf(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
-    meas = _measured(L, "zoom", L.classic_scene, ZOOM_CAMERA, L.CLASSIC_LIGHT, size)
+def fig_pcf(out: Path, L, quick: bool) -> Drawn:
+    meas = _measured(L, "zoom", quick)
     rows = [meas.panel(f"PCF {k} x {k}, 512² map", map_size=512, pcf=k) for k in (1, 3, 5)]
     rows.append(meas.panel("Poisson disk: 16 samples, radius 2.5 texels", map_size=512, pcf=5, pcf_sampling="poisson"))
     page = panels([r[0] for r in rows], [r[1] for r in rows], ncols=2, title="Percentage-closer filtering")
-    path = save_png(out / "shadows_pcf.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "Percentage-closer filtering averages the 0/1 shadow test over a k x k block of texels around the "
         "point, turning the staircase of a 512² map into a soft edge about k texels wide. It filters the "
         "test results, not the depths: averaging depths first would blur the occluder, not the shadow. "
         "The last panel spreads 16 samples over a disk instead, rotated differently at every texel: the "
         "square block's bands along the edge become fine noise, with 16 lookups instead of 25.",
-        LAB,
     )
 
 
 @figure_name("shadows_pyrender")
-def fig_pyrender(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
+def fig_pyrender(out: Path, L, quick: bool) -> Drawn:
+    size = _panel_size(quick)
     scene = L.torus_scene(125, 50) if quick else L.torus_scene()
     meas = _Measured(L, scene, TORUS_CAMERA, TORUS_LIGHT, size)
     vis, _ = L.light_visibility(scene, meas.eb, TORUS_LIGHT, map_size=2048, pcf=3)
@@ -210,20 +206,18 @@ def fig_pyrender(out: Path, L, quick: bool) -> Figure:
         "error of pyrender",
     ]
     page = panels(images, captions, ncols=3, title=f"Against pyrender and exact shadows ({len(scene.F):,} faces)")
-    path = save_png(out / "shadows_pyrender.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "A bumpy torus above a floor. Our render (Blinn-Phong, receiver-plane slope-scaled bias, no culling) next to "
         "pyrender's own shadow mapping of the same scene, camera and light, and exact shadows by one ray "
         "per pixel. Error maps: pyrender's constant bias leaves acne (dark speckle) on the curved, slanted "
         "parts of the torus; ours differs from the truth only along shadow edges.",
-        LAB,
     )
 
 
 @figure_name("shadows_lights")
-def fig_lights(out: Path, L, quick: bool) -> Figure:
-    size = (240, 180) if quick else (400, 300)
+def fig_lights(out: Path, L, quick: bool) -> Drawn:
+    size = _panel_size(quick)
     scene = L.classic_scene()
     ms = 512 if quick else 1024
     spot = _u8(L.render_with_shadows(scene, L.CLASSIC_CAMERA, SPOT_LIGHT, size=size, map_size=ms))
@@ -243,13 +237,11 @@ def fig_lights(out: Path, L, quick: bool) -> Figure:
         ],
         title="What the light sees, and other lights",
     )
-    path = save_png(out / "shadows_lights.png", page)
-    return Figure(
-        path,
+    return Drawn(
+        page,
         "Left: the depth map of the classic scene from the directional light (orthographic, fitted to the "
         "scene's bounds; nearer is darker). Right: the same scene lit by a spot light (one perspective map) "
         "and by a point light above the boxes (six 90-degree maps on the faces of a cube).",
-        LAB,
     )
 
 

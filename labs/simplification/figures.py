@@ -13,8 +13,8 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import closest_points, mesh_distance
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, heat_colors, line_plot, panels
 from geomlib.render import render
 
 __all__ = ["make_figures", "make_view", "airplane", "cracked_sheet"]
@@ -48,7 +48,7 @@ def cracked_sheet(n: int = 12, gap: float = 0.03) -> tuple[np.ndarray, np.ndarra
 
 
 @figure_name("series")
-def fig_series(out: Path, lab, quick: bool) -> Figure:
+def fig_series(out: Path, lab, quick: bool) -> Drawn:
     qem_simplify = _simplify(lab)
     V, F = airplane()
     diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
@@ -80,15 +80,13 @@ def fig_series(out: Path, lab, quick: bool) -> Figure:
         ],
         axis=1,
     )
-    path = save_png(out / "series.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "The lecture's series: the pyvista airplane and its QEM simplifications to 50%, 10% and 2% of the faces "
         "(top, wireframe). Bottom: every input vertex coloured by its distance to the simplified surface, on one "
         "colour scale. At 50% the error is invisible: contractions in flat regions cost nothing. At 2% the error "
         "sits on the rounded nose and along the thin leading and trailing edges of the wings and tail, whose "
         "thickness is lost; the flat parts stay exact.",
-        LAB,
     )
 
 
@@ -121,7 +119,7 @@ def _anchor_runs(V, F, targets):
 
 
 @figure_name("error_vs_faces")
-def fig_error_curve(out: Path, lab, quick: bool) -> Figure:
+def fig_error_curve(out: Path, lab, quick: bool) -> Drawn:
     qem_simplify = _simplify(lab)
     V, F = datasets.icosphere(3 if quick else 4)
     V = datasets.add_noise(V, 0.01, seed=1, direction="normal", F=F)
@@ -154,19 +152,17 @@ def fig_error_curve(out: Path, lab, quick: bool) -> Figure:
         for name, r in ((n, y / ref) for n, y in zip(labels, ys, strict=True))
         if name != "igl.qslim"
     )
-    path = save_png(out / "error_vs_faces.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "RMS surface distance between a noisy sphere and its simplifications, against the number of faces kept "
         "(both axes logarithmic), for our greedy loop and three libraries: all follow the same power law. Right: "
         "the same errors divided by igl.qslim's, where the curves separate. Our greedy loop places each vertex at "
         f"its quadric minimum like igl.qslim and stays close to it; relative to igl.qslim: {spread}.",
-        LAB,
     )
 
 
 @figure_name("pairs")
-def fig_pairs(out: Path, lab, quick: bool) -> Figure:
+def fig_pairs(out: Path, lab, quick: bool) -> Drawn:
     qem_simplify = _simplify(lab)
     V, F = cracked_sheet(8 if quick else 12)
     target = 24 if quick else 40
@@ -191,19 +187,17 @@ def fig_pairs(out: Path, lab, quick: bool) -> Figure:
         imgs.append(render(np.asarray(U), np.asarray(G), face_colors=colours, **kw))
         caps.append(f"{title}: {len(G)} faces, {n} piece{'s' if n > 1 else ''}")
     img = panels(imgs, caps, title="Valid pairs: edges vs non-edge pairs across a 0.03 crack")
-    path = save_png(out / "pairs.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         f"Two sheets separated by a crack of width 0.03 (colour = connected piece), simplified towards the same "
         f"target of {target} faces (a contraction removes two faces, or one on the boundary, so the two runs can "
         f"stop one face apart: {len(edges_only[1])} and {len(with_pairs[1])}). Contracting edges only can never join the pieces: each keeps its own boundary. Adding the non-edge "
         "pairs closer than 0.05 lets vertices on both sides of the crack merge, zipping the sheets into one piece.",
-        LAB,
     )
 
 
 @figure_name("boundary")
-def fig_boundary(out: Path, lab, quick: bool) -> Figure:
+def fig_boundary(out: Path, lab, quick: bool) -> Drawn:
     qem_simplify = _simplify(lab)
     V, F = datasets.height_field(16 if quick else 32)
     target = max(20, len(F) // 25)
@@ -217,14 +211,12 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
         imgs.append(render(np.asarray(U), np.asarray(G), highlight_points=loop, **kw))
         caps.append(f"{len(G)} faces, {'with' if keep else 'without'} boundary quadrics")
     img = panels(imgs, caps, title="Boundary penalty quadrics keep the outline")
-    path = save_png(out / "boundary.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "An open height field simplified to 4% of its faces (red dots: boundary vertices). Without penalty "
         "quadrics a boundary vertex only feels the planes of its few faces, so the outline shrinks and cuts the "
         "corners. A plane through each boundary edge, perpendicular to its face and weighted heavily, keeps the "
         "boundary vertices on the square outline.",
-        LAB,
     )
 
 

@@ -18,8 +18,8 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, line_plot, panels, save_png, with_colorbar
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, line_plot, panels, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
 
@@ -83,12 +83,12 @@ def _errors(V, F, Vr, Fr, n_samples):
     return d["hausdorff"], d["chamfer"]
 
 
-def _save(path: Path, img: np.ndarray) -> Path:
-    """``save_png`` after reducing the page to 256 colours (keeps the figures small)."""
+def _quantized(img: np.ndarray) -> np.ndarray:
+    """The page reduced to 256 colours (keeps the PNG files small)."""
     from PIL import Image
 
     q = Image.fromarray(np.ascontiguousarray(img)).quantize(256, method=Image.Quantize.MEDIANCUT, dither=0)
-    return save_png(path, np.asarray(q.convert("RGB")))
+    return np.asarray(q.convert("RGB"))
 
 
 def _render(V, F, size, **kw):
@@ -99,7 +99,7 @@ def _render(V, F, size, **kw):
 
 
 @figure_name("vdm_pipeline")
-def _pipeline(out: Path, L, quick: bool) -> Figure:
+def _pipeline(out: Path, L, quick: bool) -> Drawn:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     px = 200 if quick else 340
@@ -150,17 +150,15 @@ def _pipeline(out: Path, L, quick: bool) -> Figure:
         title="VDM baking pipeline",
         font_size=15,
     )
-    path = _save(out / "vdm_pipeline.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        _quantized(img),
         "The VDM pipeline on the rock: mesh, parameterization, importance field, transport "
         "displacement, and the sample grid before and after optimisation.",
-        LAB,
     )
 
 
 @figure_name("vdm_rock_naive_vs_optimised")
-def _rock_reconstruction(out: Path, L, quick: bool) -> Figure:
+def _rock_reconstruction(out: Path, L, quick: bool) -> Drawn:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     size = (300, 225) if quick else (420, 315)
@@ -177,17 +175,15 @@ def _rock_reconstruction(out: Path, L, quick: bool) -> Figure:
         label = "naive (uniform grid)" if name == "naive" else "optimised (density + alignment + diagonals)"
         caps.append(f"{res}x{res} {label}: Hausdorff {h:.2e}, Chamfer {c:.2e}")
     img = panels(imgs, caps, title=f"{res}x{res} VDM of the rock: naive vs optimised", font_size=13)
-    path = _save(out / "vdm_rock_naive_vs_optimised.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        _quantized(img),
         f"The same {res * res} texels reconstruct the rock far better when they are moved toward "
         "creases and snapped onto them (errors relative to the bbox diagonal).",
-        LAB,
     )
 
 
 @figure_name("vdm_box_stages")
-def _box_stages(out: Path, L, quick: bool) -> Figure:
+def _box_stages(out: Path, L, quick: bool) -> Drawn:
     V, F = L.open_box(8)
     res = 16
     size = (280, 210) if quick else (340, 255)
@@ -201,18 +197,16 @@ def _box_stages(out: Path, L, quick: bool) -> Figure:
         imgs.append(_render(Vr, Fr, size, wireframe=True, edge_width=0.7))
         caps.append(f"{name}: Hausdorff {h:.1e}, Chamfer {c:.1e}")
     img = panels(imgs, caps, ncols=4, title="16x16 VDM of an open box, stage by stage", font_size=13)
-    path = _save(out / "vdm_box_stages.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        _quantized(img),
         "A 16x16 VDM of a box without its bottom: the naive grid rounds every crease; transport "
         "gathers samples at the creases, alignment puts vertices on them and the corners exactly on "
         "the box's corners, and per-quad diagonals make the reconstruction exact.",
-        LAB,
     )
 
 
 @figure_name("vdm_diagonals")
-def _diagonals(out: Path, L, quick: bool) -> Figure:
+def _diagonals(out: Path, L, quick: bool) -> Drawn:
     V, F = L.open_box(8)
     res = 16
     px = 260 if quick else 340
@@ -249,17 +243,15 @@ def _diagonals(out: Path, L, quick: bool) -> Figure:
         h, c = _errors(V, F, Vr, Fr, 5000 if quick else 20000)
         caps.append(f"{name} diagonals, close-up of the crease above the corner (1, 0, 0): Hausdorff {h:.1e}")
     img = panels(imgs, caps, ncols=4, title="Global vs per-quad diagonals (16x16 box, aligned grid)", font_size=13)
-    path = _save(out / "vdm_diagonals.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        _quantized(img),
         "The aligned 16x16 grid of the box in uv with its triangles; sharp edges in red. Cells a "
         "crease crosses take the diagonal whose triangles stay on the surface.",
-        LAB,
     )
 
 
 @figure_name("vdm_background_sweep")
-def _background_sweep(out: Path, L, quick: bool) -> Figure:
+def _background_sweep(out: Path, L, quick: bool) -> Drawn:
     V, F = datasets.rock_on_plinth(32 if quick else 48)
     res = 16 if quick else 32
     px = 180 if quick else 240
@@ -292,14 +284,12 @@ def _background_sweep(out: Path, L, quick: bool) -> Figure:
     )
     caps.append("errors of the optimised VDM against the background")
     img = panels(imgs, caps, ncols=3, title=f"Background importance sweep (rock, {res}x{res})", font_size=12)
-    path = _save(out / "vdm_background_sweep.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        _quantized(img),
         "The optimised grids for several background importances. A small background crowds the samples onto "
         "the creases and starves the flat floor (largest Hausdorff error); growing it spreads the samples out "
         f"again, back toward the uniform grid (at {values[-1]:g} the grid is still visibly pulled toward the rock). "
         f"Hausdorff error is smallest at background {values[int(np.argmin(haus))]:g} here; Chamfer keeps falling.",
-        LAB,
     )
 
 

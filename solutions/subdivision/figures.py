@@ -12,8 +12,8 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.labfigures import MeshView, figure_name, lab_figure_makers
-from geomlib.plot import Figure, colorbar, heat_colors, line_plot, panels, save_png, with_colorbar
+from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.plot import colorbar, heat_colors, line_plot, panels, with_colorbar
 from geomlib.render import camera_pose, render, render_polygons
 
 __all__ = ["make_figures", "make_view", "airplane"]
@@ -46,7 +46,7 @@ def _levels(subdivide, V, F, levels: int, **kw) -> list[tuple[np.ndarray, np.nda
 
 
 @figure_name("loop_levels")
-def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
+def fig_loop_levels(out: Path, lab, quick: bool) -> Drawn:
     loop_subdivide, _ = _functions(lab)
     size = (240, 200) if quick else (330, 270)
     L = 2 if quick else 3
@@ -76,21 +76,19 @@ def fig_loop_levels(out: Path, lab, quick: bool) -> Figure:
             extra = f", {len(border):,} boundary vertices" if border is not None else ""
             captions.append(f"{name}, level {k}: {len(F):,} faces{extra}")
     img = panels(images, captions, ncols=L + 1, title=f"Loop subdivision, Warren weights (levels 0-{L})")
-    path = save_png(out / "loop_levels.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "Loop subdivision of the icosahedron (top) and of the open airplane mesh (bottom): every level splits each "
         "triangle into four and moves all vertices by fixed weights. The icosahedron shrinks toward a smooth limit "
         "surface inside its control mesh. The airplane is open (red dots: its boundary vertices): the wings and the "
         "tail are sheets whose edges and roots are boundary loops. Boundary vertices follow the curve rule "
         "(midpoints; 3/4, 1/8, 1/8 along the boundary), so these edges stay sharp and straight at every level while "
         "the fuselage is rounded off.",
-        LAB,
     )
 
 
 @figure_name("warren_vs_loop")
-def fig_weights(out: Path, lab, quick: bool) -> Figure:
+def fig_weights(out: Path, lab, quick: bool) -> Drawn:
     loop_subdivide, _ = _functions(lab)
     size = (260, 220) if quick else (360, 300)
     V, F = datasets.pyvista_mesh("ant")
@@ -114,18 +112,16 @@ def fig_weights(out: Path, lab, quick: bool) -> Figure:
         "distance between the two",
     ]
     img = panels(imgs, caps, ncols=3, title="Warren's weights vs Loop's beta on the pyvista ant")
-    path = save_png(out / "warren_vs_loop.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "The same mesh subdivided with Warren's simplified weights (u = 3/(8n), as in igl.loop) and with Loop's "
         f"original beta(n) (as in trimesh and VTK). The rules agree at valence 3 and 6 only; the largest difference "
         f"here is {hi:.1e} of the bounding-box diagonal, at vertices of unusual valence.",
-        LAB,
     )
 
 
 @figure_name("catmull_clark_levels")
-def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
+def fig_catmull_clark(out: Path, lab, quick: bool) -> Drawn:
     _, catmull_clark = _functions(lab)
     size = (240, 200) if quick else (330, 270)
     L = 2 if quick else 3
@@ -145,18 +141,16 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Figure:
             )  # fmt: skip
             captions.append(f"{name}, level {k}: {len(faces):,} faces, {len(ext)} extraordinary")
     img = panels(images, captions, ncols=L + 1, title="Catmull-Clark subdivision (red: extraordinary vertices)")
-    path = save_png(out / "catmull_clark_levels.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "Catmull-Clark subdivision of a cube and of a cage of pentagon, quads and triangles. After one level every "
         "face is a quad; the extraordinary vertices (valence != 4, red) are the old corners of valence 3 or 5 and "
         "the face points of non-quad faces, and their number stays the same at every later level.",
-        LAB,
     )
 
 
 @figure_name("boundary")
-def fig_boundary(out: Path, lab, quick: bool) -> Figure:
+def fig_boundary(out: Path, lab, quick: bool) -> Drawn:
     loop_subdivide, catmull_clark = _functions(lab)
     import trimesh
 
@@ -191,19 +185,17 @@ def fig_boundary(out: Path, lab, quick: bool) -> Figure:
         f"trimesh.subdivide_loop, {L} levels",
     ]
     img = panels(imgs, caps, ncols=3, title="Boundary rules: midpoints and 1/8, 3/4, 1/8 along the boundary")
-    path = save_png(out / "boundary.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "An open grid subdivided twice with Loop's weights. The boundary is refined as a cubic B-spline curve of "
         "its own (odd = edge midpoint, even = 1/8, 3/4, 1/8 along the boundary), as in igl.loop and VTK. trimesh "
         "gives 1/8 to every neighbour that lies on the boundary, so boundary vertices joined to another boundary "
         "vertex by an interior edge get weights summing to 9/8 and move off (dark red).",
-        LAB,
     )
 
 
 @figure_name("convergence")
-def fig_convergence(out: Path, lab, quick: bool) -> Figure:
+def fig_convergence(out: Path, lab, quick: bool) -> Drawn:
     loop_subdivide, catmull_clark = _functions(lab)
     L = 4 if quick else 6
     curves, labels = [], []
@@ -225,13 +217,11 @@ def fig_convergence(out: Path, lab, quick: bool) -> Figure:
         xs, curves, labels, xlabel="level", ylabel="largest move of an old vertex", logy=True,
         title="Subdivision converges: moves shrink geometrically", size=(560, 380),
     )  # fmt: skip
-    path = save_png(out / "convergence.png", img)
-    return Figure(
-        path,
+    return Drawn(
+        img,
         "How far the old vertices move at each level (log scale). The moves shrink by a roughly constant factor "
         "per level (about 1/4 on regular regions), so the meshes converge to a limit surface; the limit position "
         "of every vertex is a fixed weighted average of its neighbourhood.",
-        LAB,
     )
 
 

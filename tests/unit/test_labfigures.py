@@ -15,6 +15,7 @@ import pytest
 
 import geomlib
 from geomlib.labfigures import (
+    Drawn,
     MeshView,
     figure_name,
     figures_or_placeholders,
@@ -154,3 +155,60 @@ def test_a_partial_figure_names_its_first_missing_panel(tmp_path):
     ]
     missing.append("stale")  # emptied before the next drawing
     assert [f.caption for f in drawn(tmp_path, False)] == ["a", "b"]
+
+
+def test_a_drawn_picture_is_written_under_its_figure_name_with_its_caption(tmp_path):
+    picture = np.zeros((6, 9, 3), np.uint8)
+    picture[2:4, 3:7] = (200, 30, 10)
+
+    @figure_name("toy_picture")
+    def fig_picture(out, L, quick):
+        return Drawn(picture, f"A red bar (quick={quick}).")
+
+    make_figures, _ = lab_figure_makers("toy", "geomlib.toyfigures", (fig_picture,), None, quick="Tiny.")
+    (fig,) = make_figures(tmp_path / "out", quick=True)
+    assert fig == Figure(tmp_path / "out" / "toy_picture.png", "A red bar (quick=True).", "toy")
+    from PIL import Image
+
+    assert np.array_equal(np.asarray(Image.open(fig.path)), picture)
+    # The same bytes as writing the picture directly.
+    assert fig.path.read_bytes() == save_png(tmp_path / "direct.png", picture).read_bytes()
+
+
+def test_a_partial_drawn_picture_keeps_its_name_and_names_the_missing_task(tmp_path):
+    missing: list[str] = []
+
+    @figure_name("half")
+    def fig_half(out, quick):
+        missing.append("4")
+        return Drawn(np.full((4, 4, 3), 255, np.uint8), "the left panel")
+
+    (fig,) = figures_or_placeholders((partial_figure(fig_half, missing),), tmp_path, "toy", False)
+    assert fig.path == tmp_path / "half.png" and fig.path.is_file()
+    assert fig.caption == "Task 4 not implemented yet; the other panels show: the left panel"
+
+
+def test_a_builder_returning_something_else_or_several_drawn_pictures_fails(tmp_path):
+    image = np.zeros((4, 4, 3), np.uint8)
+
+    @figure_name("odd")
+    def fig_odd(out, quick):
+        return image  # forgot the caption
+
+    with pytest.raises(MeshError, match="fig_odd returned ndarray; expected a Drawn"):
+        figures_or_placeholders((fig_odd,), tmp_path, "toy", False)
+
+    @figure_name("two")
+    def fig_two(out, quick):
+        return [Drawn(image, "a"), Drawn(image, "b")]
+
+    with pytest.raises(MeshError, match=r"fig_two returned several pictures as Drawn.*\(two\.png\)"):
+        figures_or_placeholders((fig_two,), tmp_path, "toy", False)
+    assert not (tmp_path / "two.png").exists()
+
+    @figure_name("bad_image")
+    def fig_bad(out, quick):
+        return Drawn(np.zeros((4, 4, 7)), "seven channels")
+
+    with pytest.raises(MeshError):
+        figures_or_placeholders((fig_bad,), tmp_path, "toy", False)
