@@ -204,23 +204,28 @@ def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
     m = cnt[0]
     cnt[0] += 1
     V[m] = p
-    hn = nx(h)
-    out_bc = T[hn]
+
+    def new_face(g, x, y, z, old, s_out, s_in):
+        # g = (x, y, z) takes over the outer edge of half-edge `old` at corner s_out; its corner
+        # s_in is the inner edge, twin of `old` (which now ends or starts at m)
+        F[g, 0], F[g, 1], F[g, 2] = x, y, z
+        falive[g] = True
+        out = T[old]
+        T[3 * g + s_out] = out
+        feat[3 * g + s_out] = feat[old]
+        if out >= 0:
+            T[out] = 3 * g + s_out
+        feat[old] = False
+        T[old], T[3 * g + s_in] = 3 * g + s_in, old
+        feat[3 * g + s_in] = False
+
     g = nf
+    g0 = 3 * g
     F[f, (k + 1) % 3] = m  # f = (a, m, c)
-    F[g, 0], F[g, 1], F[g, 2] = m, b, c  # g = (m, b, c)
-    falive[g] = True
-    g0, g1, g2 = 3 * g, 3 * g + 1, 3 * g + 2
-    T[g1] = out_bc
-    feat[g1] = feat[hn]
-    if out_bc >= 0:
-        T[out_bc] = g1
-    feat[hn] = False
-    T[hn], T[g2] = g2, hn
-    feat[g2] = False
+    new_face(g, m, b, c, nx(h), 1, 2)  # g = (m, b, c): b->c moves to g, c->m is the twin of m->c
     feat[g0] = feat[h]
     VH[m] = g0
-    VH[b] = g1
+    VH[b] = g0 + 1
     val[m] = 4 if t >= 0 else 3
     val[c] += 1
     cls[m] = 1 if feat[h] else 0
@@ -228,19 +233,9 @@ def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
         f2, k2 = t // 3, t % 3
         d = F[f2, (k2 + 2) % 3]
         q = nf + 1
-        tp = pv(t)
-        out_db = T[tp]
+        q0 = 3 * q
         F[f2, k2] = m  # f2 = (m, a, d)
-        F[q, 0], F[q, 1], F[q, 2] = b, m, d  # q = (b, m, d)
-        falive[q] = True
-        q0, q1, q2 = 3 * q, 3 * q + 1, 3 * q + 2
-        T[q2] = out_db
-        feat[q2] = feat[tp]
-        if out_db >= 0:
-            T[out_db] = q2
-        feat[tp] = False
-        T[tp], T[q1] = q1, tp
-        feat[q1] = False
+        new_face(q, b, m, d, pv(t), 2, 1)  # q = (b, m, d): d->b moves to q, m->d is the twin of d->m
         feat[q0] = feat[t]
         T[h], T[t] = t, h
         T[g0], T[q0] = q0, g0
