@@ -315,32 +315,28 @@ def collapse(V, F, T, VH, val, cls, feat, falive, h, p, hes):
     for i in range(n):  # rename b -> a in every face around b
         g = hes[i]
         F[g // 3, g % 3] = a
-    c = org(F, pv(h))
-    x1, x2 = T[nx(h)], T[pv(h)]  # twins of b->c and c->a: (c->b, now) c->a and a->c
-    fe = feat[nx(h)] or feat[pv(h)]
-    if x1 >= 0:
-        T[x1] = x2
-        feat[x1] = fe or feat[x1]
-    if x2 >= 0:
-        T[x2] = x1
-        feat[x2] = fe or feat[x2]
-    falive[h // 3] = False
-    VH[c] = x1 if x1 >= 0 else nx(x2)
-    val[c] -= 1
+
+    def delete_face(e):
+        # delete the face of half-edge e, glue the twins of its other two edges to each other
+        # (a feature if either was one); its third vertex loses an edge; returns the two twins
+        o = org(F, pv(e))
+        e1, e2 = T[nx(e)], T[pv(e)]
+        fe = feat[nx(e)] or feat[pv(e)]
+        if e1 >= 0:
+            T[e1] = e2
+            feat[e1] = fe or feat[e1]
+        if e2 >= 0:
+            T[e2] = e1
+            feat[e2] = fe or feat[e2]
+        falive[e // 3] = False
+        VH[o] = e1 if e1 >= 0 else nx(e2)
+        val[o] -= 1
+        return e1, e2
+
+    x1, x2 = delete_face(h)  # twins of b->c and c->a: (c->b, now) c->a and a->c
     cand = x2
     if t >= 0:
-        d = org(F, pv(t))
-        y1, y2 = T[nx(t)], T[pv(t)]  # twins of a->d and d->b: d->a and (b->d, now) a->d
-        fe = feat[nx(t)] or feat[pv(t)]
-        if y1 >= 0:
-            T[y1] = y2
-            feat[y1] = fe or feat[y1]
-        if y2 >= 0:
-            T[y2] = y1
-            feat[y2] = fe or feat[y2]
-        falive[t // 3] = False
-        VH[d] = y1 if y1 >= 0 else nx(y2)
-        val[d] -= 1
+        y1, y2 = delete_face(t)  # twins of a->d and d->b: d->a and (b->d, now) a->d
         if cand < 0:
             cand = y2 if y2 >= 0 else (nx(y1) if y1 >= 0 else -1)
         val[a] = val[a] + val[b] - 4
