@@ -98,7 +98,7 @@ def icosphere(level: int = 2, radius: float = 1.0) -> tuple[np.ndarray, np.ndarr
         Closed, genus 0, outward oriented.
     """
     level = check_int(level, "level", minimum=0, maximum=8, where="icosphere")
-    radius = _positive(radius, "radius", "icosphere")
+    radius = check_float(radius, "radius", positive=True, where="icosphere")
     V, F = _icosahedron()
     for _ in range(level):
         V, F = _midpoint_subdivide(V, F)
@@ -271,16 +271,9 @@ def grid_patch(n: int = 16, size: float = 1.0, *, diagonals: str = "uniform") ->
     """
     where = "grid_patch"
     n = check_int(n, "n", minimum=1, where=where)
-    size = _positive(size, "size", where)
+    size = check_float(size, "size", positive=True, where=where)
     check_choice(diagonals, "diagonals", ("uniform", "radial"), where=where)
     return _grid_xy(n, size), _grid_faces(n, diagonals)
-
-
-def _positive(x, name: str, where: str) -> float:
-    x = check_float(x, name, minimum=0.0, where=where)
-    if x <= 0:
-        raise MeshError(f"{where}: {name} must be > 0, got {x}")
-    return x
 
 
 def _bumps(x: np.ndarray, y: np.ndarray, rng: np.random.Generator, count: int = 7) -> np.ndarray:
@@ -322,7 +315,7 @@ def height_field(
     """
     where = "height_field"
     n = check_int(n, "n", minimum=1, where=where)
-    size = _positive(size, "size", where)
+    size = check_float(size, "size", positive=True, where=where)
     V = _grid_xy(n, size)
     if fn is None:
         seed = check_int(seed, "seed", minimum=0, where=where)
@@ -439,7 +432,7 @@ def rock_on_plinth(n: int = 48, seed: int = 0, size: float = 1.0) -> tuple[np.nd
     if n % 2:
         raise MeshError(f"{where}: n must be even (the plinth is centred on a grid vertex), got {n}")
     seed = check_int(seed, "seed", minimum=0, where=where)
-    size = _positive(size, "size", where)
+    size = check_float(size, "size", positive=True, where=where)
     h = n // 2
     k_top = max(2, round(0.5 * h))  # rings 0..k_top: plinth top
     k_foot = k_top + max(1, round(0.125 * h))  # rings k_top..k_foot: vertical walls
@@ -509,7 +502,7 @@ def uv_sphere(n_lat: int = 16, n_lon: int = 32, radius: float = 1.0) -> tuple[np
     where = "uv_sphere"
     n_lat = check_int(n_lat, "n_lat", minimum=2, where=where)
     n_lon = check_int(n_lon, "n_lon", minimum=3, where=where)
-    radius = _positive(radius, "radius", where)
+    radius = check_float(radius, "radius", positive=True, where=where)
     c = np.arange(n_lon + 1)
     phi = 2 * np.pi * (c % n_lon) / n_lon  # modulo: the seam copies get identical positions
     rows = np.arange(1, n_lat)
@@ -578,7 +571,7 @@ def uv_grid(n: int = 16, size: float = 1.0) -> tuple[np.ndarray, np.ndarray, np.
     """
     where = "uv_grid"
     n = check_int(n, "n", minimum=1, where=where)
-    size = _positive(size, "size", where)
+    size = check_float(size, "size", positive=True, where=where)
     V = _grid_xy(n, size)
     return V, _grid_faces(n, "uniform"), V[:, :2] / size
 

@@ -204,23 +204,28 @@ def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
     m = cnt[0]
     cnt[0] += 1
     V[m] = p
-    hn = nx(h)
-    out_bc = T[hn]
+
+    def new_face(g, x, y, z, old, s_out, s_in):
+        # g = (x, y, z) takes over the outer edge of half-edge `old` at corner s_out; its corner
+        # s_in is the inner edge, twin of `old` (which now ends or starts at m)
+        F[g, 0], F[g, 1], F[g, 2] = x, y, z
+        falive[g] = True
+        out = T[old]
+        T[3 * g + s_out] = out
+        feat[3 * g + s_out] = feat[old]
+        if out >= 0:
+            T[out] = 3 * g + s_out
+        feat[old] = False
+        T[old], T[3 * g + s_in] = 3 * g + s_in, old
+        feat[3 * g + s_in] = False
+
     g = nf
+    g0 = 3 * g
     F[f, (k + 1) % 3] = m  # f = (a, m, c)
-    F[g, 0], F[g, 1], F[g, 2] = m, b, c  # g = (m, b, c)
-    falive[g] = True
-    g0, g1, g2 = 3 * g, 3 * g + 1, 3 * g + 2
-    T[g1] = out_bc
-    feat[g1] = feat[hn]
-    if out_bc >= 0:
-        T[out_bc] = g1
-    feat[hn] = False
-    T[hn], T[g2] = g2, hn
-    feat[g2] = False
+    new_face(g, m, b, c, nx(h), 1, 2)  # g = (m, b, c): b->c moves to g, c->m is the twin of m->c
     feat[g0] = feat[h]
     VH[m] = g0
-    VH[b] = g1
+    VH[b] = g0 + 1
     val[m] = 4 if t >= 0 else 3
     val[c] += 1
     cls[m] = 1 if feat[h] else 0
@@ -228,19 +233,9 @@ def split(V, F, T, VH, val, cls, feat, falive, cnt, h, p):
         f2, k2 = t // 3, t % 3
         d = F[f2, (k2 + 2) % 3]
         q = nf + 1
-        tp = pv(t)
-        out_db = T[tp]
+        q0 = 3 * q
         F[f2, k2] = m  # f2 = (m, a, d)
-        F[q, 0], F[q, 1], F[q, 2] = b, m, d  # q = (b, m, d)
-        falive[q] = True
-        q0, q1, q2 = 3 * q, 3 * q + 1, 3 * q + 2
-        T[q2] = out_db
-        feat[q2] = feat[tp]
-        if out_db >= 0:
-            T[out_db] = q2
-        feat[tp] = False
-        T[tp], T[q1] = q1, tp
-        feat[q1] = False
+        new_face(q, b, m, d, pv(t), 2, 1)  # q = (b, m, d): d->b moves to q, m->d is the twin of d->m
         feat[q0] = feat[t]
         T[h], T[t] = t, h
         T[g0], T[q0] = q0, g0
@@ -320,32 +315,28 @@ def collapse(V, F, T, VH, val, cls, feat, falive, h, p, hes):
     for i in range(n):  # rename b -> a in every face around b
         g = hes[i]
         F[g // 3, g % 3] = a
-    c = org(F, pv(h))
-    x1, x2 = T[nx(h)], T[pv(h)]  # twins of b->c and c->a: (c->b, now) c->a and a->c
-    fe = feat[nx(h)] or feat[pv(h)]
-    if x1 >= 0:
-        T[x1] = x2
-        feat[x1] = fe or feat[x1]
-    if x2 >= 0:
-        T[x2] = x1
-        feat[x2] = fe or feat[x2]
-    falive[h // 3] = False
-    VH[c] = x1 if x1 >= 0 else nx(x2)
-    val[c] -= 1
+
+    def delete_face(e):
+        # delete the face of half-edge e, glue the twins of its other two edges to each other
+        # (a feature if either was one); its third vertex loses an edge; returns the two twins
+        o = org(F, pv(e))
+        e1, e2 = T[nx(e)], T[pv(e)]
+        fe = feat[nx(e)] or feat[pv(e)]
+        if e1 >= 0:
+            T[e1] = e2
+            feat[e1] = fe or feat[e1]
+        if e2 >= 0:
+            T[e2] = e1
+            feat[e2] = fe or feat[e2]
+        falive[e // 3] = False
+        VH[o] = e1 if e1 >= 0 else nx(e2)
+        val[o] -= 1
+        return e1, e2
+
+    x1, x2 = delete_face(h)  # twins of b->c and c->a: (c->b, now) c->a and a->c
     cand = x2
     if t >= 0:
-        d = org(F, pv(t))
-        y1, y2 = T[nx(t)], T[pv(t)]  # twins of a->d and d->b: d->a and (b->d, now) a->d
-        fe = feat[nx(t)] or feat[pv(t)]
-        if y1 >= 0:
-            T[y1] = y2
-            feat[y1] = fe or feat[y1]
-        if y2 >= 0:
-            T[y2] = y1
-            feat[y2] = fe or feat[y2]
-        falive[t // 3] = False
-        VH[d] = y1 if y1 >= 0 else nx(y2)
-        val[d] -= 1
+        y1, y2 = delete_face(t)  # twins of a->d and d->b: d->a and (b->d, now) a->d
         if cand < 0:
             cand = y2 if y2 >= 0 else (nx(y1) if y1 >= 0 else -1)
         val[a] = val[a] + val[b] - 4

@@ -313,6 +313,7 @@ def test_registry_entries_build():
     [
         (lambda: datasets.icosphere(-1), r"^icosphere: level must be >= 0"),
         (lambda: datasets.icosphere(2, radius=0), r"^icosphere: radius must be > 0"),
+        (lambda: datasets.icosphere(2, radius=-1), r"^icosphere: radius must be > 0, got -1.0"),
         (lambda: datasets.torus(1.0, 2.0), r"^torus: need 0 < minor < major"),
         (lambda: datasets.torus(n_major=2), r"^torus: n_major must be >= 3"),
         (lambda: datasets.sharp_box((1, -1, 1)), r"^sharp_box: size must be positive"),
