@@ -5,15 +5,17 @@ behind in the parent; see :func:`geomlib.render.context.inherited_context`). The
 feedback pictures in forked children (to bound their time), and a notebook often renders figures
 before it grades, so :func:`geomlib.render.render` sends the call to a new Python process instead:
 the arrays and options go over a pipe (pickled), the image comes back. That costs the start of an
-interpreter and a context (about 2 s) per call, paid only in such a child.
+interpreter and a context (about 1 s) once per child, then a render as usual; paid only in such a child.
 """
 
 from __future__ import annotations
 
 import os
 import pickle
+import struct
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 
@@ -31,8 +33,50 @@ def _die_with_parent() -> None:  # pragma: no cover - runs in the child between 
         pass
 
 
+#: The fresh process serving this process's calls: ``(owner pid, Popen, stderr file)``, started on the
+#: first call and reused (a feedback picture renders three images: one start instead of three).
+_SERVER: list = []
+
+
+def _server():
+    if _SERVER and _SERVER[0][0] == os.getpid() and _SERVER[0][1].poll() is None:
+        return _SERVER[0]
+    _SERVER.clear()  # none yet, a parent's (inherited through a fork: its pipes are not ours), or dead
+    # The fresh interpreter sees the modules this one sees (a course root added to sys.path, ...).
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    err = tempfile.TemporaryFile()  # a file, not a pipe: a chatty stderr cannot block the server
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "from geomlib.render.fresh import _serve; _serve()"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=err,
+        env=env,
+        preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+    )
+    _SERVER.append((os.getpid(), proc, err))
+    return _SERVER[0]
+
+
+def _send(stream, obj) -> None:
+    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    stream.write(struct.pack("<Q", len(data)))
+    stream.write(data)
+    stream.flush()
+
+
+def _receive(stream):
+    head = stream.read(8)
+    if len(head) < 8:
+        raise EOFError("the fresh process closed its pipe")
+    (n,) = struct.unpack("<Q", head)
+    data = stream.read(n)
+    if len(data) < n:
+        raise EOFError("the fresh process closed its pipe")
+    return pickle.loads(data)
+
+
 def render_in_fresh_process(entry: str, V, F, options, overrides: dict) -> np.ndarray:
-    """Call ``geomlib.render.<entry>(V, F, options, **overrides)`` in a new Python process.
+    """Call ``geomlib.render.<entry>(V, F, options, **overrides)`` in a fresh Python process.
 
     Parameters
     ----------
@@ -44,40 +88,40 @@ def render_in_fresh_process(entry: str, V, F, options, overrides: dict) -> np.nd
     Returns and raises what the entry point does there (the image; a ``MeshError`` for a bad mesh,
     ...), or a ``RuntimeError`` naming the failure when the fresh process itself failed.
     """
-    payload = pickle.dumps((entry, V, F, options, overrides), protocol=pickle.HIGHEST_PROTOCOL)
-    # The fresh interpreter sees the modules this one sees (a course root added to sys.path, ...).
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
-    proc = subprocess.run(
-        [sys.executable, "-c", "from geomlib.render.fresh import _serve; _serve()"],
-        input=payload,
-        capture_output=True,
-        env=env,
-        preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
-    )
-    if proc.returncode != 0 or not proc.stdout:
-        tail = proc.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["no message"]
+    _, proc, err = _server()
+    try:
+        _send(proc.stdin, (entry, V, F, options, overrides))
+        status, value = _receive(proc.stdout)
+    except (OSError, EOFError) as e:
+        proc.kill()
+        proc.wait()
+        err.seek(0)
+        tail = err.read().decode(errors="replace").strip().splitlines()[-1:] or [str(e)]
         raise RuntimeError(
             f"geomlib.render.{entry}: the fresh process drawing for this forked one failed "
             f"(exit code {proc.returncode}: {tail[0]})"
-        )
-    status, value = pickle.loads(proc.stdout)
+        ) from None
     if status == "error":
         raise value
     return value
 
 
 def _serve() -> None:  # pragma: no cover - runs in the fresh process (tested through render)
-    """Read one pickled call from stdin, run it, write the pickled ``("ok", image)`` or ``("error", exc)``."""
+    """Answer pickled calls from stdin with ``("ok", image)`` or ``("error", exc)`` until stdin closes."""
     from geomlib.render import draw
 
-    entry, V, F, options, overrides = pickle.load(sys.stdin.buffer)
-    try:
-        out = ("ok", getattr(draw, entry)(V, F, options, **overrides))
-    except Exception as e:
-        out = ("error", e)
-    try:
-        data = pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL)
-    except Exception:  # an exception that does not pickle: keep its type's name and message
-        data = pickle.dumps(("error", RuntimeError(f"{type(out[1]).__name__}: {out[1]}")))
-    sys.stdout.buffer.write(data)
-    sys.stdout.flush()
+    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
+    while True:
+        try:
+            entry, V, F, options, overrides = _receive(stdin)
+        except EOFError:
+            return
+        try:
+            out = ("ok", getattr(draw, entry)(V, F, options, **overrides))
+        except Exception as e:
+            out = ("error", e)
+        try:
+            pickle.dumps(out)
+        except Exception:  # an exception that does not pickle: keep its type's name and message
+            out = ("error", RuntimeError(f"{type(out[1]).__name__}: {out[1]}"))
+        _send(stdout, out)
