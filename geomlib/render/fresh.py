@@ -57,8 +57,12 @@ def _server():
     return _SERVER[0]
 
 
-def _send(stream, obj) -> None:
-    data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+def _pickled(obj) -> bytes:
+    return pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+
+
+def _send(stream, data: bytes) -> None:
+    """Write one message: its length (8 bytes), then the pickled bytes."""
     stream.write(struct.pack("<Q", len(data)))
     stream.write(data)
     stream.flush()
@@ -90,7 +94,7 @@ def render_in_fresh_process(entry: str, V, F, options, overrides: dict) -> np.nd
     """
     _, proc, err = _server()
     try:
-        _send(proc.stdin, (entry, V, F, options, overrides))
+        _send(proc.stdin, _pickled((entry, V, F, options, overrides)))
         status, value = _receive(proc.stdout)
     except (OSError, EOFError) as e:
         proc.kill()
@@ -121,7 +125,7 @@ def _serve() -> None:  # pragma: no cover - runs in the fresh process (tested th
         except Exception as e:
             out = ("error", e)
         try:
-            pickle.dumps(out)
+            data = _pickled(out)
         except Exception:  # an exception that does not pickle: keep its type's name and message
-            out = ("error", RuntimeError(f"{type(out[1]).__name__}: {out[1]}"))
-        _send(stdout, out)
+            data = _pickled(("error", RuntimeError(f"{type(out[1]).__name__}: {out[1]}")))
+        _send(stdout, data)
