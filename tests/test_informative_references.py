@@ -55,3 +55,25 @@ def test_a_trivial_case_carries_no_points():
     with pytest.raises(ValueError, match="carries no points"):
         _case(trivial="an empty mesh stays empty", points=1)
     assert _case(trivial="an empty mesh stays empty", points=0).trivial
+
+
+def test_a_wrong_scalar_output_fails_with_a_message():
+    """Found by the forgeries: a wrong 0-d output (vdm's grad_sq) crashed the comparison with IndexError."""
+    from geomlib.grading.checks import Context, compare_arrays
+    from geomlib.grading.errors import Mismatch
+
+    with pytest.raises(Mismatch, match=r"grad_sq\[0\] expected 2, got 0"):
+        compare_arrays("grad_sq", np.array(2.0), np.array(0.0), Context(label="f"), atol=1e-10)
+
+
+def test_a_degenerate_submitted_mesh_fails_a_custom_check_with_a_message():
+    """Found by the forgeries: a zero-area submitted mesh made a lab's own check raise MeshError (a grader error)."""
+    from geomlib import geometry
+    from geomlib.grading.checks import Context
+    from geomlib.grading.errors import Mismatch
+
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    F = np.array([[0, 1, 2]])
+    check = checks.Custom(lambda e, g, ctx: geometry.mesh_distance(e["V"], e["F"], g["V"], g["F"]) and None)
+    with pytest.raises(Mismatch, match="not a valid mesh.*zero total area"):
+        check({"V": V, "F": F}, {"V": np.zeros((3, 3)), "F": F}, Context(label="f"))
