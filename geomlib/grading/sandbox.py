@@ -333,7 +333,10 @@ class _Zygote:
                 raise GraderError(f"the sandbox stopped working ({e}): {self.log_tail()}") from None
             os.lseek(out_fd, 0, 0)
             printed = os.read(out_fd, 4 * tolerances.OUTPUT_CHARS).decode("utf-8", "replace")
-            return {"data": data, "why": why, "status": done.get("status", 0), "printed": printed}
+            from geomlib.grading import shader_watch
+
+            shader = shader_watch.read(scratch) if data is None else None  # the shader the call died in, if any
+            return {"data": data, "why": why, "status": done.get("status", 0), "printed": printed, "shader": shader}
         finally:
             for fd in (r, w, out_fd):
                 if fd >= 0:
@@ -531,6 +534,12 @@ def call(
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)
+    if reply.get("shader"):
+        from geomlib.grading import shader_watch
+
+        reply["shader"] = shader_watch.timeout_message(
+            function, timeout, reply["shader"], [p for p in (stubs, snap) if p]
+        )
     return _outcome(function, reply, timeout, memory_mb, max_bytes)
 
 
@@ -545,6 +554,8 @@ def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_byt
                 f"{function} was stopped after {timeout:.3g} s when the time budget for the whole submission "
                 f"({_STATE['budget']:g} s) ran out; make the slow functions faster"
             )
+        if reply.get("shader"):
+            raise StudentTimeout(reply["shader"])
         raise StudentTimeout(
             f"{function} did not finish within {timeout:g} s (time limit); look for an infinite loop "
             f"or a Python loop over every vertex/pixel that should be vectorised"
@@ -562,6 +573,8 @@ def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_byt
                 "SIGKILL": "being killed (out of memory?)",
                 "SIGABRT": "an abort",
             }.get(sig, sig)
+            if sig == "SIGXCPU" and reply.get("shader"):  # llvmpipe's threads spent the CPU-time limit
+                raise StudentTimeout(reply["shader"])
             raise StudentCrash(f"{function} crashed the worker process with {what}.{tail}")
         code = os.WEXITSTATUS(st) if os.WIFEXITED(st) else "?"
         raise StudentCrash(

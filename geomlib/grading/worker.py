@@ -379,6 +379,9 @@ def run_call(fd: int, lab_dir: str, lab: str, function: str, args, kwargs, stubs
     """Find and call ``function`` in an already confined worker, send the outcome to ``fd``, exit."""
     lab_path = Path(lab_dir)
     try:
+        from geomlib.grading import shader_watch
+
+        shader_watch.install(os.environ.get("TMPDIR"))  # the call's scratch folder (zygote.confine)
         try:
             fn = find_function(lab_path, lab, function, Path(stubs_dir) if stubs_dir else None)
         except LookupError as e:

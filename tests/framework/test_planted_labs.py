@@ -78,3 +78,36 @@ def test_sdf_zeros_for_shadows_and_occlusion_earn_nothing():
     assert sum(t["score"] for t in planted) == 0
     # push_out was left correct: it still earns its points (the grading itself ran)
     assert all(t["status"] == "passed" for t in r["tests"] if "push_out" in t["name"])
+
+
+def _hanging_relief_shader(lab: Path) -> None:
+    """A march that never ends in ``shaders/relief.frag``.
+
+    llvmpipe stops any fragment after 65535 loop turns in all (so ``while (true)`` alone ends, with a
+    wrong answer, in a few seconds); 1024 texture reads a turn make it run for many minutes.
+    """
+    reads = "".join(
+        f"        spin += texelFetch(height, ivec2({i % 8}, {i // 8 % 8}), 0).r * 1e-9;\n" for i in range(1024)
+    )
+    frag = lab / "shaders" / "relief.frag"
+    _replace(
+        frag,
+        "    float f_above = 0.0;\n",
+        f"    float spin = 0.0;\n    while (spin >= 0.0) {{\n{reads}    }}\n    float f_above = 0.0;\n",
+    )
+    _replace(frag, "scale * d, float(hit));", "scale * d, float(hit) + spin);")
+
+
+def test_relief_hanging_shader_time_out_names_the_shader_the_task_and_the_cause():
+    impl = _planted("relief", _hanging_relief_shader)
+    try:
+        r = _grade(impl, "relief", "--part", "GLSL relief mapping", timeout=900)
+    finally:
+        shutil.rmtree(impl, ignore_errors=True)
+    tests = [t for t in r["tests"] if "relief" in t["name"].lower()]
+    assert tests and all(t["status"] == "failed" and t["score"] == 0 for t in tests), tests
+    text = tests[0]["text"]
+    assert "glsl_relief_uv did not finish within" in text, text
+    assert "shaders/relief.frag" in text and "Task 3 (march and refine)" in text, text
+    assert "a loop that does not end or a very long one" in text, text
+    assert "Python loop" not in text, text
