@@ -84,10 +84,11 @@ def _hanging_relief_shader(lab: Path) -> None:
     """A march that never ends in ``shaders/relief.frag``.
 
     llvmpipe stops any fragment after 65535 loop turns in all (so ``while (true)`` alone ends, with a
-    wrong answer, in a few seconds); 1024 texture reads a turn make it run for many minutes.
+    wrong answer, in a few seconds); 1024 dependent texture reads a turn (each address depends on the
+    sum so far, so none can be merged) make it run for many minutes (256 took 170 s on 48 x 48 pixels).
     """
     reads = "".join(
-        f"        spin += texelFetch(height, ivec2({i % 8}, {i // 8 % 8}), 0).r * 1e-9;\n" for i in range(1024)
+        f"        spin += texelFetch(height, ivec2(int(spin * 1e9) & 7, {i % 8}), 0).r * 1e-9;\n" for i in range(1024)
     )
     frag = lab / "shaders" / "relief.frag"
     _replace(
