@@ -114,6 +114,8 @@ def fetch_wheel(dest_dir: str) -> str:
     url, sha = wheel_for_this_machine()
     name = url.rsplit("/", 1)[1]
     target = os.path.join(dest_dir, name)
+    if os.path.isfile(target) and _sha256(target) == sha:
+        return target  # kept from an earlier fetch (fetch-wheel DIR)
     local = os.environ.get("GEOMLIB_UV_WHEEL")
     if local:
         shutil.copyfile(local, target)
@@ -121,14 +123,19 @@ def fetch_wheel(dest_dir: str) -> str:
         _say(f"downloading uv {UV_VERSION} from PyPI ({name})")
         with urllib.request.urlopen(url, timeout=120) as r, open(target, "wb") as f:
             shutil.copyfileobj(r, f)
+    got = _sha256(target)
+    if got != sha:
+        os.unlink(target)
+        raise BootstrapError(f"{name}: sha256 {got} is not the pinned {sha}; not installing it")
+    return target
+
+
+def _sha256(path: str) -> str:
     h = hashlib.sha256()
-    with open(target, "rb") as f:
+    with open(path, "rb") as f:
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
-    if h.hexdigest() != sha:
-        os.unlink(target)
-        raise BootstrapError(f"{name}: sha256 {h.hexdigest()} is not the pinned {sha}; not installing it")
-    return target
+    return h.hexdigest()
 
 
 def _unpack(wheel: str, dest: str) -> None:
@@ -202,8 +209,12 @@ def main(argv: list[str]) -> int:
             print(f"[setup] error: {e}", file=sys.stderr)
             return 1
         return 0
-    if argv[1:2] == ["fetch-wheel"] and len(argv) == 3:  # tests keep one verified copy (GEOMLIB_UV_WHEEL)
-        print(fetch_wheel(argv[2]))
+    if argv[1:2] == ["fetch-wheel"] and len(argv) == 3:  # keep one verified copy (for GEOMLIB_UV_WHEEL)
+        try:
+            print(fetch_wheel(argv[2]))
+        except (BootstrapError, OSError) as e:
+            print(f"[setup] error: {e}", file=sys.stderr)
+            return 1
         return 0
     print("usage: python3 bootstrap.py uv | fetch-wheel DIR", file=sys.stderr)
     return 2
