@@ -57,17 +57,23 @@ def _give(path: Path) -> None:
 
 
 def _student_cache(cache: Path, base: Path) -> Path:
-    """The uv cache as the student's own: hard links to the machine's cache entries (no copy, no
-    download), in folders the student owns; the root-owned lock files are left out (uv makes them)."""
+    """The uv cache as the student's own: the unpacked wheels (archive-v0, 1.5 GB) as hard links to
+    the machine's cache, in folders the student owns; the small index and metadata entries uv
+    rewrites as the student's own copies. No download, no copy of the wheels."""
     if not IS_ROOT:
         return cache
     mine = base / "uv-cache"
-    subprocess.run(["cp", "-al", str(cache), str(mine)], check=True, timeout=600)
-    subprocess.run(["find", str(mine), "-type", "d", "-exec", "chown", f"{STUDENT}:", "{}", "+"], check=True)
-    for lock in mine.rglob("*.lock"):
-        if "archive-v0" not in lock.relative_to(mine).parts:
-            lock.unlink()
-    (mine / ".lock").unlink(missing_ok=True)
+    mine.mkdir()
+    for entry in cache.iterdir():
+        if entry.name == "archive-v0":
+            subprocess.run(["cp", "-al", str(entry), str(mine / entry.name)], check=True, timeout=600)
+            subprocess.run(
+                ["find", str(mine / entry.name), "-type", "d", "-exec", "chown", f"{STUDENT}:", "{}", "+"], check=True
+            )
+        elif entry.name != ".lock":
+            subprocess.run(["cp", "-a", str(entry), str(mine / entry.name)], check=True, timeout=600)
+            subprocess.run(["chown", "-R", f"{STUDENT}:", str(mine / entry.name)], check=True)
+    subprocess.run(["chown", f"{STUDENT}:", str(mine)], check=True)
     return mine
 
 
@@ -151,4 +157,6 @@ def test_student_setup_and_first_grade_from_student_zip_without_root(base):
     glog = f"stdout:\n{grade.stdout[-3000:]}\nstderr:\n{grade.stderr[-3000:]}"
     assert grade.returncode == 0, glog
     assert "not implemented yet" in grade.stdout and "0 / " in grade.stdout, glog
-    print(f"student.zip as {'user ' + STUDENT if IS_ROOT else 'this user'}: ./run setup {t_setup:.0f} s, first grade {t_grade:.0f} s")
+    print(
+        f"student.zip as {'user ' + STUDENT if IS_ROOT else 'this user'}: ./run setup {t_setup:.0f} s, first grade {t_grade:.0f} s"
+    )
