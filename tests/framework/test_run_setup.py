@@ -81,3 +81,64 @@ def test_only_the_whole_suite_installs_the_browser(tmp_path):
         err, calls = _run(d, *args, uid=0, has_osmesa=True)
         browser = [c for c in calls if c.startswith("apt-get install") and "chromium" in c]
         assert bool(browser) == wants_browser, (args, calls, err)
+
+
+def _run_with_fake_uv(
+    tmp_path: Path, *, python_found: bool, install_ok: bool
+) -> tuple[subprocess.CompletedProcess, list[str]]:
+    """``./run figures`` as root with the library present and a fake uv (``GEOMLIB_UV``) that
+    finds no supported Python unless ``python_found``; returns the result and uv's calls."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in (*TOOLS, "python3"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
+    log = tmp_path / "uv.log"
+    find = (
+        "exit 0"
+        if python_found
+        else 'echo "error: No interpreter found for Python >=3.10, <3.15 in managed installations or search path" >&2; exit 2'
+    )
+    uv = f"""echo "uv $*" >> {log}
+case "$1 $2" in
+  "python find") {find} ;;
+  "python install") exit {0 if install_ok else 1} ;;
+esac
+exit 0
+"""
+    bash = shutil.which("bash")
+    for name, body in {"id": "echo 0", "uv": uv, "apt-get": f'echo "apt-get $*" >> {log}'}.items():
+        (fake / name).write_text(f"#!{bash}\n{body}")
+        (fake / name).chmod(0o755)
+    env = {
+        "PATH": f"{fake}:{tools}",
+        "HOME": str(tmp_path),
+        "GEOMLIB_LIB_DIRS": str(libs),
+        "GEOMLIB_UV": str(fake / "uv"),
+    }
+    p = subprocess.run([str(ROOT / "run"), "figures"], env=env, capture_output=True, text=True, timeout=120)
+    return p, (log.read_text().splitlines() if log.exists() else [])
+
+
+def test_a_system_without_a_supported_python_gets_one_from_uv_and_is_told(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=False, install_ok=True)
+    assert p.returncode == 0, p.stderr
+    assert "no Python 3.10-3.14 on this machine: installing Python 3.12 with uv" in p.stderr
+    installs = [c for c in calls if c.startswith("uv python install")]
+    syncs = [c for c in calls if c.startswith("uv sync")]
+    assert installs and "3.12" in installs[0] and syncs and "--python >=3.10,<3.15" in syncs[0], calls
+    assert calls.index(installs[0]) < calls.index(syncs[0])
+
+
+def test_when_uv_cannot_download_a_python_the_message_says_what_to_install(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=False, install_ok=False)
+    assert p.returncode == 1
+    assert "github.com" in p.stderr and "install Python 3.10-3.14 yourself" in p.stderr, p.stderr
+    assert not [c for c in calls if c.startswith("uv sync")], calls
+
+
+def test_a_supported_system_python_is_used_as_it_is(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=True, install_ok=True)
+    assert p.returncode == 0, p.stderr
+    assert not [c for c in calls if c.startswith("uv python install")] and "Python" not in p.stderr, calls
