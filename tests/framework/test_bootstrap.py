@@ -66,3 +66,28 @@ def test_an_unknown_platform_says_what_to_do(bootstrap, monkeypatch):
     monkeypatch.setattr(bootstrap.platform, "machine", lambda: "sparc64")
     with pytest.raises(bootstrap.BootstrapError, match="no pinned uv wheel for .* sparc64.*install uv yourself"):
         bootstrap.wheel_for_this_machine()
+
+
+def test_without_pypi_it_tries_pips_configured_index_then_says_what_to_do(bootstrap, monkeypatch):
+    """No route to files.pythonhosted.org: pip's own configuration (a mirror) in a private venv;
+    when that fails too, the message names the two ways out."""
+    if (bootstrap.platform.system(), bootstrap.platform.machine()) not in bootstrap.UV_WHEELS:
+        pytest.skip("no pinned wheel for this machine")
+    monkeypatch.delenv("GEOMLIB_UV_WHEEL", raising=False)
+
+    def no_network(url, timeout=None):
+        raise bootstrap.urllib.error.URLError("Name or service not known")
+
+    monkeypatch.setattr(bootstrap.urllib.request, "urlopen", no_network)
+    ran = []
+
+    def run(cmd, **kw):
+        ran.append(cmd)
+        raise subprocess.CalledProcessError(1, cmd, stderr=b"ensurepip is not available")
+
+    monkeypatch.setattr(bootstrap.subprocess, "run", run)
+    with pytest.raises(bootstrap.BootstrapError) as e:
+        bootstrap.find_uv()
+    assert [c for c in ran if c[1:3] == ["-m", "venv"]], ran
+    msg = str(e.value)
+    assert "Name or service not known" in msg and "GEOMLIB_UV_WHEEL" in msg and "docs.astral.sh/uv" in msg
