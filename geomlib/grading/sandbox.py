@@ -206,6 +206,10 @@ class _Zygote:
             raise GraderError(f"the sandbox could not start ({e}): {self.log_tail()}") from None
         # GEOMLIB_LANDLOCK=0 turns Landlock off (to test the protection of a kernel without it).
         self.landlock = 0 if os.environ.get("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
+        # What a non-Linux system lacks (no prctl, no /proc, RLIMIT_AS ignored), one line each.
+        self.notes = [n for n in ready.get("notes", []) if "Landlock" not in n]
+        for note in self.notes:  # once per run, on stderr: the sandbox works, with less
+            print(f"geomlib sandbox: {note}", file=sys.stderr)
         self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
@@ -420,11 +424,13 @@ def status() -> str:
     if z.landlock:
         parts.append(f"Landlock file-system confinement (ABI {z.landlock})")
     if not parts:
-        return (
+        text = (
             "student code is process-isolated only (not root and no Landlock): it can read and write "
             "whatever this user can"
         )
-    return "student code " + " with ".join(parts)
+    else:
+        text = "student code " + " with ".join(parts)
+    return text + "".join(f"; {n}" for n in z.notes)
 
 
 def shutdown() -> None:

@@ -423,10 +423,14 @@ def vm_size_bytes() -> int:
         return 0
 
 
-def tasks_of_user(uid: int) -> int:
-    """Threads currently running as ``uid`` (what RLIMIT_NPROC counts)."""
+def tasks_of_user(uid: int) -> int | None:
+    """Threads currently running as ``uid`` (what RLIMIT_NPROC counts); None without /proc (macOS)."""
     n = 0
-    for name in os.listdir("/proc"):
+    try:
+        names = os.listdir("/proc")
+    except OSError:
+        return None
+    for name in names:
         if name.isdigit():
             try:
                 if os.stat(f"/proc/{name}").st_uid == uid:
