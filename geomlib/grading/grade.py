@@ -36,11 +36,14 @@ class _Selection:
     tasks: dict = field(default_factory=dict)  # nodeid -> tuple of task numbers
     titles: dict = field(default_factory=dict)  # lab -> TaskTable
     deselected: int = 0
+    #: the task has no test of its own; the tests that run it (through a composite) were kept
+    through: str = ""
 
     def pytest_collection_modifyitems(self, session, config, items):
         from geomlib.grading import tasks as _tasks
 
         keep, drop = [], []
+        runs = {}
         for item in items:
             marker = item.get_closest_marker("graded")
             lab = plugin._lab_of(item.path)
@@ -61,7 +64,21 @@ class _Selection:
             ok = (self.task is None or self.task in t) and (
                 self.part is None or part.strip().lower() == self.part.strip().lower()
             )
+            if self.task is not None and self.part is None and not ok:
+                try:
+                    runs[item.nodeid] = self.task in _tasks.test_runs(item, self.titles[lab])
+                except Exception:
+                    runs[item.nodeid] = False
             (keep if ok else drop).append(item)
+        if self.task is not None and not [i for i in keep if i.nodeid in self.tasks] and any(runs.values()):
+            keep += [i for i in drop if runs.get(i.nodeid)]
+            drop = [i for i in drop if not runs.get(i.nodeid)]
+            labs = sorted({plugin._lab_of(i.path) for i in keep if i.nodeid in runs})
+            titles = [self.titles[lab].describe(self.task) for lab in labs if lab in self.titles]
+            self.through = (
+                f"{titles[0] if titles else f'Task {self.task}'} has no test of its own: "
+                "these are the tests of the functions that run it"
+            )
         if drop:
             config.hook.pytest_deselected(items=drop)
             items[:] = keep
@@ -146,6 +163,8 @@ def grade(
         tail = _problem_lines(captured.getvalue())
         if tail:
             note += ":\n" + "\n".join(tail)
+    if selection.through and records:
+        note = f"{selection.through}\n{note}" if note else selection.through
     data = build_results(records, elapsed, note)
     if results:
         write_results(data, results)

@@ -27,7 +27,7 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 
-__all__ = ["TaskTable", "derive", "table", "test_tasks"]
+__all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
 
 _MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
 
@@ -60,6 +60,13 @@ class TaskTable:
             for t in self.tasks.get(b, ())[:1]:
                 if t not in out:
                     out.append(t)
+        return tuple(sorted(out))
+
+    def runs(self, name: str) -> tuple[int, ...]:
+        """Every task a call of ``name`` runs: its own and all its blocks' main tasks."""
+        out = set(self.of_function(name))
+        for b in self.composites.get(name, ()):
+            out |= set(self.tasks.get(b, ())[:1])
         return tuple(sorted(out))
 
     def of_part(self, part: str) -> int | None:
@@ -275,4 +282,18 @@ def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     return tuple(sorted(out))
 
 
+def test_runs(item, tab: TaskTable) -> tuple[int, ...]:
+    """Every task a collected graded test runs (its functions and their building blocks): what
+    ``--task N`` falls back to for a task that has no test of its own (remeshing's collapse pass,
+    graded through the loop)."""
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    if case is not None and hasattr(case, "function"):
+        names = [case.function]
+    else:
+        names = _lab_calls(item.function) + _named_functions(item.function, tab)
+    return tuple(sorted({t for name in names for t in tab.runs(name)}))
+
+
 test_tasks.__test__ = False  # not a pytest test, despite the name
+test_runs.__test__ = False
