@@ -180,6 +180,8 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
 
 
 _SEE = re.compile(r"\(see ([^()]+?\.png)\)")
+#: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
+_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to Task (\d+) \(([^()]*)\)")
 
 
 def report_lines(
@@ -218,7 +220,11 @@ def report_lines(
             continue
         t = tasks.get(r.nodeid, ())
         where = f"{r.lab} · " if several else ""
-        line = f"  ✗ {where}{_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {where}{r.part}: {msg}"
+        part = r.part
+        rows = _ROWS.search(msg)  # the differing rows are another task's (geomlib.grading.diagnose)
+        if rows:
+            t, part = (int(rows.group(1)),), rows.group(2)
+        line = f"  ✗ {where}{_tasks_text(t)} · {part}: {msg}" if t else f"  ✗ {where}{part}: {msg}"
         if line in seen:
             continue
         seen.add(line)
