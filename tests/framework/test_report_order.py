@@ -53,3 +53,22 @@ def test_a_run_without_hidden_cases_says_what_the_lab_is_out_of():
     assert "subdivision is out of 151 (60 public + 91 hidden)" in text, text
     hidden = [*records, _r("h", "odd vertices", 3, True, "", visibility="hidden")]
     assert "out of 151" not in "\n".join(report_lines(hidden, feedback_dir=None))
+
+
+def test_results_json_messages_name_no_file_the_student_cannot_open(tmp_path):
+    """On Gradescope the picture is inlined: "(picture below)", not "(see ../results/feedback/x.png)"."""
+    from PIL import Image
+
+    from geomlib.grading.results import build_results
+
+    pic = tmp_path / "results" / "feedback" / "subdivision" / "odd-ant.png"
+    pic.parent.mkdir(parents=True)
+    Image.new("RGB", (8, 8), "red").save(pic)
+    probe = tmp_path / "results" / "feedback" / "subdivision" / "probe-odd.png"
+    msg = f"loop_subdivide is off (see {probe}) — S_odd row 0 differs (see {pic})"
+    with_pic = Record("a", "subdivision", "odd vertices", "a", 1, "visible", False, msg, 0.0, picture=str(pic))
+    without = Record("b", "subdivision", "odd vertices", "b", 1, "visible", False, msg, 0.0)
+    out = {t["name"].split(" › ")[-1]: t["output"] for t in build_results([with_pic, without], 1.0)["tests"]}
+    assert "(picture below)" in out["a"] and "<img" in out["a"], out["a"]
+    for text in out.values():
+        assert "feedback/" not in text and "(see" not in text, text
