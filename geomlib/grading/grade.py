@@ -154,6 +154,8 @@ def grade(
             code = pytest.main(args, plugins=[selection])
     elapsed = time.time() - t0
     records = list(plugin.RECORDS)
+    if task is None and part is None:
+        _remove_stale_pictures(feedback_dir, {r.lab for r in records}, before=t0)
     note = ""
     if code == 5 or (code == 0 and not records):
         what = f"task {task}" if task is not None else f'part "{part}"' if part else "these labs"
@@ -172,6 +174,20 @@ def grade(
         records, feedback_dir=feedback_dir, note=note, tasks=selection.tasks, whole=task is None and part is None
     )
     return data
+
+
+def _remove_stale_pictures(feedback_dir, labs, *, before: float) -> None:
+    """Pictures a whole-lab run did not draw belong to tests that pass now (or no longer exist):
+    remove them, so ``feedback/<lab>/`` shows only today's failures."""
+    if not feedback_dir:
+        return
+    for lab in labs:
+        for png in Path(feedback_dir, lab).glob("*.png"):
+            try:
+                if png.stat().st_mtime < before:
+                    png.unlink()
+            except OSError:
+                pass
 
 
 def _problem_lines(text: str, limit: int = 12) -> list[str]:
