@@ -279,7 +279,10 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return a.func(a)
     except (MeshError, FileNotFoundError) as e:
-        print(f"geomlib {a.command}: {e}", file=sys.stderr)
+        msg = str(e)
+        if msg.startswith(f"{a.command}: "):  # the library names its function already ("view: ...")
+            msg = msg[len(a.command) + 2 :]
+        print(f"geomlib {a.command}: {msg}", file=sys.stderr)
         return 2
 
 

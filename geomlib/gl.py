@@ -179,7 +179,11 @@ def _compile(GL, kind, source: str, name: str) -> int:
         shown = "".join(
             f"\n  line {n}: {src_lines[n - 1].strip()}" for n in dict.fromkeys(lines) if 0 < n <= len(src_lines)
         )
-        raise ShaderError(f"{name} did not compile:\n{log.strip()}{shown}", log=log, lines=lines)
+        # Lead with the file and line the student edits and the driver's first complaint there.
+        first = next((ln.strip() for ln in log.splitlines() if _LINE_RE.match(ln)), "")
+        first = re.sub(r"^(ERROR:\s*)?\d+[:(]\d+\)?(\(\d+\))?:?\s*", "", first)
+        head = f"{name} did not compile, line {lines[0]}: {first}" if lines and first else f"{name} did not compile:"
+        raise ShaderError(f"{head}{shown}\n{log.strip()}", log=log, lines=lines)
     return shader
 
 

@@ -18,7 +18,11 @@ never graded themselves). That module may also declare
 - ``WHERE``: ``{function: where(inputs, expected, got) -> " at valence-3 vertices" or ""}``;
 - ``PICTURES``: ``{function: picture(ctx, inputs, expected, got) -> path or None}``, a feedback
   picture for outputs the generic checks cannot draw (a subdivision matrix: the mesh with the
-  vertices whose rows are wrong highlighted).
+  vertices whose rows are wrong highlighted);
+- ``ROWS_TASK``: ``{function: task(inputs, expected, got) -> task number or None}``, the task of
+  the rows that differ, for cases that mix the rows of two tasks (a boundary-rules case of
+  ``loop_odd_matrix`` has interior edges too): when it is not the case's own task, the message
+  says so and gives that task's hint instead of the case's (see :func:`rows_task_note`).
 
 Everything here is a help: any problem while diagnosing leaves the original message as it was.
 """
@@ -170,5 +174,38 @@ def enrich(error: Mismatch, lab, case, inputs: dict, expected: dict, got: dict, 
         why = explain(lab, case, feedback_dir=ctx.feedback_dir)
     except Exception:
         pic, why = error.feedback, None
-    extra = why or case.hint
+    extra = why or rows_task_note(lab.name, case, inputs, expected, got) or case.hint
     return type(error)(error.message + (f" — {extra}" if extra else ""), pic)
+
+
+def rows_task_note(lab: str, case, inputs: dict, expected: dict, got: dict) -> str | None:
+    """ "the rows that differ at interior edges belong to Task 1 (odd vertices), not to Task 4: ...:
+    <Task 1's hint>" when the lab's
+    ``ROWS_TASK`` puts the differing rows of ``case`` in another task than the case's own."""
+    try:
+        fn = getattr(_module(lab), "ROWS_TASK", {}).get(case.function)
+        if fn is None:
+            return None
+        n = fn(inputs, expected, got)
+        tab = _tasks.table(lab)
+        own = tab.of_part(case.part) or (tab.of_function(case.function) or (None,))[0]
+        if n is None or n == own:
+            return None
+        from geomlib.grading.cases import load_cases
+
+        hint = next(
+            (
+                c.hint
+                for c in load_cases(lab, hidden=False, probes=False)
+                if c.function == case.function and c.hint and tab.of_part(c.part) == n
+            ),
+            "",
+        )
+        where = ""
+        w = getattr(_module(lab), "WHERE", {}).get(case.function)
+        if w is not None:
+            where = w(inputs, expected, got) or ""
+        note = f"the rows that differ{where} belong to Task {n} ({tab.titles.get(n, '')}), not to {tab.describe(own)}"
+        return note + (f": {hint}" if hint else "")
+    except Exception:  # a help only
+        return None

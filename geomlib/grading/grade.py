@@ -36,11 +36,14 @@ class _Selection:
     tasks: dict = field(default_factory=dict)  # nodeid -> tuple of task numbers
     titles: dict = field(default_factory=dict)  # lab -> TaskTable
     deselected: int = 0
+    #: the task has no test of its own; the tests that run it (through a composite) were kept
+    through: str = ""
 
     def pytest_collection_modifyitems(self, session, config, items):
         from geomlib.grading import tasks as _tasks
 
         keep, drop = [], []
+        runs = {}
         for item in items:
             marker = item.get_closest_marker("graded")
             lab = plugin._lab_of(item.path)
@@ -61,7 +64,21 @@ class _Selection:
             ok = (self.task is None or self.task in t) and (
                 self.part is None or part.strip().lower() == self.part.strip().lower()
             )
+            if self.task is not None and self.part is None and not ok:
+                try:
+                    runs[item.nodeid] = self.task in _tasks.test_runs(item, self.titles[lab])
+                except Exception:
+                    runs[item.nodeid] = False
             (keep if ok else drop).append(item)
+        if self.task is not None and not [i for i in keep if i.nodeid in self.tasks] and any(runs.values()):
+            keep += [i for i in drop if runs.get(i.nodeid)]
+            drop = [i for i in drop if not runs.get(i.nodeid)]
+            labs = sorted({plugin._lab_of(i.path) for i in keep if i.nodeid in runs})
+            titles = [self.titles[lab].describe(self.task) for lab in labs if lab in self.titles]
+            self.through = (
+                f"{titles[0] if titles else f'Task {self.task}'} has no test of its own: "
+                "these are the tests of the functions that run it"
+            )
         if drop:
             config.hook.pytest_deselected(items=drop)
             items[:] = keep
@@ -137,6 +154,8 @@ def grade(
             code = pytest.main(args, plugins=[selection])
     elapsed = time.time() - t0
     records = list(plugin.RECORDS)
+    if task is None and part is None:
+        _remove_stale_pictures(feedback_dir, {r.lab for r in records}, before=t0)
     note = ""
     if code == 5 or (code == 0 and not records):
         what = f"task {task}" if task is not None else f'part "{part}"' if part else "these labs"
@@ -146,11 +165,29 @@ def grade(
         tail = _problem_lines(captured.getvalue())
         if tail:
             note += ":\n" + "\n".join(tail)
+    if selection.through and records:
+        note = f"{selection.through}\n{note}" if note else selection.through
     data = build_results(records, elapsed, note)
     if results:
         write_results(data, results)
-    data["report"] = report_lines(records, feedback_dir=feedback_dir, note=note, tasks=selection.tasks)
+    data["report"] = report_lines(
+        records, feedback_dir=feedback_dir, note=note, tasks=selection.tasks, whole=task is None and part is None
+    )
     return data
+
+
+def _remove_stale_pictures(feedback_dir, labs, *, before: float) -> None:
+    """Pictures a whole-lab run did not draw belong to tests that pass now (or no longer exist):
+    remove them, so ``feedback/<lab>/`` shows only today's failures."""
+    if not feedback_dir:
+        return
+    for lab in labs:
+        for png in Path(feedback_dir, lab).glob("*.png"):
+            try:
+                if png.stat().st_mtime < before:
+                    png.unlink()
+            except OSError:
+                pass
 
 
 def _problem_lines(text: str, limit: int = 12) -> list[str]:
@@ -161,15 +198,26 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
 
 
 _SEE = re.compile(r"\(see ([^()]+?\.png)\)")
+#: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
+_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to Task (\d+) \(([^()]*)\)")
 
 
 def report_lines(
-    records: list, *, feedback_dir: str | Path | None = "feedback", note: str = "", tasks: dict | None = None
+    records: list,
+    *,
+    feedback_dir: str | Path | None = "feedback",
+    note: str = "",
+    tasks: dict | None = None,
+    whole: bool = True,
 ) -> list[str]:
     """The student report: score table, "What to fix", feedback pictures.
 
-    One line per failing test, in the order the tests ran; tests that fail only because a function
-    is not implemented yet are summed up in one line per function (they all say the same).
+    One line per failing test (at most :data:`LINE` characters, the details indented below it):
+    wrong results of started tasks first, in task order, then the tasks not started yet, one line
+    per function (their tests all say the same). ``whole``: the run graded whole labs (no
+    ``--task`` or ``--part``): a first grade of untouched stubs starts with "0 / 60 — nothing
+    implemented yet; start with Task 1 (...)", and a run without hidden cases says what the lab is
+    out of with them.
     """
     tasks = tasks or {}
     lines: list[str] = []
@@ -177,7 +225,12 @@ def report_lines(
         lines += [note, ""]
     if not records:
         return lines or ["no graded tests ran"]
+    first = _nothing_implemented(records) if whole else ""
+    if first:
+        lines += [first, ""]
     lines += plugin.score_table(records).splitlines()
+    if whole:  # say what the public total is out of
+        lines += _hidden_totals(records)
     failed = [r for r in records if not r.passed and not r.message.startswith("skipped")]
     skipped = [r for r in records if not r.passed and r.message.startswith("skipped")]
     if not failed and not skipped:
@@ -186,7 +239,7 @@ def report_lines(
     labs = list(dict.fromkeys(r.lab for r in records))
     several = len(labs) > 1  # then every line says which lab it is about
     todo: dict[tuple, list] = {}
-    fix: dict[str, list[str]] = {lab: [] for lab in labs}
+    fix: dict[str, list[tuple[int, str]]] = {lab: [] for lab in labs}
     pictures: list[str] = []
     seen: set[str] = set()
     for r in failed:
@@ -199,11 +252,15 @@ def report_lines(
             continue
         t = tasks.get(r.nodeid, ())
         where = f"{r.lab} · " if several else ""
-        line = f"  ✗ {where}{_tasks_text(t)} · {r.part}: {msg}" if t else f"  ✗ {where}{r.part}: {msg}"
+        part = r.part
+        rows = _ROWS.search(msg)  # the differing rows are another task's (geomlib.grading.diagnose)
+        if rows:
+            t, part = (int(rows.group(1)),), rows.group(2)
+        line = f"✗ {where}{_tasks_text(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
         if line in seen:
             continue
         seen.add(line)
-        fix[r.lab].append(line)
+        fix[r.lab].append((min(t) if t else 1_000, line))
     if failed:
         n_tests = len(failed)
         lines += ["", f"What to fix ({n_tests} failing test{'s' if n_tests != 1 else ''}):"]
@@ -212,14 +269,15 @@ def report_lines(
             m = re.search(r"Task (\d+)", msg)
             return int(m.group(1)) if m else 1_000
 
-        for lab in labs:  # per lab: tasks not started (in task order), then wrong results
+        for lab in labs:  # per lab: wrong results of started tasks, then tasks not started, in task order
+            for _, line in sorted(fix[lab], key=lambda tl: tl[0]):
+                lines += _wrapped(line)
             for (_, msg), rs in sorted(
                 ((k, v) for k, v in todo.items() if k[0] == lab), key=lambda kv: task_no(kv[0][1])
             ):
                 n = len(rs)
                 where = f"{lab} · " if several else ""
-                lines.append(f"  ✗ {where}{msg}" + (f" — {n} tests" if n != 1 else ""))
-            lines += fix[lab]
+                lines += _wrapped(f"✗ {where}{msg}" + (f" — {n} tests" if n != 1 else ""))
     for r in skipped:
         lines.append(f"  - {r.part}: {r.name}: {r.message}")
     if pictures:
@@ -229,6 +287,56 @@ def report_lines(
     elif feedback_dir and any(not r.not_implemented for r in failed):
         lines += ["", "No feedback pictures for these failures."]
     return lines
+
+
+#: Longest line of "What to fix"; the rest of a message follows on indented lines below it.
+LINE = 160
+
+
+def _wrapped(line: str) -> list[str]:
+    """``  ✗ ...`` in lines of at most :data:`LINE` characters: the first says which task and
+    check, the details follow below it, indented."""
+    import textwrap
+
+    return textwrap.wrap(
+        line, LINE, initial_indent="  ", subsequent_indent="      ", break_long_words=True, break_on_hyphens=False
+    )
+
+
+def _nothing_implemented(records) -> str:
+    """ "0 / 60 — nothing implemented yet; start with Task 1 (odd vertices): loop_odd_matrix" when
+    no point-carrying test passes and every failure is a task not started; else ""."""
+    pointed = [r for r in records if r.points > 0]
+    if not pointed or any(r.passed or not r.not_implemented for r in pointed):
+        return ""
+    best = None
+    for r in pointed:
+        m = re.search(r"Task (\d+)[a-z]? \(([^()]*)\)", r.message)
+        if m and (best is None or int(m.group(1)) < best[0]):
+            best = (int(m.group(1)), m.group(0), r.message.split(":", 1)[0].strip())
+    total = sum(r.points for r in pointed)
+    start = f"; start with {best[1]}: {best[2]}" if best else ""
+    return f"0 / {total:g} — nothing implemented yet{start}"
+
+
+def _hidden_totals(records) -> list[str]:
+    """When the run had no hidden cases (a student's copy): what each lab is out of with them,
+    from the grading table of its handout ("| **total** | 60 + 91 = 151 |")."""
+    if any(r.visibility == "hidden" for r in records):
+        return []
+    out = []
+    for lab in dict.fromkeys(r.lab for r in records):
+        try:
+            text = (_impl.course_root() / "labs" / lab / "README.md").read_text()
+        except OSError:
+            continue
+        m = re.search(r"^\| \*\*total\*\* \| ([0-9.]+) \+ ([0-9.]+) = ([0-9.]+) \|", text, re.M)
+        if m and float(m.group(2)) > 0:
+            out.append(
+                f"These are the public tests only: with the hidden cases the autograder adds, {lab} is "
+                f"out of {m.group(3)} ({m.group(1)} public + {m.group(2)} hidden)."
+            )
+    return out
 
 
 def _tasks_text(t) -> str:

@@ -163,12 +163,22 @@ def embedded_picture(path: str | Path) -> str | None:
     return f'<img alt="feedback picture" style="max-width: 100%" src="data:image/png;base64,{base64.b64encode(data).decode()}">'
 
 
+_SEE = re.compile(r" ?\(see ([^()]+?\.png)\)")
+
+
+def _without_paths(message: str, embedded: str | None) -> str:
+    """The message without "(see feedback/....png)": the student cannot open the grader's files.
+    The embedded picture becomes "(picture below)"."""
+    return _SEE.sub(lambda m: " (picture below)" if embedded and m.group(1) == embedded else "", message)
+
+
 def _test_output(r: Record) -> dict:
     """A test's ``output`` and ``output_format``: Markdown, or HTML with its feedback picture inlined."""
     img = embedded_picture(r.picture) if (r.picture and not r.passed) else None
+    message = _without_paths(r.message, r.picture if img is not None else None)
     if img is None:
-        return {"output": markdown_text(r.message), "output_format": "md"}
-    text = html.escape(clean_text(r.message, TEST_OUTPUT_CHARS)).replace("\n", "<br>")
+        return {"output": markdown_text(message), "output_format": "md"}
+    text = html.escape(clean_text(message, TEST_OUTPUT_CHARS)).replace("\n", "<br>")
     return {"output": f"<p>{text}</p>\n{img}", "output_format": "html"}
 
 

@@ -454,6 +454,8 @@ def _signal_name(code: int) -> str:
 
 
 def _format_student_exception(function: str, info: dict) -> str:
+    if info.get("type") == "ShaderError":  # the message leads with the shader's file and line; the
+        return f"{function}: {clean_text(info.get('message', ''))}"  # Python frame is the given code's
     where = ""
     frames = info.get("frames") if isinstance(info.get("frames"), list) else []
     if frames and isinstance(frames[-1], dict):

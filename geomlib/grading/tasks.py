@@ -27,7 +27,7 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 
-__all__ = ["TaskTable", "derive", "table", "test_tasks"]
+__all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
 
 _MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
 
@@ -62,6 +62,13 @@ class TaskTable:
                     out.append(t)
         return tuple(sorted(out))
 
+    def runs(self, name: str) -> tuple[int, ...]:
+        """Every task a call of ``name`` runs: its own and all its blocks' main tasks."""
+        out = set(self.of_function(name))
+        for b in self.composites.get(name, ()):
+            out |= set(self.tasks.get(b, ())[:1])
+        return tuple(sorted(out))
+
     def of_part(self, part: str) -> int | None:
         """The task whose title is ``part`` (case and a leading "the" ignored), else None."""
         key = _norm(part)
@@ -82,20 +89,37 @@ def _norm(s: str) -> str:
 def derive(lab_dir: str | Path) -> TaskTable:
     """Read the task table from a lab's source (solutions or untouched stubs)."""
     funcs: dict[str, tuple[list, set]] = {}
+    shader_marks: list[tuple[int, str, str]] = []  # (task, title, function running the shader)
     for path in sorted(Path(lab_dir).glob("*.py")):
         if path.name == "figures.py":
             continue
         src = path.read_text()
         lines = src.splitlines()
-        for node in ast.parse(src).body:
+        tree = ast.parse(src)
+        modules = _lab_module_aliases(tree)
+        for node in tree.body:
             if not isinstance(node, ast.FunctionDef):
                 continue
-            marks = []
-            for line in lines[node.lineno - 1 : node.end_lineno]:
-                m = _MARK.search(line)
-                if m and ("BEGIN SOLUTION" in line or "NotImplementedError" in line):
-                    marks.append((int(m.group(1)), m.group(2).strip()))
-            calls = {n.func.id for n in ast.walk(node) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+            marks = _marks(lines[node.lineno - 1 : node.end_lineno])
+            # A function that runs one of the lab's shaders (``_run("parallax", ...)``) holds the
+            # shader's tasks: the student writes them in ``shaders/parallax.frag``.
+            for n in ast.walk(node):
+                if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value.isidentifier():
+                    shader = Path(lab_dir) / "shaders" / f"{n.value}.frag"
+                    if shader.is_file():
+                        shader_marks += [(n, t, node.name) for n, t in _marks(shader.read_text().splitlines())]
+            calls = set()
+            for n in ast.walk(node):
+                if not isinstance(n, ast.Call):
+                    continue
+                if isinstance(n.func, ast.Name):
+                    calls.add(n.func.id)
+                elif (  # ``K.split(...)`` after ``from . import kernels as K``
+                    isinstance(n.func, ast.Attribute)
+                    and isinstance(n.func.value, ast.Name)
+                    and n.func.value.id in modules
+                ):
+                    calls.add(n.func.attr)
             funcs[node.name] = (marks, calls)
     t = TaskTable()
     for name, (marks, _) in funcs.items():
@@ -106,6 +130,10 @@ def derive(lab_dir: str | Path) -> TaskTable:
                     nums.append(n)
                 t.titles.setdefault(n, title)
             t.tasks[name] = tuple(nums)
+    for n, title, name in shader_marks:  # after the Python markers: those name the tasks
+        t.titles.setdefault(n, title)
+        if n not in t.tasks.get(name, ()):
+            t.tasks[name] = (*t.tasks.get(name, ()), n)
 
     def blocks(name, seen):
         out = set()
@@ -124,6 +152,25 @@ def derive(lab_dir: str | Path) -> TaskTable:
             t.composites[name] = tuple(sorted(b, key=lambda f: (t.tasks[f][0], f)))
     t.titles = dict(sorted(t.titles.items()))
     return t
+
+
+def _marks(lines) -> list[tuple[int, str]]:
+    """``(task, title)`` of the task markers among ``lines`` (Python or GLSL, solution or stub)."""
+    out = []
+    for line in lines:
+        m = _MARK.search(line)
+        if m and ("BEGIN SOLUTION" in line or "NotImplementedError" in line or "#error" in line):
+            out.append((int(m.group(1)), m.group(2).strip()))
+    return out
+
+
+def _lab_module_aliases(tree) -> set[str]:
+    """Names under which a lab file imports the lab's own modules (``from . import kernels as K``)."""
+    out = set()
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and node.level >= 1 and not node.module:
+            out |= {a.asname or a.name for a in node.names}
+    return out
 
 
 def _declared(lab: str):
@@ -148,34 +195,22 @@ def table(lab: str) -> TaskTable:
 
 
 def _lab_calls(fn) -> list[str]:
-    """Lab functions a hand-written test calls: ``lab.name(...)`` and ``lab.call("name", ...)``,
-    directly or through a helper defined in the same test module."""
+    """Lab functions a hand-written test uses: ``lab.name(...)``, ``lab.call("name", ...)`` and
+    ``lab.name`` passed on (``applied(lab.split_edge, ...)``), directly or through a helper defined
+    in the same test module."""
     try:
         tree = ast.parse(_dedent(fn))
     except (OSError, TypeError, SyntaxError):
         return []
-    out: list[str] = []
-    helpers = []
-    for n in ast.walk(tree):
-        if not isinstance(n, ast.Call):
-            continue
-        f = n.func
-        if isinstance(f, ast.Attribute) and isinstance(f.value, ast.Name) and f.value.id == "lab":
-            if f.attr == "call" and n.args and isinstance(n.args[0], ast.Constant):
-                name = str(n.args[0].value)
-            else:
-                name = f.attr
-            if name not in out:
-                out.append(name)
-        elif isinstance(f, ast.Name):
-            helpers.append(f.id)
+    out = _lab_calls_direct(fn, tree)
     module = sys.modules.get(getattr(fn, "__module__", ""), None)
-    for h in helpers:
-        g = getattr(module, h, None)
-        if inspect.isfunction(g) and g.__module__ == fn.__module__ and g is not fn:
-            for name in _lab_calls_direct(g):
-                if name not in out:
-                    out.append(name)
+    for n in ast.walk(tree):
+        if isinstance(n, ast.Call) and isinstance(n.func, ast.Name):
+            g = getattr(module, n.func.id, None)
+            if inspect.isfunction(g) and g.__module__ == fn.__module__ and g is not fn:
+                for name in _lab_calls_direct(g):
+                    if name not in out:
+                        out.append(name)
     return out
 
 
@@ -185,17 +220,43 @@ def _dedent(fn) -> str:
     return textwrap.dedent(inspect.getsource(fn))
 
 
-def _lab_calls_direct(fn) -> list[str]:
+def _lab_calls_direct(fn, tree=None) -> list[str]:
+    if tree is None:
+        try:
+            tree = ast.parse(_dedent(fn))
+        except (OSError, TypeError, SyntaxError):
+            return []
+    out = []
+    for n in ast.walk(tree):
+        name = None
+        if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name) and n.value.id == "lab":
+            name = n.attr if n.attr != "call" else None
+        elif (
+            isinstance(n, ast.Call)
+            and isinstance(n.func, ast.Attribute)
+            and isinstance(n.func.value, ast.Name)
+            and n.func.value.id == "lab"
+            and n.func.attr == "call"
+            and n.args
+            and isinstance(n.args[0], ast.Constant)
+        ):
+            name = str(n.args[0].value)
+        if name is not None and name not in out:
+            out.append(name)
+    return out
+
+
+def _named_functions(fn, tab: TaskTable) -> list[str]:
+    """Lab functions a test names in a string (``check_glsl_case(lab, case, "glsl_parallax_uv")``)."""
     try:
         tree = ast.parse(_dedent(fn))
     except (OSError, TypeError, SyntaxError):
         return []
     out = []
     for n in ast.walk(tree):
-        if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute):
-            f = n.func
-            if isinstance(f.value, ast.Name) and f.value.id == "lab" and f.attr != "call" and f.attr not in out:
-                out.append(f.attr)
+        if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value not in out:
+            if n.value in tab.tasks or n.value in tab.composites:
+                out.append(n.value)
     return out
 
 
@@ -208,7 +269,11 @@ def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     case = callspec.params.get("case") if callspec is not None else None
     if case is not None and getattr(case, "task", None):
         return (int(case.task),)
-    names = [case.function] if case is not None and hasattr(case, "function") else _lab_calls(item.function)
+    if case is not None and hasattr(case, "function"):
+        names = [case.function]
+    else:
+        names = _lab_calls(item.function)
+        names += [n for n in _named_functions(item.function, tab) if n not in names]
     out: list[int] = []
     for name in names:
         for t in tab.of_function(name):
@@ -217,4 +282,18 @@ def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     return tuple(sorted(out))
 
 
+def test_runs(item, tab: TaskTable) -> tuple[int, ...]:
+    """Every task a collected graded test runs (its functions and their building blocks): what
+    ``--task N`` falls back to for a task that has no test of its own (remeshing's collapse pass,
+    graded through the loop)."""
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    if case is not None and hasattr(case, "function"):
+        names = [case.function]
+    else:
+        names = _lab_calls(item.function) + _named_functions(item.function, tab)
+    return tuple(sorted({t for name in names for t in tab.runs(name)}))
+
+
 test_tasks.__test__ = False  # not a pytest test, despite the name
+test_runs.__test__ = False

@@ -36,6 +36,8 @@ __all__ = ["SHADERS", "shader_path", "glsl_parallax_uv", "glsl_relief_uv", "glsl
 
 #: The shader files of the lab, in task order.
 SHADERS = ("parallax", "relief", "shadow")
+#: The task each shader file is.
+TASKS = {"parallax": "Task 2: parallax", "relief": "Task 3: march and refine", "shadow": "Task 4: shadow"}
 
 
 def shader_path(name: str) -> Path:
@@ -49,7 +51,11 @@ def _run(name: str, size: tuple[int, int], textures: dict, uniforms: dict) -> np
     todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
     if todo:
         raise NotImplementedError(f"shaders/{name}.frag: {todo[0]}")
-    return gl.render_quad(source, size, textures=textures, uniforms=uniforms, name=f"shaders/{name}.frag")
+    try:
+        return gl.render_quad(source, size, textures=textures, uniforms=uniforms, name=f"shaders/{name}.frag")
+    except gl.ShaderError as e:  # name the task with the file: the message leads with both
+        msg = str(e).replace(f"shaders/{name}.frag", f"shaders/{name}.frag ({TASKS[name]})", 1)
+        raise gl.ShaderError(msg, log=e.log, lines=e.lines) from None
 
 
 def glsl_parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, offset_limit: bool = False):

@@ -3,7 +3,7 @@
 ``make_figures(out_dir, lab=None, quick=False)`` writes the PNGs and returns
 :class:`geomlib.plot.Figure` records; in ``labs/remeshing/`` it renders *your* results.
 
-The issue's meshes (the Stanford bunny, the fandisk, the camel head) are not part of the course,
+The usual remeshing test meshes (the Stanford bunny, the fandisk, the camel head) are not part of the course,
 so the figures use built-in stand-ins made here: a bunny of metaballs extracted by marching cubes
 (:func:`metaball_bunny`; like a scan, it has slivers and irregular valences), the same bunny
 decimated by QEM (:func:`decimated_bunny`), a block with a curved top and sharp edges
@@ -99,7 +99,7 @@ def metaball_bunny(n: int = 64) -> tuple[np.ndarray, np.ndarray]:
 def decimated_bunny(faces: int = 1200, n: int = 64) -> tuple[np.ndarray, np.ndarray]:
     """:func:`metaball_bunny` decimated by QEM (fast-simplification) to about ``faces`` faces.
 
-    The irregular input of the issue's second case: long thin triangles where the surface is flat
+    An irregular input, as a decimated scan is: long thin triangles where the surface is flat
     in one direction, valences far from 6.
     """
     import fast_simplification
@@ -147,7 +147,7 @@ def angles(V, F) -> np.ndarray:
 
 
 def quality(V, F) -> dict:
-    """The issue's quality measures (those the graded tests use, without the distance to the input):
+    """The mesh quality measures (those the graded tests use, without the distance to the input):
     :func:`geomlib.geometry.triangle_quality`."""
     return triangle_quality(np.asarray(V, dtype=np.float64), np.asarray(F))
 

@@ -35,3 +35,15 @@ def test_handout_grading_table_matches_the_tests(table, lab):
     pub = sum(p for p, _ in table[lab].values())
     hid = sum(h for _, h in table[lab].values())
     assert rows.get("**total**") == f"{pub:g} + {hid:g} = {pub + hid:g}", f"labs/{lab}/README.md: total row"
+
+
+def test_readme_lab_table_gives_the_points_the_grader_computes(table):
+    """README.md's lab table: every lab, with "total (public + hidden)" as the grader counts them."""
+    text = (ROOT / "README.md").read_text()
+    rows = dict(re.findall(r"^\| \[([a-z]+)\]\(labs/[a-z]+/README\.md\) \|.*\| ([^|]+) \|$", text, flags=re.M))
+    assert sorted(rows) == sorted(LABS), f"README.md's lab table lists {sorted(rows)}"
+    for lab in LABS:
+        pub = sum(p for p, _ in table[lab].values())
+        hid = sum(h for _, h in table[lab].values())
+        expected = f"{pub + hid:g} ({pub:g} + {hid:g})"
+        assert rows[lab].strip() == expected, f"README.md: the points of {lab} should say {expected}"

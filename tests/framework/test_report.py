@@ -48,3 +48,16 @@ def test_check_in_a_notebook_returns_the_cli_lines(sample_course, monkeypatch):
     ).execute()
     printed = "".join(o.get("text", "") for o in nb.cells[0].outputs if o.get("output_type") == "stream")
     assert printed.splitlines() == cli
+
+
+def test_a_whole_lab_run_removes_pictures_of_tests_that_pass_now(sample_course, tmp_path):
+    import os
+
+    stale = tmp_path / "feedback" / "sample" / "tet-scale.png"
+    stale.parent.mkdir(parents=True)
+    stale.write_bytes(b"\x89PNG old picture")
+    os.utime(stale, (1e9, 1e9))
+    other = tmp_path / "feedback" / "sample" / "notes.txt"
+    other.write_text("mine")
+    _report(sample_course, "--impl", "solutions", "--feedback", str(tmp_path / "feedback"))
+    assert not stale.exists() and other.exists()

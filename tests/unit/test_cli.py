@@ -55,6 +55,18 @@ def test_info_reports_a_malformed_file_with_its_line(tmp_path, capsys):
     assert "line 4" in err and "bad.obj" in err
 
 
+def test_view_without_a_display_names_the_command_once(tmp_path, capsys, monkeypatch):
+    V, F = datasets.icosphere(1)
+    path = tmp_path / "ball.obj"
+    mesh_io.write_obj(path, V, F)
+    for var in ("DISPLAY", "WAYLAND_DISPLAY"):
+        monkeypatch.delenv(var, raising=False)
+    assert main(["view", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("geomlib view: no display here") and "view: view:" not in err, err
+    assert "--html" in err
+
+
 @pytest.mark.render
 def test_render_command_writes_a_non_blank_png(tmp_path):
     V, F = datasets.icosphere(2)

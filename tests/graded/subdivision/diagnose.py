@@ -147,6 +147,43 @@ def _where_odd(inputs, expected, got) -> str:
 WHERE = {"loop_even_matrix": _where_even, "loop_odd_matrix": _where_odd}
 
 
+def _rows_task(name: str, interior_task: int, boundary_rows):
+    """The task of the rows of ``name`` that differ: ``interior_task`` when none is a boundary row,
+    Task 4 (boundary rules) when all are, else None."""
+
+    def task(inputs, expected, got):
+        rows = wrong_rows(expected[name], got[name], name)
+        if rows is None or not len(rows):
+            return None
+        on_boundary = boundary_rows(inputs)[np.asarray(rows)]
+        if not on_boundary.any():
+            return interior_task
+        return 4 if on_boundary.all() else None
+
+    return task
+
+
+def _boundary_edge_rows(inputs):
+    F = np.asarray(inputs["F"])
+    E = topology.unique_edges(F)
+    B = {tuple(e) for e in np.sort(topology.boundary_edges(F), axis=1).tolist()}
+    return np.array([tuple(e) in B for e in E.tolist()], bool)
+
+
+def _boundary_vertex_rows(inputs):
+    out = np.zeros(len(inputs["V"]), bool)
+    out[topology.boundary_edges(np.asarray(inputs["F"])).ravel()] = True
+    return out
+
+
+#: A boundary-rules case has interior rows too: when only those differ, the message names Task 1
+#: or 2 (and its hint), not the case's Task 4.
+ROWS_TASK = {
+    "loop_odd_matrix": _rows_task("S_odd", 1, _boundary_edge_rows),
+    "loop_even_matrix": _rows_task("S_even", 2, _boundary_vertex_rows),
+}
+
+
 def _picture(name):
     def picture(ctx, inputs, expected, got):
         return matrix_picture(ctx, inputs["V"], inputs["F"], expected[name], got[name], name)

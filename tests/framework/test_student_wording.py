@@ -1,0 +1,20 @@
+"""Student-facing text speaks to students: no "the issue's meshes" (issues are the developers' tracker)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_handouts_stubs_and_notebooks_do_not_refer_to_our_issues():
+    files = [*ROOT.glob("labs/*/*.py"), *ROOT.glob("labs/*/README.md"), *ROOT.glob("notebooks/*.ipynb")]
+    files.append(ROOT / "docs" / "students.md")
+    assert len(files) > 20
+    bad = []
+    for f in files:
+        for n, line in enumerate(f.read_text().splitlines(), 1):
+            if re.search(r"\b(the|an|this) issue('s)?\b|\bissue \d+", line, re.I):
+                bad.append(f"{f.relative_to(ROOT)}:{n}: {line.strip()[:120]}")
+    assert not bad, "\n".join(bad)
