@@ -41,10 +41,11 @@ import os
 import sys
 from pathlib import Path
 
-__all__ = ["NotAllowedError", "declared", "install", "given", "handout_names", "handout_section"]
+__all__ = ["NotAllowedError", "declared", "install", "given", "handout_section", "handout_sections"]
 
-#: The handout's section that lists a lab's blacklist (``labs/<lab>/README.md``).
-HANDOUT_HEADING = "### Not allowed"
+#: The title of the handout's section that lists a lab's blacklist (``labs/<lab>/README.md``), at
+#: heading level 2 or 3.
+HANDOUT_TITLE = "Not allowed"
 
 
 class NotAllowedError(RuntimeError):
@@ -92,10 +93,10 @@ def declared(lab: str, tests_dir: Path | None = None) -> dict[str, str]:
     return {}
 
 
-def handout_section(lab: str, entries: dict[str, str]) -> str:
-    """The Markdown of the handout's "Not allowed" section for ``entries`` (what the handout must list)."""
+def handout_section(entries: dict[str, str], level: int = 3) -> str:
+    """The Markdown of the handout's "Not allowed" section for ``entries`` (what the handout must hold)."""
     lines = [
-        HANDOUT_HEADING,
+        "#" * level + " " + HANDOUT_TITLE,
         "",
         "The grader makes these functions raise an error when your code calls them, directly or through",
         "another library function (use them freely in a notebook to check your results):",
@@ -105,20 +106,16 @@ def handout_section(lab: str, entries: dict[str, str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def handout_names(readme_text: str) -> list[str] | None:
-    """The names listed (``- `name` — why``) in a handout's "Not allowed" section; None without one."""
+def handout_sections(readme_text: str) -> list[str]:
+    """Every "Not allowed" section of a handout, each from its heading to the next heading."""
     lines = readme_text.splitlines()
-    try:
-        start = next(i for i, ln in enumerate(lines) if ln.strip() == HANDOUT_HEADING)
-    except StopIteration:
-        return None
-    names = []
-    for ln in lines[start + 1 :]:
-        if ln.startswith("#"):
-            break
-        if ln.startswith("- `"):
-            names.append(ln[3:].split("`", 1)[0])
-    return names
+    out = []
+    for i, line in enumerate(lines):
+        level = len(line) - len(line.lstrip("#"))
+        if level in (2, 3) and line[level:].strip() == HANDOUT_TITLE:
+            end = next((k for k in range(i + 1, len(lines)) if lines[k].startswith("#")), len(lines))
+            out.append("\n".join(lines[i:end]).rstrip("\n") + "\n")
+    return out
 
 
 # ---------------------------------------------------------------------------------- worker side
@@ -247,6 +244,8 @@ class _Guards:
             d = vars(mod)
         except TypeError:
             return
+        if self.guard_of.keys().isdisjoint(map(id, list(d.values()))):
+            return  # the common case, at C speed (every loaded module is searched once per worker)
         for key, value in list(d.items()):
             g = self.guard_of.get(id(value))
             if g is not None:
