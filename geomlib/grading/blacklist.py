@@ -28,8 +28,11 @@ library function that calls it for the student (``trimesh.Trimesh.subdivide_loop
 ``trimesh.remesh.subdivide_loop``) is caught too.
 
 Not covered (an in-process guard cannot be): digging the raw function out of the guard's closure or
-with ``gc``, calling into the shared library with ``ctypes``, or passing the function itself as a
-callback to a given helper that calls whatever it receives. The grader's own checks run in the
+with ``gc``, switching the guard off through its own state (it is Python objects in the student's
+process, like everything else there), calling into the shared library with ``ctypes``, or passing
+the function itself as a callback to a given helper that calls whatever it receives. Each of these
+is deliberate tampering that shows in the submitted code; every ordinary way of calling the
+function (what the handout forbids) is caught. The grader's own checks run in the
 grader's process, where nothing is replaced.
 """
 
