@@ -471,7 +471,10 @@ def _not_allowed(lab: str) -> dict[str, str]:
 
     key = ("not_allowed", str(impl.tests_dir()), lab)
     if key not in _STATE:
-        _STATE[key] = blacklist.declared(lab)
+        try:
+            _STATE[key] = blacklist.declared(lab)
+        except (OSError, SyntaxError, ValueError) as e:
+            raise GraderError(f"grader problem (not your code): the lab's blacklist cannot be read ({e})") from None
     return _STATE[key]
 
 
