@@ -176,6 +176,13 @@ ROUTES = {
         import sys, igl
         return sys.modules["igl"].__dict__["winding_number"](V, F, P)
     """,
+    "a fresh import after removing it from sys.modules": """
+        import sys
+        for name in [m for m in sys.modules if m == "igl" or m.startswith("igl.")]:
+            del sys.modules[name]
+        import igl
+        return igl.winding_number(V, F, P)
+    """,
     "another library calling it (trimesh)": """
         import trimesh
         return -trimesh.Trimesh(V, F, process=False).nearest.signed_distance(P)
