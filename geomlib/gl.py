@@ -146,6 +146,17 @@ atexit.register(close)
 _LINE_RE = re.compile(r"^\s*\d+:(\d+)\(\d+\)|^ERROR:\s*\d+:(\d+)|^\s*\d+\((\d+)\)", re.M)
 
 
+#: Called as ``on_shader(name)`` when a shader named ``name`` starts (compile, draw, read-back) and
+#: ``on_shader(None)`` when it is done. The grader's worker sets it, so that a call stopped at its time
+#: limit can name the shader it was stuck in (a loop that does not end); None otherwise.
+on_shader = None
+
+
+def _note_shader(name) -> None:
+    if on_shader is not None:
+        on_shader(name)
+
+
 def _prepare(source: str, version: str) -> str:
     """Add ``#version`` when missing, keeping the driver's line numbers those of ``source``."""
     if re.match(r"\s*#version", source):
@@ -386,6 +397,14 @@ def render_quad(
     """
     size = _size(size)
     GL = _gl()
+    _note_shader(name)
+    try:
+        return _render_quad(GL, fragment, size, textures, uniforms, outputs, filter, wrap, version, name)
+    finally:
+        _note_shader(None)
+
+
+def _render_quad(GL, fragment, size, textures, uniforms, outputs, filter, wrap, version, name):
     prog = _program(GL, QUAD_VERTEX_SHADER, fragment, name, version)
     quad = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
     vao, buffers = _vertex_array(GL, prog, {"position": quad})
@@ -452,6 +471,16 @@ def render_mesh(
     if n is None or F.size and (F.min() < 0 or F.max() >= n):
         raise MeshError("geomlib.gl.render_mesh: F indexes vertices that have no attributes")
     GL = _gl()
+    _note_shader(name)
+    try:
+        return _render_mesh(
+            GL, vertex, fragment, attributes, F, size, textures, uniforms, outputs, filter, wrap, version, name
+        )
+    finally:
+        _note_shader(None)
+
+
+def _render_mesh(GL, vertex, fragment, attributes, F, size, textures, uniforms, outputs, filter, wrap, version, name):
     prog = _program(GL, vertex, fragment, name, version)
     vao, buffers = _vertex_array(GL, prog, attributes)
     idx = np.ascontiguousarray(F, dtype=np.uint32)

@@ -68,6 +68,13 @@ class Case:
         Appended to the failure message.
     timeout : float, optional
         Seconds allowed for the call (default :data:`~geomlib.grading.tolerances.TIME_LIMIT_S`).
+    trivial : str, optional
+        Why this case is meant to be matched by a submission that computes nothing (zeros, a
+        constant, an input returned unchanged); such a case carries no points. Every other case's
+        reference must be informative (:mod:`geomlib.grading.informative`).
+    trivial_outputs : dict, optional
+        ``{output: why}`` for outputs that are uninformative in an otherwise informative case
+        (e.g. a handedness that is +1 on a mesh without mirrored UVs).
     """
 
     id: str
@@ -81,10 +88,16 @@ class Case:
     visibility: str = "visible"
     hint: str | None = None
     timeout: float | None = None
+    trivial: str | None = None
+    trivial_outputs: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.visibility not in VISIBILITIES:
             raise ValueError(f"case {self.id}: visibility must be one of {VISIBILITIES}")
+        if self.trivial is not None and self.points:
+            raise ValueError(
+                f"case {self.id}: a trivial case ({self.trivial}) carries no points, got points={self.points}"
+            )
         if isinstance(self.outputs, str):
             self.outputs = (self.outputs,)
         if not re.fullmatch(r"[A-Za-z0-9_.\-]+", self.id):

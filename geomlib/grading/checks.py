@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from geomlib.errors import MeshError
 from geomlib.grading import tolerances as tol
 from geomlib.grading.errors import BadReturn, Mismatch
 
@@ -155,6 +156,7 @@ def compare_arrays(name: str, e: np.ndarray, g: np.ndarray, ctx: Context, *, ato
         ctx.fail(problem)
     if e.size == 0:
         return
+    e, g = np.atleast_1d(e), np.atleast_1d(g)  # a scalar output is reported as its one entry
     diff = np.abs(g.astype(np.float64) - e.astype(np.float64))
     bad = diff > atol + rtol * np.abs(e)
     if not bad.any():
@@ -347,7 +349,10 @@ class Custom:
     fn: Callable
 
     def __call__(self, expected: dict, got: dict, ctx: Context) -> None:
-        msg = self.fn(expected, got, ctx)
+        try:
+            msg = self.fn(expected, got, ctx)
+        except MeshError as e:  # a degenerate submitted mesh (e.g. zero area) is the submission's fault
+            ctx.fail(f"the submitted output is not a valid mesh ({e})")
         if msg:
             ctx.fail(str(msg))
 

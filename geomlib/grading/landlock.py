@@ -42,8 +42,11 @@ def abi_version() -> int:
     """The kernel's Landlock ABI version, or 0 when Landlock is unavailable."""
     if platform.system() != "Linux" or platform.machine() not in ("x86_64", "aarch64"):
         return 0
-    libc = _libc()
-    libc.syscall.restype = ctypes.c_long
+    try:
+        libc = _libc()
+        libc.syscall.restype = ctypes.c_long
+    except (AttributeError, OSError):  # a libc without syscall(): no Landlock, as on other systems
+        return 0
     v = libc.syscall(_SYS_CREATE, None, ctypes.c_size_t(0), ctypes.c_uint32(_CREATE_RULESET_VERSION))
     return max(int(v), 0)
 

@@ -2,7 +2,8 @@
 
 ``OUT/student/`` (and ``OUT/student.zip``)
     geomlib, the stubs of the chosen labs, their public graded tests and public references,
-    notebooks without outputs, the student guide as README.md, pyproject.toml, uv.lock, ``run``.
+    notebooks without outputs, the student guide as README.md, pyproject.toml, uv.lock, ``run``,
+    the dev container (``.devcontainer/``).
     No solution code, no hidden tests, no hidden references, no other lab.
 ``OUT/autograder-<lab>.zip``, one per chosen lab
     Gradescope's layout: ``setup.sh`` and ``run_autograder`` at the top, next to the sources that
@@ -31,7 +32,7 @@ from geomlib.grading import stubs
 __all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secret_lines", "ReleaseError"]
 
 _SKIP_DIRS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache", ".ruff_cache"}
-_TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version"]
+_TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version", ".dockerignore"]
 _TEXT_SUFFIXES = {
     ".py",
     ".frag",
@@ -57,70 +58,9 @@ class ReleaseError(RuntimeError):
 
 # ------------------------------------------------------------------------------------ scripts
 
-SETUP_SH = r"""#!/usr/bin/env bash
-# Gradescope runs this once, as root, when it builds the autograder image (Ubuntu).
-# Locally (as root):  GEOMLIB_AUTOGRADER_ROOT=/tmp/ag bash /tmp/ag/source/setup.sh
-# It installs the grader where the sandbox user (GEOMLIB_SANDBOX_USER, default nobody) can run it
-# and makes the hidden cases and references readable by root only. Lab: @LAB@.
-set -euo pipefail
-ROOT="${GEOMLIB_AUTOGRADER_ROOT:-/autograder}"
-SRC="$ROOT/source"
-SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
-cd "$SRC"
-export DEBIAN_FRONTEND=noninteractive
-
-# System packages, only the missing ones: headless OpenGL (OSMesa for pyrender and the GLSL
-# harness; EGL with Mesa's software driver as the fallback platform), a Python, pip.
-need=()
-ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so' || need+=(libosmesa6)
-ldconfig -p 2>/dev/null | grep -q 'libEGL\.so' || need+=(libegl1)
-ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so' || need+=(libegl-mesa0)
-compgen -G "${GEOMLIB_DRI_DIR:-/usr/lib/*/dri}/swrast_dri.so" >/dev/null || need+=(libgl1-mesa-dri)
-command -v python3 >/dev/null 2>&1 || need+=(python3 python3-venv python3-pip)
-if ! command -v uv >/dev/null 2>&1 && ! python3 -m pip --version >/dev/null 2>&1; then need+=(python3-pip); fi
-if [ ${#need[@]} -gt 0 ]; then
-  echo "setup.sh: apt-get install ${need[*]}"
-  apt-get update -qq
-  apt-get install -y -qq "${need[@]}" >/dev/null
-fi
-if ! command -v uv >/dev/null 2>&1; then
-  python3 -m pip install --quiet uv 2>/dev/null || python3 -m pip install --quiet --break-system-packages uv
-fi
-
-# A Python the sandbox user can read (not one under /root, which it cannot open): the one named by
-# GEOMLIB_AUTOGRADER_PYTHON, else a system python3.11, else uv installs 3.11 under $ROOT/python.
-PY="${GEOMLIB_AUTOGRADER_PYTHON:-}"
-for cand in /usr/bin/python3.11 /usr/local/bin/python3.11; do
-  if [ -n "$PY" ]; then break; fi
-  if [ -x "$cand" ]; then PY="$cand"; break; fi
-done
-if [ -z "$PY" ]; then
-  export UV_PYTHON_INSTALL_DIR="$ROOT/python"
-  uv python install 3.11
-  chmod -R a+rX "$ROOT/python"
-  PY="$(uv python find 3.11)"
-fi
-echo "setup.sh: Python $PY"
-
-# The locked library and the test runner (no dev tools) in source/.venv, with bytecode compiled now
-# (the sandbox user cannot write it).
-export UV_PROJECT_ENVIRONMENT="$SRC/.venv"
-uv sync --frozen --no-dev --group grading --compile-bytecode --python "$PY" --no-python-downloads --quiet
-chmod a+rx "$ROOT"
-chmod -R a+rX "$SRC"
-# Hidden cases, hidden tests and hidden references: root only.
-find "$SRC/tests" -name '*hidden*' -exec chmod -R go-rwx {} +
-
-# The grader must start, and the sandbox user must be able to run the same Python.
-"$SRC/.venv/bin/python" -c 'import geomlib.grading.grade, pytest, numpy, scipy'
-if [ "$(id -u)" = 0 ] && [ -n "$SANDBOX_USER" ]; then
-  if ! (cd / && runuser -u "$SANDBOX_USER" -- "$SRC/.venv/bin/python" -c 'import numpy, scipy, geomlib.grading.worker'); then
-    echo "setup.sh: the sandbox user '$SANDBOX_USER' cannot run $SRC/.venv/bin/python (check the permissions of $ROOT and of the Python)" >&2
-    exit 1
-  fi
-fi
-echo "setup.sh: ready to grade @LAB@"
-"""
+#: The one set-up script of a grading machine (Gradescope's image and the dev container's image):
+#: ``geomlib/grading/setup.sh``, shipped with the lab's name in place of ``@LAB@``.
+SETUP_SH = (Path(__file__).with_name("setup.sh")).read_text()
 
 RUN_AUTOGRADER = r"""#!/usr/bin/env bash
 # Gradescope runs this for every submission, as root. It always writes results/results.json.
@@ -258,6 +198,7 @@ def student_files(
         ),
     )
     out += _tests(root, labs, include_hidden=include_hidden)
+    out += _tree(root, ".devcontainer")  # the dev container (docs/students.md), built by geomlib/grading/setup.sh
     out += [(root / n, Path(n)) for n in _TOP_FILES if (root / n).is_file()]
     return out
 

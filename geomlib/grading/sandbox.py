@@ -206,6 +206,10 @@ class _Zygote:
             raise GraderError(f"the sandbox could not start ({e}): {self.log_tail()}") from None
         # GEOMLIB_LANDLOCK=0 turns Landlock off (to test the protection of a kernel without it).
         self.landlock = 0 if os.environ.get("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
+        # What a non-Linux system lacks (no prctl, no /proc, RLIMIT_AS ignored), one line each.
+        self.notes = [n for n in ready.get("notes", []) if "Landlock" not in n]
+        for note in self.notes:  # once per run, on stderr: the sandbox works, with less
+            print(f"geomlib sandbox: {note}", file=sys.stderr)
         self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
@@ -333,7 +337,10 @@ class _Zygote:
                 raise GraderError(f"the sandbox stopped working ({e}): {self.log_tail()}") from None
             os.lseek(out_fd, 0, 0)
             printed = os.read(out_fd, 4 * tolerances.OUTPUT_CHARS).decode("utf-8", "replace")
-            return {"data": data, "why": why, "status": done.get("status", 0), "printed": printed}
+            from geomlib.grading import shader_watch
+
+            shader = shader_watch.read(scratch) if data is None else None  # the shader the call died in, if any
+            return {"data": data, "why": why, "status": done.get("status", 0), "printed": printed, "shader": shader}
         finally:
             for fd in (r, w, out_fd):
                 if fd >= 0:
@@ -417,11 +424,13 @@ def status() -> str:
     if z.landlock:
         parts.append(f"Landlock file-system confinement (ABI {z.landlock})")
     if not parts:
-        return (
+        text = (
             "student code is process-isolated only (not root and no Landlock): it can read and write "
             "whatever this user can"
         )
-    return "student code " + " with ".join(parts)
+    else:
+        text = "student code " + " with ".join(parts)
+    return text + "".join(f"; {n}" for n in z.notes)
 
 
 def shutdown() -> None:
@@ -545,6 +554,12 @@ def call(
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)
+    if reply.get("shader"):
+        from geomlib.grading import shader_watch
+
+        reply["shader"] = shader_watch.timeout_message(
+            function, timeout, reply["shader"], [p for p in (stubs, snap) if p]
+        )
     return _outcome(function, reply, timeout, memory_mb, max_bytes)
 
 
@@ -559,6 +574,8 @@ def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_byt
                 f"{function} was stopped after {timeout:.3g} s when the time budget for the whole submission "
                 f"({_STATE['budget']:g} s) ran out; make the slow functions faster"
             )
+        if reply.get("shader"):
+            raise StudentTimeout(reply["shader"])
         raise StudentTimeout(
             f"{function} did not finish within {timeout:g} s (time limit); look for an infinite loop "
             f"or a Python loop over every vertex/pixel that should be vectorised"
@@ -576,6 +593,8 @@ def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_byt
                 "SIGKILL": "being killed (out of memory?)",
                 "SIGABRT": "an abort",
             }.get(sig, sig)
+            if sig == "SIGXCPU" and reply.get("shader"):  # llvmpipe's threads spent the CPU-time limit
+                raise StudentTimeout(reply["shader"])
             raise StudentCrash(f"{function} crashed the worker process with {what}.{tail}")
         code = os.WEXITSTATUS(st) if os.WIFEXITED(st) else "?"
         raise StudentCrash(

@@ -392,6 +392,9 @@ def run_call(
         send_json(fd, b"E", {"kind": "internal", "message": f"blacklist set-up failed: {e!r}"[:2000]})
         os._exit(0)
     try:
+        from geomlib.grading import shader_watch
+
+        shader_watch.install(os.environ.get("TMPDIR"))  # the call's scratch folder (zygote.confine)
         try:
             fn = find_function(lab_path, lab, function, Path(stubs_dir) if stubs_dir else None)
         except LookupError as e:
@@ -433,10 +436,14 @@ def vm_size_bytes() -> int:
         return 0
 
 
-def tasks_of_user(uid: int) -> int:
-    """Threads currently running as ``uid`` (what RLIMIT_NPROC counts)."""
+def tasks_of_user(uid: int) -> int | None:
+    """Threads currently running as ``uid`` (what RLIMIT_NPROC counts); None without /proc (macOS)."""
     n = 0
-    for name in os.listdir("/proc"):
+    try:
+        names = os.listdir("/proc")
+    except OSError:
+        return None
+    for name in names:
         if name.isdigit():
             try:
                 if os.stat(f"/proc/{name}").st_uid == uid:

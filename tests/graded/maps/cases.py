@@ -100,6 +100,7 @@ def mirrored_torus():
 
 def degenerate_uvs():
     V, F = datasets.icosphere(1)
+    V = V * np.array([1.0, 0.8, 0.6])  # an ellipsoid: on the unit sphere the normals are the positions
     UV = np.random.default_rng(7).random((len(V), 2))
     UV[F[:4].ravel()] = 0.5  # the first four triangles (and parts of their neighbours) have zero UV area
     return {"V": V, "F": F, "UV": UV}
@@ -248,6 +249,7 @@ CASES = [
         part="tangent frames",
         points=2,
         hint=FRAME_HINT,
+        trivial_outputs={"w": "no mirrored UVs on this mesh: w = +1 everywhere (tangents-mirrored-torus has w = -1)"},
     ),
     Case(
         id="tangents-uv-sphere",
@@ -258,6 +260,7 @@ CASES = [
         part="tangent frames",
         points=2,
         hint="weight each face's unit tangent by its area; the pole copies have their own UVs",
+        trivial_outputs={"w": "no mirrored UVs on this mesh: w = +1 everywhere (tangents-mirrored-torus has w = -1)"},
     ),
     Case(
         id="tangents-mirrored-torus",
@@ -268,6 +271,9 @@ CASES = [
         part="tangent frames",
         points=1,
         hint="mirrored UVs (det < 0) must give w = -1; dividing by a negative det flips dP/du",
+        trivial_outputs={
+            "w": "the whole UV layout is mirrored: w = -1 everywhere (the other tangent cases have w = +1)"
+        },
     ),
     Case(
         id="tangents-degenerate-uvs",

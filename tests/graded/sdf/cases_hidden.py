@@ -39,6 +39,17 @@ def _tri_cloud(n, m, seed):
     return make
 
 
+def _budget_rays():
+    """Rays that run out of a 6-step budget, and 20 that fall straight onto the ground in two steps
+    (far from the balls), so the step counts differ from ray to ray."""
+    rays = _rays("balls", 200, 117)()
+    x = np.random.default_rng(122).uniform(-3.0, -2.5, 20)
+    down = np.c_[x, np.linspace(-1.0, 1.0, 20), np.full(20, 2.0)]
+    rays["origins"] = np.r_[rays["origins"], down]
+    rays["directions"] = np.r_[rays["directions"], np.tile([0.0, 0.0, -1.0], (20, 1))]
+    return rays
+
+
 H = "hidden"
 
 CASES = [
@@ -306,7 +317,7 @@ CASES = [
     Case(
         id="hidden-trace-budget",
         function="sphere_trace",
-        inputs=_rays("balls", 200, 117),
+        inputs=_budget_rays,
         params={"max_steps": 6, "eps": 1e-4},
         outputs=("t", "hit", "steps"),
         check=checks.All(

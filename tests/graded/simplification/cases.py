@@ -84,10 +84,14 @@ def torus_chain():
 
 
 def height_field_boundary_pairs():
-    """Contractions along the boundary and into the interior of an open mesh."""
+    """Contractions along the boundary and into the interior of an open mesh.
+
+    The new positions are off the survivors' own (at them, the returned V would equal the input V).
+    """
     d = height_field()
     pairs = np.array([[0, 1], [2, 19], [272, 273]])  # boundary edge, boundary-interior edge, boundary edge
-    return {**d, "Q": random_quadrics(len(d["V"]), seed=6), "pairs": pairs, "positions": d["V"][pairs[:, 0]]}
+    positions = d["V"][pairs[:, 0]] + np.array([0.01, -0.02, 0.005])
+    return {**d, "Q": random_quadrics(len(d["V"]), seed=6), "pairs": pairs, "positions": positions}
 
 
 def simplify(make, target):
@@ -169,6 +173,10 @@ CASES = [
         points=2,
         hint="flat faces and creases make A singular: minimise along the segment, and when the cost is the same "
         "everywhere on it take the midpoint",
+        trivial_outputs={
+            "cost": "every edge of a box contracts onto its faces and creases exactly (cost 0); the point "
+            "here is the placement on singular quadrics, costs are graded on the noisy icosphere"
+        },
     ),
     # ---------------------------------------------------------------- Task 3: contraction
     Case(
@@ -202,6 +210,9 @@ CASES = [
         part="contraction",
         points=2,
         hint=CONTRACT_HINT + "; update vertex_faces so the next contraction sees the new faces of i",
+        trivial_outputs={
+            "removed": "a closed mesh: every contraction removes its edge's two faces (the boundary case has 1)"
+        },
     ),
     Case(
         id="contract-boundary-height-field",

@@ -89,6 +89,9 @@ CASES = [
         part="contraction",
         points=7,
         visibility="hidden",
+        trivial_outputs={
+            "removed": "a closed mesh: every contraction removes its edge's two faces (the boundary case has 1)"
+        },
     ),
     Case(
         id="hidden-simplify-ant-20pct",

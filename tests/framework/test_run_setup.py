@@ -1,0 +1,144 @@
+"""``./run``'s system-package step: who may install what (issue 28 item 2, issue 26 item 2).
+
+``./run`` runs with fake ``id``, ``sudo``, ``apt-get``, ``apt-cache`` and ``python3`` on a PATH that
+holds nothing else but the shell tools it uses (no ``ldconfig``: it lives in /sbin, off an ordinary
+user's PATH). The fake ``python3`` stops ``./run`` right after the system step (the bootstrap of uv
+is tested in test_bootstrap.py and the fresh-machine tests), and every fake records its calls.
+``GEOMLIB_LIB_DIRS`` names the only folders where ``./run`` may find libOSMesa.
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+TOOLS = ("bash", "grep", "mktemp", "cat", "rm", "uname", "tr", "dirname", "true")
+
+
+def _run(tmp_path: Path, *args: str, uid: int, has_osmesa: bool, sudo_ok: bool = False) -> tuple[str, list[str]]:
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in TOOLS:
+        found = shutil.which(t)
+        if not found:
+            pytest.skip(f"{t} is not installed")
+        (tools / t).symlink_to(found)
+    if has_osmesa:
+        (libs / "libOSMesa.so.8").write_text("")
+    log = tmp_path / "calls.log"
+    scripts = {
+        "id": f'[ "$1" = -u ] && echo {uid} || echo "uid={uid}"',
+        "sudo": f'echo "sudo $*" >> {log}; ' + ('[ "$1" = -n ] && shift; exec "$@"' if sudo_ok else "exit 1"),
+        "apt-get": f'echo "apt-get $*" >> {log}',
+        "apt-cache": 'echo "  Candidate: 1.0"',
+        "python3": f'echo "python3 $*" >> {log}; exit 1',
+    }
+    for name, body in scripts.items():
+        (fake / name).write_text(f"#!{shutil.which('bash')}\n{body}\n")
+        (fake / name).chmod(0o755)
+    env = {"PATH": f"{fake}:{tools}", "HOME": str(tmp_path), "GEOMLIB_LIB_DIRS": str(libs)}
+    p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1, p.stderr  # stopped by the fake python3, after the system step
+    calls = log.read_text().splitlines() if log.exists() else []
+    assert calls and calls[-1].startswith("python3 geomlib/grading/bootstrap.py uv"), (calls, p.stderr)
+    return p.stderr, calls[:-1]
+
+
+def test_an_ordinary_user_with_the_library_is_not_asked_anything(tmp_path):
+    """The library is there but ldconfig is not on the PATH: nothing to install, no sudo."""
+    err, calls = _run(tmp_path, "tests", "-q", "tests/graded/subdivision", uid=1000, has_osmesa=True)
+    assert [c for c in calls if c != "sudo -n true"] == [], calls
+    assert "installing" not in err and "sudo" not in err, err
+
+
+def test_an_ordinary_user_without_the_library_is_told_what_to_ask_for_and_goes_on(tmp_path):
+    err, calls = _run(tmp_path, "setup", uid=1000, has_osmesa=False)
+    assert [c for c in calls if c != "sudo -n true"] == [], calls  # no apt-get, no sudo apt-get
+    assert "libosmesa6" in err and "administrator" in err and "going on" in err, err
+
+
+def test_password_less_sudo_may_install_the_missing_library(tmp_path):
+    err, calls = _run(tmp_path, "setup", uid=1000, has_osmesa=False, sudo_ok=True)
+    assert any(c.startswith("apt-get install") and "libosmesa6" in c for c in calls), calls
+
+
+def test_root_installs_the_missing_library_quietly_and_no_browser_for_a_students_run(tmp_path):
+    err, calls = _run(tmp_path, "tests", "-q", "tests/graded/subdivision", uid=0, has_osmesa=False)
+    installs = [c for c in calls if c.startswith("apt-get install")]
+    assert len(installs) == 1 and "libosmesa6" in installs[0] and "chromium" not in installs[0], calls
+    assert "chromium" not in err, err
+
+
+def test_only_the_whole_suite_installs_the_browser(tmp_path):
+    for args, wants_browser in ((("setup",), False), (("figures",), False), (("tests",), True)):
+        d = tmp_path / "-".join(args)
+        d.mkdir()
+        err, calls = _run(d, *args, uid=0, has_osmesa=True)
+        browser = [c for c in calls if c.startswith("apt-get install") and "chromium" in c]
+        assert bool(browser) == wants_browser, (args, calls, err)
+
+
+def _run_with_fake_uv(
+    tmp_path: Path, *, python_found: bool, install_ok: bool
+) -> tuple[subprocess.CompletedProcess, list[str]]:
+    """``./run figures`` as root with the library present and a fake uv (``GEOMLIB_UV``) that
+    finds no supported Python unless ``python_found``; returns the result and uv's calls."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in (*TOOLS, "python3"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
+    log = tmp_path / "uv.log"
+    find = (
+        "exit 0"
+        if python_found
+        else 'echo "error: No interpreter found for Python >=3.10, <3.15 in managed installations or search path" >&2; exit 2'
+    )
+    uv = f"""echo "uv $*" >> {log}
+case "$1 $2" in
+  "python find") {find} ;;
+  "python install") exit {0 if install_ok else 1} ;;
+esac
+exit 0
+"""
+    bash = shutil.which("bash")
+    for name, body in {"id": "echo 0", "uv": uv, "apt-get": f'echo "apt-get $*" >> {log}'}.items():
+        (fake / name).write_text(f"#!{bash}\n{body}")
+        (fake / name).chmod(0o755)
+    env = {
+        "PATH": f"{fake}:{tools}",
+        "HOME": str(tmp_path),
+        "GEOMLIB_LIB_DIRS": str(libs),
+        "GEOMLIB_UV": str(fake / "uv"),
+    }
+    p = subprocess.run([str(ROOT / "run"), "figures"], env=env, capture_output=True, text=True, timeout=120)
+    return p, (log.read_text().splitlines() if log.exists() else [])
+
+
+def test_a_system_without_a_supported_python_gets_one_from_uv_and_is_told(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=False, install_ok=True)
+    assert p.returncode == 0, p.stderr
+    assert "no Python 3.10-3.14 on this machine: installing Python 3.12 with uv" in p.stderr
+    installs = [c for c in calls if c.startswith("uv python install")]
+    syncs = [c for c in calls if c.startswith("uv sync")]
+    assert installs and "3.12" in installs[0] and syncs and "--python >=3.10,<3.15" in syncs[0], calls
+    assert calls.index(installs[0]) < calls.index(syncs[0])
+
+
+def test_when_uv_cannot_download_a_python_the_message_says_what_to_install(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=False, install_ok=False)
+    assert p.returncode == 1
+    assert "github.com" in p.stderr and "install Python 3.10-3.14 yourself" in p.stderr, p.stderr
+    assert not [c for c in calls if c.startswith("uv sync")], calls
+
+
+def test_a_supported_system_python_is_used_as_it_is(tmp_path):
+    p, calls = _run_with_fake_uv(tmp_path, python_found=True, install_ok=True)
+    assert p.returncode == 0, p.stderr
+    assert not [c for c in calls if c.startswith("uv python install")] and "Python" not in p.stderr, calls
