@@ -476,6 +476,19 @@ def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
     return stubs
 
 
+def _not_allowed(lab: str) -> dict[str, str]:
+    """The lab's blacklist (:mod:`geomlib.grading.blacklist`), read once per run."""
+    from geomlib.grading import blacklist, impl
+
+    key = ("not_allowed", str(impl.tests_dir()), lab)
+    if key not in _STATE:
+        try:
+            _STATE[key] = blacklist.declared(lab)
+        except (OSError, SyntaxError, ValueError) as e:
+            raise GraderError(f"grader problem (not your code): the lab's blacklist cannot be read ({e})") from None
+    return _STATE[key]
+
+
 def _input_bytes(args, kwargs) -> int:
     import numpy as np
 
@@ -539,6 +552,7 @@ def call(
             "cpu_s": timeout,
             "cwd": str(snap),
             "read": [str(snap)] + ([str(stubs)] if stubs else []),
+            "not_allowed": _not_allowed(lab),
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)

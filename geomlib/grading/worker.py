@@ -36,7 +36,7 @@ import traceback
 import types
 from pathlib import Path
 
-from geomlib.grading import wire
+from geomlib.grading import blacklist, wire
 
 __all__ = ["find_function", "merge_module", "task_names", "run_call", "describe_exception"]
 
@@ -214,6 +214,8 @@ class _MergedLoader(importlib.abc.Loader):
         module.__file__ = str(self.student_path if self.student_path is not None else self.stub_path)
         for stmt, filename in pieces:
             code = compile(ast.Module(body=[stmt], type_ignores=[]), filename, "exec", flags=flags, dont_inherit=True)
+            if filename == str(self.stub_path):
+                blacklist.given(code)  # given code may call what the lab forbids the student
             exec(code, module.__dict__)
 
 
@@ -375,9 +377,20 @@ def send_json(fd: int, tag: bytes, obj: dict) -> None:
     send(fd, tag + json.dumps(obj, ensure_ascii=True).encode())
 
 
-def run_call(fd: int, lab_dir: str, lab: str, function: str, args, kwargs, stubs_dir: str | None = None) -> None:
-    """Find and call ``function`` in an already confined worker, send the outcome to ``fd``, exit."""
+def run_call(
+    fd: int, lab_dir: str, lab: str, function: str, args, kwargs, stubs_dir: str | None = None, not_allowed=None
+) -> None:
+    """Find and call ``function`` in an already confined worker, send the outcome to ``fd``, exit.
+
+    ``not_allowed``: the lab's blacklist (:mod:`geomlib.grading.blacklist`), guarded before the
+    submission is imported.
+    """
     lab_path = Path(lab_dir)
+    try:
+        blacklist.install(lab, lab_dir, not_allowed)
+    except Exception as e:  # noqa: BLE001 - the grader's problem, not the student's
+        send_json(fd, b"E", {"kind": "internal", "message": f"blacklist set-up failed: {e!r}"[:2000]})
+        os._exit(0)
     try:
         from geomlib.grading import shader_watch
 

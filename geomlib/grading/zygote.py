@@ -304,7 +304,8 @@ def _worker_main(req: dict, blob: bytes, result_fd: int, out_fd: int) -> None:
             _worker.send_json(result_fd, b"E", {"kind": "internal", "message": f"sandbox set-up failed: {e!r}"[:2000]})
         finally:
             os._exit(0)
-    _worker.run_call(result_fd, req["lab_dir"], req["lab"], req["function"], args, kwargs, req.get("stubs_dir"))
+    extra = (req.get("stubs_dir"), req.get("not_allowed"))  # not_allowed: the lab's blacklist
+    _worker.run_call(result_fd, req["lab_dir"], req["lab"], req["function"], args, kwargs, *extra)
 
 
 # ---------------------------------------------------------------------------------- the server
