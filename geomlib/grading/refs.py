@@ -110,9 +110,9 @@ def _entry(case: Case, digest: str, arrays: dict) -> dict:
     }
 
 
-def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> list[Path]:
-    """Write the manifests that changed; returns them."""
-    written = []
+def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> Written:
+    """Write the manifests that changed; returns them (the others counted in ``unchanged``)."""
+    written = Written()
     for key, entries in manifests.items():
         folder = folders[key]
         if not entries:
@@ -131,6 +131,8 @@ def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> lis
         if not path.is_file() or path.read_text() != text:
             path.write_text(text)
             written.append(path)
+        else:
+            written.unchanged += 1
     return written
 
 
@@ -153,9 +155,11 @@ def _build_outputs(lab: str, cases, path_of, folders: dict, note: str, log) -> W
         path.write_bytes(data)
         written.append(path)
         log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
-    for path in _write_manifests(lab, manifests, folders, note):
+    manifest_files = _write_manifests(lab, manifests, folders, note)
+    for path in manifest_files:
         written.append(path)
         log(f"  {path.relative_to(ref)}")
+    written.unchanged += manifest_files.unchanged
     return written
 
 
