@@ -87,17 +87,18 @@ def _cmd_render(a) -> int:
 
 
 #: The files ``geomlib refs|stubs build|check`` make from solutions/ (a module of geomlib.grading with
-#: ``build(labs)`` and ``check(labs)``), and how their reports read: ``built`` with ``{n}`` files and
-#: ``{seconds}``, ``problem`` with one problem ``{p}``, ``stale`` with ``{n}`` problems.
+#: ``build(labs)`` and ``check(labs, **check_options)``), and how their reports read: ``built`` with
+#: ``{n}`` files written (changed), ``{same}`` unchanged and ``{seconds}``, ``problem`` with one
+#: problem ``{p}``, ``stale`` with ``{n}`` problems.
 _GENERATED = {
     "refs": dict(
-        built="wrote {n} reference files in {seconds:.1f} s",
+        built="{n} reference file(s) written (changed), {same} unchanged, in {seconds:.1f} s",
         problem="FAIL {p.lab}/{p.case}: {p.message}",
         ok="references OK",
         stale="{n} reference problem(s)",
     ),
     "stubs": dict(
-        built="{n} stub files up to date in labs/",
+        built="labs/: {n} stub file(s) written (changed), {same} unchanged",
         problem="STALE {p}",
         ok="labs/ is up to date",
         stale="labs/ is stale: run `geomlib stubs build`",
@@ -107,16 +108,17 @@ _GENERATED = {
 
 def _cmd_generated(a) -> int:
     """``build``: regenerate what ``a.command`` makes from solutions/; ``check``: print each difference
-    and exit 1 if there is any."""
+    (stubs: with its diff; refs: and every graded test the solutions fail) and exit 1 if there is any."""
     tool = importlib.import_module(f"geomlib.grading.{a.command}")
     report = _GENERATED[a.command]
     labs = [a.lab] if a.lab else None
     if a.action == "build":
         t = time.time()
         files = tool.build(labs)
-        print(report["built"].format(n=len(files), seconds=time.time() - t))
+        print(report["built"].format(n=len(files), same=getattr(files, "unchanged", 0), seconds=time.time() - t))
         return 0
-    problems = tool.check(labs)
+    options = {"grade": not a.no_grade} if a.command == "refs" else {"diff": True}
+    problems = tool.check(labs, **options)
     for p in problems:
         print(report["problem"].format(p=p))
     print(report["stale"].format(n=len(problems)) if problems else report["ok"])
@@ -146,7 +148,7 @@ def _cmd_release(a) -> int:
 
     t = time.time()
     try:
-        release.release(Path(a.out), a.lab)
+        release.release(Path(a.out), a.lab, check=not a.no_check)
     except (release.ReleaseError, OSError) as e:
         print(f"geomlib release: error: {e}", file=sys.stderr)
         return 1
@@ -230,6 +232,11 @@ def build_parser() -> argparse.ArgumentParser:
     rf = sub.add_parser("refs", help="reference outputs: build from solutions/, or check they are reproduced")
     rf.add_argument("action", choices=["build", "check"])
     rf.add_argument("--lab")
+    rf.add_argument(
+        "--no-grade",
+        action="store_true",
+        help="check: compare with the references only, without grading the solutions on every graded test",
+    )
     rf.set_defaults(func=_cmd_generated)
 
     st = sub.add_parser("stubs", help="regenerate labs/ from solutions/, or check labs/ is up to date")
@@ -254,6 +261,12 @@ def build_parser() -> argparse.ArgumentParser:
     rl = sub.add_parser("release", help="write the student bundle and one Gradescope autograder zip per lab")
     rl.add_argument("out", help="output folder")
     rl.add_argument("--lab", action="append", help="only this lab (repeatable; default: every lab)")
+    rl.add_argument(
+        "--no-check",
+        action="store_true",
+        help="skip grading the solutions (public and hidden tests) before releasing; by default a lab "
+        "whose solutions do not score full marks is not released",
+    )
     rl.set_defaults(func=_cmd_release)
 
     ga = sub.add_parser(

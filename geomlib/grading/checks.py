@@ -46,6 +46,9 @@ class Context:
         Appended to failure messages ("check the even-vertex weights").
     feedback_dir : Path or None
         Where feedback pictures go (``feedback/<lab>/``); None disables pictures.
+    got_name, got_owner : str
+        How messages name the output under test: ``"submitted"`` vertex of ``"the submission"``
+        (``geomlib refs check``: ``"recomputed"``, ``"the solution"``).
     """
 
     label: str
@@ -53,6 +56,8 @@ class Context:
     case_id: str = ""
     hint: str | None = None
     feedback_dir: Path | None = None
+    got_name: str = "submitted"
+    got_owner: str = "the submission"
 
     def fail(self, what: str, feedback: str | None = None):
         msg = f"{self.label}: {what}"
@@ -248,12 +253,14 @@ class MeshMatch:
         if off.any():
             i = int(np.flatnonzero(off)[0])
             ctx.fail(
-                f"expected a vertex at {format_vec(Ve[i])}, nearest submitted vertex is {format_vec(Vg[j[i]])} "
+                f"expected a vertex at {format_vec(Ve[i])}, nearest {ctx.got_name} vertex is {format_vec(Vg[j[i]])} "
                 f"(distance {d[i]:.3g}); {int(off.sum())} of {len(Ve)} expected vertices have no match within {self.atol:g}",
                 self._picture(Ve, Fe, Vg, Fg, ctx),
             )
         if len(np.unique(j)) != len(j):
-            ctx.fail("several expected vertices match the same submitted vertex: the submission has duplicate vertices")
+            ctx.fail(
+                f"several expected vertices match the same {ctx.got_name} vertex: {ctx.got_owner} has duplicate vertices"
+            )
         to_expected = np.empty(len(Vg), dtype=np.int64)
         to_expected[j] = np.arange(len(Ve))
         Fm = _canonical_faces(to_expected[Fg.astype(np.int64)])
@@ -290,7 +297,7 @@ class SurfaceDistance:
         try:
             dist = geometry.mesh_distance(Ve, Fe, Vg, Fg)
         except ValueError as e:
-            ctx.fail(f"the submitted mesh is not valid ({e})")
+            ctx.fail(f"the {ctx.got_name} mesh is not valid ({e})")
         value = float(dist[self.metric])
         if value > self.rel_tol:
             ctx.fail(

@@ -15,7 +15,12 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import os
 import platform
+import re
+import subprocess
+import sys
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -25,8 +30,9 @@ from geomlib.grading import impl as _impl
 from geomlib.grading.cases import Case, inputs_digest, load_cases, load_stored, reference_path, stored_path
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import GradingFailure
+from geomlib.grading.stubs import Written
 
-__all__ = ["build", "check", "RefProblem"]
+__all__ = ["build", "check", "graded_failures", "RefProblem"]
 
 
 @dataclass
@@ -104,7 +110,9 @@ def _entry(case: Case, digest: str, arrays: dict) -> dict:
     }
 
 
-def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> None:
+def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> Written:
+    """Write the manifests that changed; returns them (the others counted in ``unchanged``)."""
+    written = Written()
     for key, entries in manifests.items():
         folder = folders[key]
         if not entries:
@@ -118,52 +126,112 @@ def _write_manifests(lab: str, manifests: dict, folders: dict, note: str) -> Non
             "versions": _versions(),
             "cases": entries,
         }
-        (folder / "manifest.json").write_text(json.dumps(manifest, indent=1, sort_keys=True) + "\n")
+        text = json.dumps(manifest, indent=1, sort_keys=True) + "\n"
+        path = folder / "manifest.json"
+        if not path.is_file() or path.read_text() != text:
+            path.write_text(text)
+            written.append(path)
+        else:
+            written.unchanged += 1
+    return written
 
 
-def _build_outputs(lab: str, cases, path_of, folders: dict, note: str, log) -> list[Path]:
+def _build_outputs(lab: str, cases, path_of, folders: dict, note: str, log) -> Written:
     """Run the solution on each case, write one ``.npz`` per case at ``path_of(lab, case)`` and the
-    public/hidden manifests into ``folders``; return the files written."""
+    public/hidden manifests into ``folders``; return the files written. A file that already holds the
+    same bytes is left untouched (counted in ``unchanged``), so only what changed is listed."""
     ref = _impl.reference_dir()
-    written = []
+    written = Written()
     manifests = {False: {}, True: {}}
     for case in cases:
         arrays, digest = _run_solution(lab, case)
         path = path_of(lab, case)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(_npz_bytes(arrays))
-        written.append(path)
+        data = _npz_bytes(arrays)
         manifests[case.hidden][case.id] = _entry(case, digest, arrays)
+        if path.is_file() and path.read_bytes() == data:
+            written.unchanged += 1
+            continue
+        path.write_bytes(data)
+        written.append(path)
         log(f"  {path.relative_to(ref)}  {', '.join(f'{k}{list(a.shape)}' for k, a in arrays.items())}")
-    _write_manifests(lab, manifests, folders, note)
+    manifest_files = _write_manifests(lab, manifests, folders, note)
+    for path in manifest_files:
+        written.append(path)
+        log(f"  {path.relative_to(ref)}")
+    written.unchanged += manifest_files.unchanged
     return written
 
 
-def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
+def build(labs: list[str] | None = None, *, log=print) -> Written:
     """Run the solutions on every stored input and every declared case and store the outputs.
 
     Stored inputs (``STORED``) are built first, in order, since cases' inputs may read them.
-    Returns the files written.
+    Returns the files written (those whose content changed), listed through ``log``; the number
+    of files left unchanged is its ``unchanged`` attribute.
     """
     labs = labs or _impl.lab_names()
-    written = []
+    written = Written()
     ref = _impl.reference_dir()
     for lab in labs:
         stored = load_stored(lab)
+        parts = []
         if stored:  # before the cases, whose inputs may read them
             folders = {False: ref / lab / "inputs", True: ref / lab / "hidden" / "inputs"}
             note = "inputs of graded tests, from solutions/; do not edit by hand"
-            written += _build_outputs(lab, stored, stored_path, folders, note, log)
+            parts.append(_build_outputs(lab, stored, stored_path, folders, note, log))
         cases = load_cases(lab)
         if cases:
             folders = {False: ref / lab, True: ref / lab / "hidden"}
             note = "generated from solutions/; do not edit by hand"
-            written += _build_outputs(lab, cases, reference_path, folders, note, log)
+            parts.append(_build_outputs(lab, cases, reference_path, folders, note, log))
+        for part in parts:
+            written += part
+            written.unchanged += part.unchanged
     return written
 
 
-def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
-    """Re-run the solutions and compare with the stored references using each case's own check."""
+def graded_failures(lab: str, *, timeout: float = 3600) -> tuple[float, float, list[tuple[str, str]]]:
+    """Grade the solutions of ``lab`` on its graded tests, public and hidden, through the sandbox, as
+    ``geomlib grade --impl solutions --lab LAB`` does (in a fresh process: a grading session imports
+    the lab's test modules, which must not linger in the caller).
+
+    Returns
+    -------
+    score, max_score : float
+    failures : list of (test, message)
+        The tests that do not pass (named as in the score table, without the lab), with the first
+        line of their message.
+    """
+    root = _impl.course_root()
+    env = {**os.environ, "GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
+    env.pop("GEOMLIB_IMPL", None)
+    with tempfile.TemporaryDirectory(prefix="geomlib-solutions-") as tmp:
+        results = Path(tmp) / "results.json"
+        cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", "solutions", "--lab", lab]
+        cmd += ["--results", str(results), "--feedback", str(Path(tmp) / "feedback")]
+        p = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout)
+        if p.returncode != 0 or not results.is_file():
+            tail = (p.stdout + p.stderr).strip().splitlines()[-12:]
+            raise RuntimeError(f"grading the solutions of {lab} failed (exit {p.returncode}):\n" + "\n".join(tail))
+        data = json.loads(results.read_text())
+    tests = data.get("tests", [])
+    failures = []
+    for t in tests:
+        if t.get("status") != "passed" or t.get("score", 0) < t.get("max_score", 0):
+            name = t["name"].removeprefix(f"{lab} › ")
+            message = re.sub(r"\\([\\`*_{}\[\]()#+\-.!|<>])", r"\1", (t.get("output") or "failed").strip())
+            message = message.splitlines()[0]  # the results' Markdown escapes undone: read in a terminal
+            failures.append((name, message[:240] + ("…" if len(message) > 240 else "")))
+    if not tests:
+        failures.append(("(no test)", data.get("output", "no graded test ran")[:240]))
+    return float(data.get("score", 0.0)), float(sum(t.get("max_score", 0.0) for t in tests)), failures
+
+
+def check(labs: list[str] | None = None, *, grade: bool = True, log=print) -> list[RefProblem]:
+    """Re-run the solutions and compare with the stored references using each case's own check;
+    with ``grade``, also grade the solutions on every graded test (:func:`graded_failures`) and
+    report each test they fail (hand-written tests hold expected values no reference rebuild moves)."""
     labs = labs or _impl.lab_names()
     problems: list[RefProblem] = []
     for lab in labs:
@@ -187,11 +255,13 @@ def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
                 continue
             with np.load(path, allow_pickle=False) as z:
                 stored = {k: z[k] for k in z.files}
-            ctx = Context(label=f"{lab}/{case.id}", lab=lab, case_id=case.id)
+            # Worded for the solution (not "submitted"); the case is named once, by the report line.
+            ctx = Context(label=case.id, lab=lab, case_id=case.id, got_name="recomputed", got_owner="the solution")
             try:
                 case.check(stored, arrays, ctx)
             except GradingFailure as e:
-                problems.append(RefProblem(lab, case.id, f"the solution no longer reproduces the reference: {e}"))
+                what = str(e).removeprefix(f"{ctx.label}: ")
+                problems.append(RefProblem(lab, case.id, f"the solution no longer reproduces the reference: {what}"))
         # Reference files for which no case exists any more.
         known = {(c.hidden, c.id) for c in cases}
         known_inputs = {(c.hidden, c.id) for c in inputs}
@@ -204,4 +274,8 @@ def check(labs: list[str] | None = None, *, log=print) -> list[RefProblem]:
                 if (hidden, f.stem) not in known_inputs:
                     problems.append(RefProblem(lab, f.stem, f"stale stored input {f.name} has no STORED entry"))
         log(f"  {lab}: {len(inputs)} stored inputs and {len(cases)} cases checked")
+        if grade:
+            score, out_of, failures = graded_failures(lab)
+            problems += [RefProblem(lab, name, f"the solution fails this graded test: {msg}") for name, msg in failures]
+            log(f"  {lab}: the solutions score {score:g} / {out_of:g} on the graded tests (public and hidden)")
     return problems

@@ -22,14 +22,24 @@ import json
 import os
 import shutil
 import stat
+import subprocess
 import tempfile
+import time
 import zipfile
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import stubs
 
-__all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secret_lines", "ReleaseError"]
+__all__ = [
+    "release",
+    "check_solutions",
+    "student_files",
+    "autograder_files",
+    "leaked_lines",
+    "secret_lines",
+    "ReleaseError",
+]
 
 _SKIP_DIRS = {"__pycache__", ".ipynb_checkpoints", ".pytest_cache", ".ruff_cache"}
 _TOP_FILES = ["pyproject.toml", "uv.lock", "run", ".python-version", ".dockerignore"]
@@ -329,7 +339,39 @@ def _check_course(root: Path, labs: list[str]) -> None:
             )
 
 
-def release(out: str | os.PathLike, labs: list[str] | None = None, *, log=print) -> dict[str, Path]:
+def check_solutions(labs: list[str], *, log=print) -> None:
+    """Grade the solutions of each lab on its graded tests, public and hidden, through the sandbox
+    (:func:`geomlib.grading.refs.graded_failures`); raise :class:`ReleaseError` naming the failing
+    tests of every lab whose solutions do not score full marks (as ``otter assign`` refuses an
+    assignment whose solution fails its tests). A rebuilt reference follows a changed solution, a
+    hand-written test does not: this is where a broken solution shows."""
+    from geomlib.grading import refs
+
+    broken = []
+    for lab in labs:
+        t = time.time()
+        try:
+            score, out_of, failures = refs.graded_failures(lab)
+        except (RuntimeError, OSError, subprocess.SubprocessError) as e:
+            raise ReleaseError(f"{lab}: the solutions could not be graded: {e}") from None
+        log(f"  {lab}: the solutions score {score:g} / {out_of:g} (public and hidden tests, {time.time() - t:.0f} s)")
+        if failures:
+            lines = [f"    {name}: {msg}" for name, msg in failures[:12]]
+            if len(failures) > 12:
+                lines.append(f"    … and {len(failures) - 12} more")
+            broken.append(
+                f"{lab}: the solutions score {score:g} / {out_of:g} on their own tests; "
+                f"{len(failures)} test(s) fail:\n" + "\n".join(lines)
+            )
+    if broken:
+        raise ReleaseError(
+            "a release would ship a broken solution\n"
+            + "\n".join(broken)
+            + "\nfix the solution (or the test), then `geomlib refs check --lab LAB` lists what still fails"
+        )
+
+
+def release(out: str | os.PathLike, labs: list[str] | None = None, *, check: bool = True, log=print) -> dict[str, Path]:
     """Write the student bundle and one autograder zip per lab into ``out``; returns their paths.
 
     Parameters
@@ -338,12 +380,15 @@ def release(out: str | os.PathLike, labs: list[str] | None = None, *, log=print)
         Output folder (created if needed). Earlier outputs of the same names are replaced.
     labs : list of str, optional
         Labs to release (default: every lab with a solution).
+    check : bool
+        Grade the solutions of each lab first (:func:`check_solutions`; ``geomlib release --no-check``
+        skips it, for packaging only).
 
     Raises
     ------
     ReleaseError
-        When a lab is unknown, ``labs/`` is stale, references are missing or a solution line would
-        reach students. ``out`` is then left as it was.
+        When a lab is unknown, ``labs/`` is stale, references are missing, the solutions fail a
+        graded test or a solution line would reach students. ``out`` is then left as it was.
     """
     root = _impl.course_root()
     labs = _labs(root, labs)
@@ -364,6 +409,8 @@ def release(out: str | os.PathLike, labs: list[str] | None = None, *, log=print)
                 f"{len(leaks)} solution line(s) would reach students, e.g. {f}: {line!r} (from {task}); "
                 f"move that code into a solution block's stored reference or the library"
             )
+        if check:  # the slowest check last: after the quick ones, before anything is in place
+            check_solutions(labs, log=log)
         with zipfile.ZipFile(tmp / "student.zip", "w") as z:
             _zip_tree(z, student, "student/")
         made = {"student": out / "student", "student_zip": out / "student.zip"}

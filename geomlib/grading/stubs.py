@@ -21,6 +21,7 @@ block becomes ``#error Task ...``, so the stub shader does not compile and names
 
 from __future__ import annotations
 
+import difflib
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -156,13 +157,21 @@ def _pairs(labs: list[str] | None):
             yield lab, f, lab_root / lab / f.relative_to(src)
 
 
-def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
-    """Regenerate the ``.py`` files of ``labs/<lab>/`` from ``solutions/<lab>/``; returns files written.
+class Written(list):
+    """The files a ``build`` wrote (those whose content changed); ``unchanged`` counts the files that
+    already held what it would write (left untouched, so git and timestamps do not move)."""
+
+    unchanged: int = 0
+
+
+def build(labs: list[str] | None = None, *, log=print) -> Written:
+    """Regenerate the ``.py`` files of ``labs/<lab>/`` from ``solutions/<lab>/``; returns the files
+    written (changed), their ``unchanged`` count as an attribute.
 
     Stub ``.py`` files with no solution counterpart are removed; other files in ``labs/`` (the
     handout README, data) are left alone.
     """
-    written = []
+    written = Written()
     expected: dict[str, set[Path]] = {}
     for lab, src, dst in _pairs(labs):
         stub = make_stub(src.read_text(), str(src.relative_to(_impl.course_root())))
@@ -170,7 +179,9 @@ def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
         if not dst.is_file() or dst.read_text() != stub:
             dst.write_text(stub)
             log(f"  wrote {dst.relative_to(_impl.course_root())}")
-        written.append(dst)
+            written.append(dst)
+        else:
+            written.unchanged += 1
         expected.setdefault(lab, set()).add(dst)
     for lab, files in expected.items():
         for f in (_impl.course_root() / "labs" / lab).rglob("*"):
@@ -180,8 +191,9 @@ def build(labs: list[str] | None = None, *, log=print) -> list[Path]:
     return written
 
 
-def check(labs: list[str] | None = None) -> list[str]:
-    """Problems that make ``labs/`` stale: missing, differing or extra stub files."""
+def check(labs: list[str] | None = None, *, diff: bool = False) -> list[str]:
+    """Problems that make ``labs/`` stale: missing, differing or extra stub files. With ``diff``, a
+    differing file's problem is followed by the unified diff from ``labs/`` to the generated stub."""
     problems = []
     seen: dict[str, set[Path]] = {}
     for lab, src, dst in _pairs(labs):
@@ -189,8 +201,19 @@ def check(labs: list[str] | None = None) -> list[str]:
         rel = dst.relative_to(_impl.course_root())
         if not dst.is_file():
             problems.append(f"{rel} is missing")
-        elif dst.read_text() != make_stub(src.read_text(), str(src)):
-            problems.append(f"{rel} differs from the stub generated from {src.relative_to(_impl.course_root())}")
+            continue
+        have, want = dst.read_text(), make_stub(src.read_text(), str(src))
+        if have != want:
+            problem = f"{rel} differs from the stub generated from {src.relative_to(_impl.course_root())}"
+            if diff:
+                lines = difflib.unified_diff(
+                    have.splitlines(keepends=True),
+                    want.splitlines(keepends=True),
+                    f"{rel} (in labs/)",
+                    f"{rel} (generated from solutions/)",
+                )
+                problem += "\n" + "".join(ln if ln.endswith("\n") else ln + "\n" for ln in lines).rstrip("\n")
+            problems.append(problem)
     for lab, files in seen.items():
         for f in (_impl.course_root() / "labs" / lab).rglob("*"):
             if f.suffix in STUB_SUFFIXES and f not in files and "__pycache__" not in f.parts:

@@ -198,6 +198,14 @@ def test_correct_blocks_point_at_the_composite_itself():
 
 @pytest.mark.parametrize("lab", _impl.lab_names())
 def test_declared_task_tables_match_the_solutions(lab):
+    """Every lab declares its table (without one, ``tasks.table`` derives it from the solutions and this
+    test would compare the derived table with itself; a student's copy has no solutions, and the stubs
+    lose the composites' calls) and the declaration matches the solutions' markers."""
+    module = _tasks._declared(lab)
+    assert module is not None and hasattr(module, "TASKS"), (
+        f"tests/graded/{lab}/diagnose.py declares no task table (TASKS, TITLES, COMPOSITES): print it with "
+        f'geomlib.grading.tasks.derive("solutions/{lab}")'
+    )
     declared = _tasks.table(lab)
     derived = _tasks.derive(_impl.course_root() / "solutions" / lab)
     assert declared.tasks == derived.tasks

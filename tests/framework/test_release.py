@@ -152,7 +152,8 @@ def test_generic_lines_of_a_solution_block_are_not_leaks(sample_course):
     task1 = next(v for k, v in secrets.items() if "Task 1" in k)
     assert "c = V.mean(axis=0)" in task1 and "if tol is None:" not in task1 and "return False" not in task1
     out = root.parent / "dist"
-    p = run_geomlib(root, "release", str(out), check=False)
+    # packaging only: the planted lines break the solution, which the release check would refuse
+    p = run_geomlib(root, "release", str(out), "--no-check", check=False)
     assert p.returncode == 0, p.stdout + p.stderr
 
 

@@ -33,6 +33,7 @@ from solutions.subdivision import (
     loop_subdivide,
     loop_weight,
 )
+from tests.graded.subdivision.support import RULES
 
 # --------------------------------------------------------------------------- meshes
 
@@ -583,3 +584,31 @@ def test_order_matches_unique_edges_and_igl_keeps_old_vertices_first():
             opp[(min(a, b), max(a, b))].append(c)
     expected = np.array([3 / 8 * (V[a] + V[b]) + 1 / 8 * V[opp[(a, b)]].sum(0) for a, b in E.tolist()])
     np.testing.assert_allclose(V1[len(V) :], expected, atol=1e-14)
+
+
+@pytest.mark.parametrize("rule", list(RULES))
+def test_the_solution_follows_the_rule(rule):
+    """Each rule of the handout, as the graded tests' one place states it (``support.RULES``): a
+    deliberate change of a rule in the solution fails here, named, as well as in the graded tests."""
+    from tests.graded.subdivision.support import SQUARE_F, SQUARE_V, TET_F, TET_V
+
+    given = RULES[rule]
+    if rule.startswith("odd interior"):  # tetrahedron: every edge interior, opposite = the other two
+        S = sp.csr_matrix(loop_odd_matrix(TET_V, TET_F)).toarray()
+        E = topology.unique_edges(TET_F)
+        expected = np.full((len(E), 4), given[1])
+        expected[np.arange(len(E))[:, None], E] = given[0]
+    elif rule.startswith("odd boundary"):  # split square: the four boundary edges
+        S = sp.csr_matrix(loop_odd_matrix(SQUARE_V, SQUARE_F)).toarray()
+        E = topology.unique_edges(SQUARE_F)
+        rows = [i for i, (a, b) in enumerate(E.tolist()) if (a, b) != (0, 2)]
+        S, expected = S[rows], np.zeros((len(rows), 4))
+        expected[np.arange(len(rows))[:, None], E[rows]] = given[0]
+    elif rule.startswith("even boundary"):  # split square: 0's boundary neighbours are 1 and 3
+        S = sp.csr_matrix(loop_even_matrix(SQUARE_V, SQUARE_F, "loop")).toarray()[:1]
+        expected = np.array([[given[0], given[1], 0, given[1]]])
+    else:
+        weights, formula = given
+        n = np.arange(3, 13)
+        S, expected = np.asarray(loop_weight(n, weights)), formula(n)
+    assert np.allclose(S, expected, atol=1e-14), f"the solution breaks the rule {rule}:\n{S}\nexpected\n{expected}"

@@ -8,10 +8,12 @@ thresholds set from runs of the reference solution with a margin (numbers beside
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from geomlib import datasets, topology
 from geomlib.geometry import mesh_distance, triangle_quality
 from geomlib.grading import checks, expect_raises
+from geomlib.grading.cases import stored_input
 
 #: Unit square of two triangles, diagonal 0-2, facing +z.
 SQUARE_V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
@@ -129,10 +131,16 @@ def spheroid(level=3, axes=(1.5, 0.6, 0.6)):
     return V * np.asarray(axes), F
 
 
-def adaptive_check(make, *, min_angle, hausdorff, tip_ratio):
+def adaptive_check(make, *, targets, min_angle, hausdorff, tip_ratio, length_tol=0.25):
     """A check for adaptive ``isotropic_remesh`` outputs on a shape stretched along x: validity, the
-    minimum angle, Hausdorff distance, and edges at the tips (|x| > 0.8 max |x|) shorter than at the
-    waist (|x| < 0.2 max |x|) by at least ``tip_ratio`` (a uniform remesh gives about 1)."""
+    minimum angle, Hausdorff distance, edges as long as their targets, and edges at the tips
+    (|x| > 0.8 max |x|) shorter than at the waist (|x| < 0.2 max |x|) by at least ``tip_ratio`` (a
+    uniform remesh gives about 1).
+
+    ``targets`` names the ``STORED`` per-vertex target lengths of the input (``adaptive_target_length``,
+    stored by ``geomlib refs build``): an edge's target is the smaller of its ends' targets, a result
+    vertex taking the target of the nearest input vertex; the mean of length / target must be within
+    ``length_tol`` of 1 (the input itself, unchanged: 1.5 and 2.1)."""
 
     def fn(expected, got, ctx):
         d = make()
@@ -145,6 +153,13 @@ def adaptive_check(make, *, min_angle, hausdorff, tip_ratio):
         e = np.linalg.norm(V[ends[:, 0]] - V[ends[:, 1]], axis=1)
         x = np.abs(V[ends, 0].mean(axis=1))
         tips, waist = e[x > 0.8 * x.max()].mean(), e[x < 0.2 * x.max()].mean()
+        target = stored_input("remeshing", targets)["lengths"][cKDTree(d["V"]).query(V)[1]]
+        ratio = float(np.mean(e / np.minimum(target[ends[:, 0]], target[ends[:, 1]])))
+        if abs(ratio - 1) > length_tol:
+            return (
+                f"edges are on average {ratio:.3g} times their target length (the smaller of the "
+                f"adaptive_target_length of their ends), needs within {length_tol:.0%} of 1"
+            )
         if q["min_angle"] < min_angle:
             return f"min_angle = {q['min_angle']:.3g}, needs >= {min_angle:g}"
         if q["hausdorff"] > hausdorff:

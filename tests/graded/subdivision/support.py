@@ -14,6 +14,42 @@ from geomlib.grading import tolerances as tol
 from geomlib.grading.checks import format_vec, nonfinite_problem
 
 # --------------------------------------------------------------------------------------------
+# the handout's rules (labs/subdivision/README.md), in one place
+
+#: Odd vertex of an interior edge (a, b) with opposite vertices c, d: ``3/8 (a + b) + 1/8 (c + d)``.
+ODD_ENDS, ODD_OPPOSITE = 3 / 8, 1 / 8
+#: Odd vertex of a boundary edge: the midpoint.
+ODD_BOUNDARY = 1 / 2
+#: Even boundary vertex v with boundary neighbours p, q: ``3/4 v + 1/8 (p + q)``.
+EVEN_BOUNDARY_SELF, EVEN_BOUNDARY_NEIGHBOUR = 3 / 4, 1 / 8
+
+
+def warren_weight(n):
+    """Warren's even weight ``u(n) = 3/16 if n == 3 else 3/(8n)``."""
+    n = np.asarray(n, dtype=float)
+    return np.where(n == 3, 3 / 16, 3 / (8 * n))
+
+
+def loop_beta(n):
+    """Loop's even weight ``β(n) = (1/n) (5/8 - (3/8 + 1/4 cos(2π/n))²)``."""
+    n = np.asarray(n, dtype=float)
+    return (5 / 8 - (3 / 8 + np.cos(2 * np.pi / n) / 4) ** 2) / n
+
+
+#: Each rule by the handout's formula: the hand-written tests build their expected weights from the
+#: constants above, and ``tests/solutions/test_subdivision.py::test_the_solution_follows_the_rule``
+#: checks the reference solution against each, so a deliberate change of a rule fails there, in one
+#: test named after it (change the constant here and the handout with it).
+RULES = {
+    "odd interior edge: 3/8 (a + b) + 1/8 (c + d)": (ODD_ENDS, ODD_OPPOSITE),
+    "odd boundary edge: 1/2 (a + b)": (ODD_BOUNDARY,),
+    "even boundary vertex: 3/4 v + 1/8 (p + q)": (EVEN_BOUNDARY_SELF, EVEN_BOUNDARY_NEIGHBOUR),
+    "even weight, warren: 3/16 if n = 3 else 3/(8n)": ("warren", warren_weight),
+    "even weight, loop: (5/8 - (3/8 + cos(2 pi/n)/4)^2)/n": ("loop", loop_beta),
+}
+
+
+# --------------------------------------------------------------------------------------------
 # tiny meshes (by hand)
 
 #: One triangle: every vertex and edge is on the boundary.

@@ -16,8 +16,13 @@ from geomlib.grading.feedback import marked_picture, picture_context
 from ..common import expect_rejected
 from .cases import CASES
 from .support import (
+    EVEN_BOUNDARY_NEIGHBOUR,
+    EVEN_BOUNDARY_SELF,
     OCTA_F,
     OCTA_V,
+    ODD_BOUNDARY,
+    ODD_ENDS,
+    ODD_OPPOSITE,
     QUAD_F,
     QUAD_V,
     REG_TET_F,
@@ -31,8 +36,10 @@ from .support import (
     as_dense,
     centroids,
     faces_mismatch,
+    loop_beta,
     matrix_mismatch,
     matrix_picture,
+    warren_weight,
 )
 
 test_references = reference_tests(CASES)
@@ -63,9 +70,9 @@ def test_tetrahedron_odd_rows(lab):
     # Edges in sorted order (0,1), (0,2), (0,3), (1,2), (1,3), (2,3); in a tetrahedron the two
     # vertices opposite an edge are simply the two vertices not on it.
     E = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-    expected = np.full((6, 4), 1 / 8)
+    expected = np.full((6, 4), ODD_OPPOSITE)
     for i, (a, b) in enumerate(E):
-        expected[i, [a, b]] = 3 / 8
+        expected[i, [a, b]] = ODD_ENDS
     expect_matrix("loop_odd_matrix on the tetrahedron", S, expected, "S_odd", mesh=(TET_V, TET_F))
 
 
@@ -76,7 +83,7 @@ def test_octahedron_odd_positions(lab):
     E = topology.unique_edges(OCTA_F)
     # Every edge joins two unit vectors on different axes; its opposite vertices are the two
     # antipodes on the third axis, which cancel: odd = 3/8 (a + b).
-    expected = 3 / 8 * (OCTA_V[E[:, 0]] + OCTA_V[E[:, 1]])
+    expected = ODD_ENDS * (OCTA_V[E[:, 0]] + OCTA_V[E[:, 1]])
     expect_close(
         "loop_odd_matrix(octahedron) @ V", S @ OCTA_V, expected, atol=1e-12, name="odd vertices", mesh=(OCTA_V, OCTA_F)
     )
@@ -90,14 +97,14 @@ def test_octahedron_odd_positions(lab):
 def test_weights_by_hand(lab):
     """loop_weight: both rules give 3/16 at n = 3 and 1/16 at n = 6; at n = 4 Warren 3/32, Loop 31/256"""
     # beta(4) = (5/8 - (3/8 + cos(pi/2)/4)^2) / 4 = (5/8 - 9/64) / 4 = 31/256
-    expect_close("loop_weight([3, 4, 6], 'warren')", lab.loop_weight([3, 4, 6], "warren"), [3 / 16, 3 / 32, 1 / 16])
-    expect_close("loop_weight([3, 4, 6], 'loop')", lab.loop_weight([3, 4, 6], "loop"), [3 / 16, 31 / 256, 1 / 16])
+    expect_close("loop_weight([3, 4, 6], 'warren')", lab.loop_weight([3, 4, 6], "warren"), warren_weight([3, 4, 6]))
+    expect_close("loop_weight([3, 4, 6], 'loop')", lab.loop_weight([3, 4, 6], "loop"), loop_beta([3, 4, 6]))
 
 
 @graded(points=2, part="even vertices")
 def test_octahedron_even_rows(lab):
     """octahedron, valence 4: row v = (1 - 4u) on v and u on its 4 neighbours (every vertex but its antipode)"""
-    for weights, u in (("warren", 3 / 32), ("loop", 31 / 256)):
+    for weights, u in (("warren", warren_weight(4)), ("loop", loop_beta(4))):
         expected = np.full((6, 6), u)
         np.fill_diagonal(expected, 1 - 4 * u)
         for k in range(3):
@@ -160,12 +167,12 @@ def test_one_triangle_boundary_rows(lab):
     expect_matrix(
         "loop_odd_matrix on one triangle",
         lab.loop_odd_matrix(TRIANGLE_V, TRIANGLE_F),
-        [[0.5, 0.5, 0], [0.5, 0, 0.5], [0, 0.5, 0.5]],  # edges (0,1), (0,2), (1,2)
+        np.array([[1, 1, 0], [1, 0, 1], [0, 1, 1]]) * ODD_BOUNDARY,  # edges (0,1), (0,2), (1,2)
         "S_odd",
         mesh=(TRIANGLE_V, TRIANGLE_F),
     )
-    expected = np.full((3, 3), 1 / 8)
-    np.fill_diagonal(expected, 3 / 4)
+    expected = np.full((3, 3), EVEN_BOUNDARY_NEIGHBOUR)
+    np.fill_diagonal(expected, EVEN_BOUNDARY_SELF)
     expect_matrix(
         "loop_even_matrix on one triangle",
         lab.loop_even_matrix(TRIANGLE_V, TRIANGLE_F, "loop"),
@@ -179,12 +186,14 @@ def test_one_triangle_boundary_rows(lab):
 def test_square_interior_edge_between_boundary_vertices(lab):
     """square split along 0-2: the interior edge keeps the 3/8-1/8 rule; vertex 0 ignores its interior neighbour 2"""
     # Edges (0,1), (0,2), (0,3), (1,2), (2,3). Only (0,2) is interior (opposite vertices 1 and 3).
-    odd = [[0.5, 0.5, 0, 0], [3 / 8, 1 / 8, 3 / 8, 1 / 8], [0.5, 0, 0, 0.5], [0, 0.5, 0.5, 0], [0, 0, 0.5, 0.5]]
+    h, e, o = ODD_BOUNDARY, ODD_ENDS, ODD_OPPOSITE
+    odd = [[h, h, 0, 0], [e, o, e, o], [h, 0, 0, h], [0, h, h, 0], [0, 0, h, h]]
     S = lab.loop_odd_matrix(SQUARE_V, SQUARE_F)
     expect_matrix("loop_odd_matrix on the split square", S, odd, "S_odd", mesh=(SQUARE_V, SQUARE_F))
     # Every vertex is on the boundary: 3/4 on itself, 1/8 on its two boundary neighbours only.
     # Vertex 0's boundary neighbours are 1 and 3; vertex 2 is a neighbour too, but across the interior edge.
-    even = [[3 / 4, 1 / 8, 0, 1 / 8], [1 / 8, 3 / 4, 1 / 8, 0], [0, 1 / 8, 3 / 4, 1 / 8], [1 / 8, 0, 1 / 8, 3 / 4]]
+    v, n = EVEN_BOUNDARY_SELF, EVEN_BOUNDARY_NEIGHBOUR
+    even = [[v, n, 0, n], [n, v, n, 0], [0, n, v, n], [n, 0, n, v]]
     for weights in ("warren", "loop"):
         S = lab.loop_even_matrix(SQUARE_V, SQUARE_F, weights)
         expect_matrix(
