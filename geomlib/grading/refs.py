@@ -206,6 +206,11 @@ def graded_failures(lab: str, *, timeout: float = 3600) -> tuple[float, float, l
     root = _impl.course_root()
     env = {**os.environ, "GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
     env.pop("GEOMLIB_IMPL", None)
+    # This asks whether the solutions are right, not whether this machine is fast: a busy build
+    # machine must not turn a correct solution into a refused release. Per-call limits stay as a
+    # guard against hangs (300 s, far above any solution's need) and the whole-run budget is off.
+    env.setdefault("GEOMLIB_TIME_LIMIT", "300")
+    env.setdefault("GEOMLIB_TIME_BUDGET", "0")
     with tempfile.TemporaryDirectory(prefix="geomlib-solutions-") as tmp:
         results = Path(tmp) / "results.json"
         cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", "solutions", "--lab", lab]
