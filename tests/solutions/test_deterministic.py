@@ -9,8 +9,9 @@ one flipped bit in a cost reorders the heap. These tests run the labs' graded ca
 * with the numba kernels compiled and with ``NUMBA_DISABLE_JIT=1`` (plain Python), byte for byte,
   and check that the chosen cases together call every kernel of each lab's numba module;
 * on this machine and on an emulated other one, byte for byte: numba compiling for the generic
-  x86-64 CPU (no AVX, no FMA), OpenBLAS running its oldest x86-64 kernels and numpy its baseline
-  loops (no AVX2/AVX-512 dispatch) — the switches a different CPU flips;
+  x86-64 CPU (no AVX, no FMA), OpenBLAS running its oldest x86-64 kernels, numpy its baseline
+  loops (no AVX2/AVX-512 dispatch) and glibc's libm its non-FMA code — the switches a different
+  CPU flips;
 * and check that numba's on-disk cache keeps one entry per CPU target (a kernel compiled for one
   CPU is never loaded on another).
 
@@ -59,12 +60,13 @@ MACHINE_RUNS = [
 ]
 
 #: Another machine, as far as one machine can play it: what a different CPU changes in numba's code
-#: generation, OpenBLAS's kernel choice and numpy's SIMD dispatch. (Unknown names are ignored on
-#: CPUs that have no such kernels or features.)
+#: generation, OpenBLAS's kernel choice, numpy's SIMD dispatch and glibc's libm variants. (Unknown
+#: names are ignored on CPUs that have no such kernels or features.)
 OTHER_MACHINE = {
     "NUMBA_CPU_NAME": "generic",
     "OPENBLAS_CORETYPE": "Prescott",
     "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
+    "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX512F",  # libm's exp/log/sin/pow have FMA variants
 }
 PINNED = ("NUMBA_DISABLE_JIT", "NUMBA_CPU_FEATURES", *OTHER_MACHINE)  # cleared from the inherited environment
 
