@@ -98,7 +98,7 @@ def place(Q: np.ndarray, v1: tuple, v2: tuple) -> tuple:
     adj0, adj1, adj2 = cross(A1, A2), cross(A2, A0), cross(A0, A1)  # A⁻¹ = [adj0 adj1 adj2] / det
     det = dot(A0, adj0)
     norm = np.sqrt(dot(A0, A0) + dot(A1, A1) + dot(A2, A2))
-    if abs(det) > SINGULAR_RCOND * norm**3:
+    if abs(det) > SINGULAR_RCOND * (norm * norm * norm):  # not norm**3: pow's last bit varies (libm, numba)
         s = -1.0 / det  # x = -A⁻¹ b, A symmetric
         position = (
             s * (adj0[0] * b[0] + adj1[0] * b[1] + adj2[0] * b[2]),

@@ -82,4 +82,5 @@ def optimal_contraction(Q, v1, v2) -> tuple[np.ndarray, np.ndarray]:
                 f"optimal_contraction: {name} has shape {v.shape}, expected {expected} to match Q {Q.shape}"
             )
     Q, v1, v2 = Q.reshape(-1, 4, 4), v1.reshape(-1, 3), v2.reshape(-1, 3)  # batch of k = 1 when single
+
     raise NotImplementedError('Task 2 (placement): solve A x = -b; singular -> t* = -dᵀ(A v1 + b) / dᵀAd on [0, 1]; else best of mid, v1, v2')

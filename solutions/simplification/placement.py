@@ -82,35 +82,56 @@ def optimal_contraction(Q, v1, v2) -> tuple[np.ndarray, np.ndarray]:
                 f"optimal_contraction: {name} has shape {v.shape}, expected {expected} to match Q {Q.shape}"
             )
     Q, v1, v2 = Q.reshape(-1, 4, 4), v1.reshape(-1, 3), v2.reshape(-1, 3)  # batch of k = 1 when single
+
     # BEGIN SOLUTION: Task 2 (placement): solve A x = -b; singular -> t* = -dᵀ(A v1 + b) / dᵀAd on [0, 1]; else best of mid, v1, v2
+    # Every step is an elementwise product or sum in a fixed order (the adjugate of A instead of
+    # np.linalg.det / np.linalg.solve, and no ``** 3``), so the result is the same on every CPU:
+    # LAPACK's and np.power's last bits depend on which SIMD kernels the machine runs, and one
+    # flipped bit in a cost can reorder the greedy loop. It is also the compiled loop's formula
+    # (``compiled.place``), operation for operation.
+    def dot(x, y):
+        return x[:, 0] * y[:, 0] + x[:, 1] * y[:, 1] + x[:, 2] * y[:, 2]
+
+    def cross(x, y):
+        return np.stack(
+            [x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1], x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2],
+             x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]], axis=1)  # fmt: skip
+
     A, b, c = Q[:, :3, :3], Q[:, :3, 3], Q[:, 3, 3]
-    k = len(Q)
-    det = np.linalg.det(A)
-    norm = np.linalg.norm(A, axis=(1, 2))
-    regular = np.abs(det) > SINGULAR_RCOND * norm**3
-    position = np.empty((k, 3))
+    A0, A1, A2 = A[:, 0], A[:, 1], A[:, 2]  # rows
+    adj0, adj1, adj2 = cross(A1, A2), cross(A2, A0), cross(A0, A1)  # A⁻¹ = [adj0 adj1 adj2] / det (A symmetric)
+    det = dot(A0, adj0)
+    norm = np.sqrt(dot(A0, A0) + dot(A1, A1) + dot(A2, A2))  # Frobenius norm
+    regular = np.abs(det) > SINGULAR_RCOND * (norm * norm * norm)
+    position = np.empty((len(Q), 3))
     if regular.any():
-        position[regular] = np.linalg.solve(A[regular], -b[regular][:, :, None])[:, :, 0]
+        s = (-1.0 / det[regular])[:, None]  # x = -A⁻¹ b
+        br = b[regular]
+        position[regular] = s * (adj0[regular] * br[:, 0:1] + adj1[regular] * br[:, 1:2] + adj2[regular] * br[:, 2:3])
     singular = ~regular
     if singular.any():
-        As, bs, cs = A[singular], b[singular], c[singular]
+        # The minimum on the segment v1 + t d, or, when the cost is flat along it, the best of the
+        # midpoint, v1 and v2 (ties within round-off in that order of preference).
+        S0, S1, S2, bs, cs = A0[singular], A1[singular], A2[singular], b[singular], c[singular]
         p1, p2 = v1[singular], v2[singular]
         d = p2 - p1
-        dAd = np.einsum("ki,kij,kj->k", d, As, d)
-        slope = np.einsum("ki,ki->k", d, np.einsum("kij,kj->ki", As, p1) + bs)
-        trace = np.trace(As, axis1=1, axis2=2)
-        length2 = np.einsum("ki,ki->k", d, d)
-        reach = np.maximum(np.einsum("ki,ki->k", p1, p1), np.einsum("ki,ki->k", p2, p2)) + length2
+        Ad = np.stack([dot(S0, d), dot(S1, d), dot(S2, d)], axis=1)
+        dAd = dot(d, Ad)
+        slope = dot(Ad, p1) + dot(d, bs)  # dᵀ(A v1 + b), A symmetric
+        trace = S0[:, 0] + S1[:, 1] + S2[:, 2]
+        length2 = dot(d, d)
+        reach = np.maximum(dot(p1, p1), dot(p2, p2)) + length2
         scale = trace * reach + np.abs(cs)  # size of the terms whose round-off we must ignore
         on_segment = dAd > TIE_RTOL * trace * length2
-        t = np.clip(np.divide(-slope, dAd, out=np.zeros_like(dAd), where=on_segment), 0.0, 1.0)
+        t = np.minimum(np.maximum(np.divide(-slope, dAd, out=np.zeros_like(dAd), where=on_segment), 0.0), 1.0)
         # Flat along the segment: compare the midpoint, v1, v2 (in that order of preference).
         cand = np.stack([0.5 * (p1 + p2), p1, p2], axis=1)  # (s, 3, 3)
         cand_cost = quadric_error(Q[singular][:, None], cand)  # (s, 3)
         best = cand_cost.min(axis=1, keepdims=True)
         pick = np.argmax(cand_cost <= best + TIE_RTOL * scale[:, None], axis=1)
         fallback = cand[np.arange(len(cand)), pick]
-        position[singular] = np.where(on_segment[:, None], p1 + t[:, None] * d, fallback)
+        t = t[:, None]
+        position[singular] = np.where(on_segment[:, None], p1 + t * d, fallback)
     cost = np.maximum(quadric_error(Q, position), 0.0)
     if single:
         return position[0], cost[0]  # (3,) and a 0-d float

@@ -1,0 +1,141 @@
+"""Digests of the reference solutions' outputs on the graded cases, for ``test_deterministic.py``.
+
+Run as a script in a fresh interpreter with the environment under test (``NUMBA_DISABLE_JIT=1``,
+``NUMBA_CPU_NAME=generic``, ``OPENBLAS_CORETYPE=...``, ``NPY_DISABLE_CPU_FEATURES=...``: numba,
+numpy and OpenBLAS read them when they load, so one process cannot switch them)::
+
+    python tests/solutions/kernel_digests.py LAB/ID [LAB/ID ...]
+
+It prints one JSON object on its last line: ``digests`` maps each ``LAB/ID`` to the sha256 of its
+output (every returned array's dtype, shape and bytes), so two runs agree only when they agree
+bit for bit; ``inputs`` holds the same for the run's inputs; ``kernels`` maps each lab to the functions of its numba module that ran (recorded
+only with ``NUMBA_DISABLE_JIT=1``, when the kernels are plain Python functions).
+
+Run ids are the graded case ids of ``tests/graded/<lab>/cases*.py``; for simplification, whose
+graded cases only run the lab's Python loop, ``<case id>[greedy]`` and ``<case id>[fast]`` run a
+``qem_simplify`` case through the Python loop and through the compiled one, and
+``series-airplane-<p>pct`` is the handout figure's simplification of the airplane to p% of its
+faces (the run whose result differed between machines, issue #24).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib
+import json
+import os
+import sys
+from functools import partial
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: The module of numba kernels of each lab that has one.
+KERNEL_MODULES = {
+    "simplification": "solutions.simplification.compiled",
+    "remeshing": "solutions.remeshing.kernels",
+    "sdf": "solutions.sdf.kernels",
+}
+
+
+def _feed(h, value) -> None:
+    import numpy as np
+
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for f in dataclasses.fields(value):
+            h.update(f.name.encode())
+            _feed(h, getattr(value, f.name))
+    elif isinstance(value, tuple | list):
+        h.update(b"(%d" % len(value))
+        for v in value:
+            _feed(h, v)
+        h.update(b")")
+    elif isinstance(value, dict):
+        for k in sorted(value):
+            h.update(str(k).encode())
+            _feed(h, value[k])
+    else:
+        a = np.ascontiguousarray(value)
+        h.update(f"{a.dtype.str}{a.shape}".encode())
+        h.update(a.tobytes())
+
+
+def digest(value) -> str:
+    """sha256 of ``value``'s arrays (dtype, shape, bytes), through tuples, lists, dicts and dataclasses."""
+    h = hashlib.sha256()
+    _feed(h, value)
+    return h.hexdigest()
+
+
+def runs(lab: str) -> dict:
+    """``{run id: (inputs, function)}``: every run of the lab this script knows; it computes ``function(**inputs())``."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from geomlib.grading.cases import load_cases
+
+    module = importlib.import_module(f"solutions.{lab}")
+    out = {}
+    for case in load_cases(lab, probes=False):
+        if lab != "simplification":
+            out[case.id] = (case.inputs, partial(getattr(module, case.function), **case.params))
+        elif case.function == "qem_simplify":
+            for method in ("greedy", "fast"):
+                if method == "fast" and case.params.get("pair_threshold", 0) > 0:
+                    continue  # the compiled loop contracts edges only
+                out[f"{case.id}[{method}]"] = (case.inputs, partial(module.qem_simplify, **case.params, method=method))
+    if lab == "simplification":
+        # the handout figure series.png (solutions.simplification.figures.fig_series)
+        from solutions.simplification.figures import airplane
+
+        def series(V, F, percent):
+            return module.qem_simplify(V, F, max(4, round(percent / 100 * len(F))))
+
+        for percent in (50, 10, 2):
+            inputs = partial(lambda percent: dict(zip("VF", airplane(), strict=True), percent=percent), percent)
+            out[f"series-airplane-{percent}pct"] = (inputs, series)
+    return out
+
+
+def _record_kernels(labs) -> dict[str, set[str]]:
+    """``{lab: names of the functions of its kernel module that get called}``, filled by a profile hook."""
+    sources = {importlib.util.find_spec(KERNEL_MODULES[lab]).origin: lab for lab in labs if lab in KERNEL_MODULES}
+    called: dict[str, set[str]] = {lab: set() for lab in sources.values()}
+
+    def hook(frame, event, arg):
+        if event == "call" and frame.f_code.co_filename in sources and frame.f_code.co_name != "<module>":
+            called[sources[frame.f_code.co_filename]].add(frame.f_code.co_name)
+
+    sys.setprofile(hook)
+    return called
+
+
+def compute(wanted: list[str], record: bool = False) -> dict:
+    """``{"digests": {lab/id: sha256}, "inputs": {lab/id: sha256}, "kernels": {lab: [names]}}`` for ``wanted`` (``lab/id``)."""
+    labs = sorted({w.split("/", 1)[0] for w in wanted})
+    available = {f"{lab}/{rid}": call for lab in labs for rid, call in runs(lab).items()}
+    unknown = [w for w in wanted if w not in available]
+    if unknown:
+        raise KeyError(f"kernel_digests: no run {unknown}; runs: {sorted(available)}")
+    inputs = {w: available[w][0]() for w in wanted}
+    input_digests = {w: digest(inputs[w]) for w in wanted}  # before the calls (in case one writes to them)
+    called = _record_kernels(labs) if record else {}
+    try:
+        digests = {w: digest(available[w][1](**inputs[w])) for w in wanted}
+    finally:
+        sys.setprofile(None)
+    return {
+        "digests": digests,
+        "inputs": input_digests,
+        "kernels": {lab: sorted(names) for lab, names in called.items()},
+    }
+
+
+def main(argv: list[str]) -> None:
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    print(json.dumps(compute(argv, record=os.environ.get("NUMBA_DISABLE_JIT") == "1")))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

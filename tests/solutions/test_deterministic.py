@@ -1,0 +1,203 @@
+"""The reference solutions give the same bytes on every machine, compiled or not (issue #24, part 4).
+
+The committed ``docs/figures/simplification/series.png`` once differed from a build on another
+machine in 0.97% of its pixels. The cause was not numba: the Python greedy loop's placement called
+``np.linalg.det`` and ``np.linalg.solve``, whose last bits depend on the OpenBLAS kernel the CPU
+selects at run time (AVX-512 vs AVX2 vs SSE), and ``norm ** 3`` went through numpy's SIMD ``pow``;
+one flipped bit in a cost reorders the heap. These tests run the labs' graded cases
+
+* with the numba kernels compiled and with ``NUMBA_DISABLE_JIT=1`` (plain Python), byte for byte,
+  and check that the chosen cases together call every kernel of each lab's numba module;
+* on this machine and on an emulated other one, byte for byte: numba compiling for the generic
+  x86-64 CPU (no AVX, no FMA), OpenBLAS running its oldest x86-64 kernels, numpy its baseline
+  loops (no AVX2/AVX-512 dispatch) and glibc's libm its non-FMA code — the switches a different
+  CPU flips;
+* and check that numba's on-disk cache keeps one entry per CPU target (a kernel compiled for one
+  CPU is never loaded on another).
+
+The environment variables are read when numba, numpy and OpenBLAS load, so every other setting
+runs in a fresh interpreter (``tests/solutions/kernel_digests.py``).
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.solutions import kernel_digests
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: Graded cases that together call every numba kernel and run in a few seconds as plain Python.
+NO_JIT_RUNS = [
+    "simplification/simplify-height-field-10pct[fast]",
+    "simplification/simplify-sharp-box-10pct[fast]",
+    "simplification/hidden-simplify-rock-20pct[fast]",
+    "remeshing/split-bumpy-sphere",
+    "remeshing/hidden-split-torus",
+    "remeshing/remesh-wavy-patch",
+    "remeshing/hidden-remesh-height-field",
+    "sdf/hidden-bvh-closest-box",
+    "sdf/hidden-bvh-band-wedge",
+    "sdf/hidden-vote-wedge",
+]
+
+#: The same, the Python simplification loop on those meshes, and the handout figure's airplane series.
+MACHINE_RUNS = [
+    *NO_JIT_RUNS,
+    "simplification/simplify-height-field-10pct[greedy]",
+    "simplification/simplify-sharp-box-10pct[greedy]",
+    "simplification/hidden-simplify-rock-20pct[greedy]",
+    "simplification/series-airplane-50pct",
+    "simplification/series-airplane-10pct",
+    "simplification/series-airplane-2pct",
+]
+
+#: Another machine, as far as one machine can play it: what a different CPU changes in numba's code
+#: generation, OpenBLAS's kernel choice, numpy's SIMD dispatch and glibc's libm variants. (Unknown
+#: names are ignored on CPUs that have no such kernels or features.)
+OTHER_MACHINE = {
+    "NUMBA_CPU_NAME": "generic",
+    "OPENBLAS_CORETYPE": "Prescott",
+    "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
+    "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-AVX512F",  # libm's exp/log/sin/pow have FMA variants
+}
+PINNED = ("NUMBA_DISABLE_JIT", "NUMBA_CPU_FEATURES", *OTHER_MACHINE)  # cleared from the inherited environment
+
+pytestmark = pytest.mark.skipif(
+    os.environ.get("NUMBA_DISABLE_JIT") == "1", reason="compares compiled kernels: needs numba's JIT"
+)
+
+
+def run_digests(runs: list[str], timeout: float = 600, **env: str) -> dict:
+    """``kernel_digests.py`` in a fresh interpreter with ``env`` (on top of a clean environment)."""
+    base = {k: v for k, v in os.environ.items() if k not in PINNED}
+    out = subprocess.run(
+        [sys.executable, str(ROOT / "tests" / "solutions" / "kernel_digests.py"), *runs],
+        cwd=ROOT,
+        env={**base, "PYTHONPATH": str(ROOT), **env},
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    assert out.returncode == 0, f"kernel_digests.py with {env} failed:\n{out.stderr[-3000:]}"
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="module")
+def here() -> dict:
+    """Digests of :data:`MACHINE_RUNS` in this process (compiled kernels, this machine)."""
+    return kernel_digests.compute(MACHINE_RUNS)
+
+
+def differing(a: dict, b: dict, runs: list[str]) -> list[str]:
+    return [r for r in runs if a[r] != b[r]]
+
+
+def numba_kernels(lab: str) -> set[str]:
+    """Names of the ``@njit`` functions defined in the lab's kernel module."""
+    from numba.core.dispatcher import Dispatcher
+
+    name = kernel_digests.KERNEL_MODULES[lab]
+    module = importlib.import_module(name)
+    return {k for k, v in vars(module).items() if isinstance(v, Dispatcher) and v.py_func.__module__ == name}
+
+
+def test_every_numba_module_is_covered():
+    # A new lab with compiled kernels must be added to kernel_digests.KERNEL_MODULES and to the runs.
+    found = {
+        f"solutions.{p.parent.name}.{p.stem}"
+        for p in sorted((ROOT / "solutions").glob("*/*.py"))
+        if "from numba import" in p.read_text(encoding="utf-8") or "import numba" in p.read_text(encoding="utf-8")
+    }
+    assert found == set(kernel_digests.KERNEL_MODULES.values()), (
+        f"modules importing numba: {sorted(found)}; covered by tests/solutions/kernel_digests.py: "
+        f"{sorted(kernel_digests.KERNEL_MODULES.values())}"
+    )
+
+
+def test_compiled_kernels_give_the_bytes_of_plain_python(here):
+    plain = run_digests(NO_JIT_RUNS, NUMBA_DISABLE_JIT="1")
+    for lab in kernel_digests.KERNEL_MODULES:
+        missing = numba_kernels(lab) - set(plain["kernels"][lab])
+        assert not missing, f"{lab}: the cases of NO_JIT_RUNS never call the kernels {sorted(missing)}; add a case"
+    diff = differing(here["digests"], plain["digests"], NO_JIT_RUNS)
+    assert not diff, (
+        f"compiled and plain-Python (NUMBA_DISABLE_JIT=1) kernels give different bytes on {diff}: "
+        "look for fastmath, FMA contraction, parallel reductions or ** / math functions that numba "
+        "and CPython evaluate differently"
+    )
+
+
+#: Runs whose *inputs* differ between CPUs: ``geomlib.datasets.height_field`` sums Gaussian bumps
+#: with ``np.exp``, and numpy's float64 ``exp`` has separate AVX-512, AVX2 and baseline code that
+#: differ in the last bit. The solutions cannot give equal bytes for unequal inputs; their outputs
+#: are not compared. (Making the datasets CPU-independent would change stored references of
+#: several labs: a separate change.)
+MACHINE_DEPENDENT_INPUTS = {
+    "simplification/simplify-height-field-10pct[fast]",
+    "simplification/simplify-height-field-10pct[greedy]",
+    "remeshing/hidden-remesh-height-field",
+}
+
+
+def test_another_machine_gives_the_same_bytes(here):
+    other = run_digests(MACHINE_RUNS, **OTHER_MACHINE)
+    moved = set(differing(here["inputs"], other["inputs"], MACHINE_RUNS))
+    assert moved <= MACHINE_DEPENDENT_INPUTS, (
+        f"the inputs of {sorted(moved - MACHINE_DEPENDENT_INPUTS)} differ on an emulated other CPU "
+        f"({OTHER_MACHINE}): a dataset depends on the CPU's SIMD code (numpy's exp/log/pow, BLAS)"
+    )
+    same_inputs = [r for r in MACHINE_RUNS if r not in moved]
+    diff = differing(here["digests"], other["digests"], same_inputs)
+    assert not diff, (
+        f"an emulated other CPU ({OTHER_MACHINE}) gives different bytes on {diff}: something depends on "
+        "the CPU's SIMD kernels (np.linalg / BLAS, numpy's dispatched pow/exp/log, numba's CPU target)"
+    )
+
+
+CACHE_PROBE = """
+import json
+import numpy as np
+from numba.core import config
+from geomlib import datasets
+from solutions.simplification import qem_simplify
+from solutions.simplification.compiled import greedy_collapse
+V, F = datasets.icosphere(2)
+qem_simplify(V, F, 60, method="fast")
+s = greedy_collapse.stats
+print(json.dumps({"cpu": config.CPU_NAME, "hits": sum(s.cache_hits.values()), "misses": sum(s.cache_misses.values())}))
+"""
+
+
+def probe_cache(cache: Path, **env: str) -> dict:
+    base = {k: v for k, v in os.environ.items() if k not in PINNED}
+    out = subprocess.run(
+        [sys.executable, "-c", CACHE_PROBE],
+        cwd=ROOT,
+        env={**base, "PYTHONPATH": str(ROOT), "NUMBA_CACHE_DIR": str(cache), **env},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert out.returncode == 0, out.stderr[-3000:]
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.slow
+def test_the_kernel_cache_keeps_cpu_targets_apart(tmp_path):
+    # numba keys a cache entry on (signature, (target triple, CPU name, CPU features)): machine code
+    # compiled for this CPU is not loaded for another, and the other's is kept beside it.
+    generic = {"NUMBA_CPU_NAME": "generic"}
+    first = probe_cache(tmp_path)
+    assert (first["hits"], first["misses"]) == (0, 1), first
+    other = probe_cache(tmp_path, **generic)
+    assert (other["hits"], other["misses"]) == (0, 1), f"the generic CPU loaded this CPU's machine code: {other}"
+    assert probe_cache(tmp_path, **generic)["hits"] == 1, "the generic CPU's entry was not kept"
+    assert probe_cache(tmp_path)["hits"] == 1, "this CPU's entry was overwritten by the generic one"
