@@ -755,7 +755,7 @@ def audit(
             prog.end()
         for i in sorted(rows):
             report["labs"][rows[i]["lab"]]["mutants"].append(rows[i])
-        for lab, lr in report["labs"].items():
+        for lr in report["labs"].values():
             lr["tasks"] = _task_summary(lr)
             for s in lr["stale_equivalents"]:
                 lr["errors"].append(f"equivalent_mutants.toml names {s!r}, which is not a mutant of the solution")
