@@ -155,6 +155,12 @@ _BINOPS = {
 }
 _CMPOPS = {ast.Lt: "<=", ast.LtE: "<", ast.Gt: ">=", ast.GtE: ">"}
 _CMPSYM = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">="}
+#: Calls whose first two arguments commute: swapping them is an equivalent mutant, never generated.
+_COMMUTATIVE = {
+    "max", "min", "maximum", "minimum", "fmax", "fmin", "hypot", "add", "multiply", "logical_and",
+    "logical_or", "logical_xor", "bitwise_and", "bitwise_or", "bitwise_xor", "union1d", "intersect1d",
+    "array_equal", "isclose", "allclose", "equal", "not_equal",
+}  # fmt: skip
 
 
 def _number_variants(v) -> list[tuple[str, str]]:
@@ -233,7 +239,8 @@ def _operator_edits(text: str, tree: ast.AST, b: _Block) -> list[tuple[int, int,
             a0, a1 = node.args[0], node.args[1]
             s0, e0 = _span(lines, a0)
             s1, e1 = _span(lines, a1)
-            if seg(a0) != seg(a1):
+            fname = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            if seg(a0) != seg(a1) and fname not in _COMMUTATIVE:
                 new = text[s1:e1] + text[e0:s1] + text[s0:e0]
                 name = ast.unparse(node.func)
                 label = f"{name}(a, b) → {name}(b, a)"
