@@ -23,6 +23,7 @@ examples:
   geomlib stubs build                          regenerate labs/ from solutions/
   geomlib release dist/ --lab subdivision      student bundle + dist/autograder-subdivision.zip
   geomlib grade-all exports/ --lab subdivision --out regrade/   batch grading (instructors)
+  geomlib audit --lab subdivision --jobs 2     mutation analysis of the graded tests (instructors)
   geomlib info mesh.obj                        counts, defects (duplicate, degenerate, non-manifold), genus, bbox
   geomlib view mesh.obj                        turn the mesh in a window (needs a display)
   geomlib view mesh.obj --html mesh.html       the same as one self-contained page (works offline)
@@ -167,6 +168,27 @@ def _cmd_grade_all(a) -> int:
     return 0 if summary["graded"] else 1
 
 
+def _cmd_audit(a) -> int:
+    import json
+
+    from geomlib.grading import audit
+
+    try:
+        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs)
+    except audit.AuditError as e:
+        print(f"geomlib audit: error: {e}", file=sys.stderr)
+        return 1
+    text = audit.markdown(report)
+    print(text, end="")
+    if a.out:
+        out = Path(a.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "audit.md").write_text(text)
+        (out / "audit.json").write_text(json.dumps(report, indent=1, ensure_ascii=False) + "\n")
+        print(f"wrote {out / 'audit.md'} and {out / 'audit.json'}")
+    return 1 if audit.failed(report) else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="geomlib",
@@ -278,6 +300,15 @@ def build_parser() -> argparse.ArgumentParser:
     ga.add_argument("--jobs", type=int, default=None, help="submissions graded at once (default: CPU count, max 4)")
     ga.add_argument("--timeout", type=float, default=1800.0, help="seconds allowed per submission (default 1800)")
     ga.set_defaults(func=_cmd_grade_all)
+
+    au = sub.add_parser(
+        "audit", help="mutation analysis: grade mutants of the solutions and report the ones the tests miss"
+    )
+    au.add_argument("--lab", action="append", help="only this lab (repeatable; default: every lab)")
+    au.add_argument("--quick", action="store_true", help="a fixed sample of a few mutants per lab (for CI)")
+    au.add_argument("--jobs", type=int, default=1, help="mutants graded at once (default 1)")
+    au.add_argument("--out", help="also write audit.md and audit.json into this folder")
+    au.set_defaults(func=_cmd_audit)
     return p
 
 

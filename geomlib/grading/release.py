@@ -182,6 +182,8 @@ def _tests(root: Path, labs: list[str], *, include_hidden: bool) -> list[tuple[P
             return True  # tests/graded/__init__.py
         if len(parts) < 3 or parts[2] not in labs:
             return False
+        if rel.name == "equivalent_mutants.toml":
+            return False  # `geomlib audit`'s declarations quote solution code: instructors only
         return include_hidden or not _is_hidden(rel)
 
     return _tree(root, "tests", keep)

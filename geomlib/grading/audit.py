@@ -1,0 +1,864 @@
+"""``geomlib audit``: mutation analysis of the graded tests.
+
+A *mutant* is a copy of ``solutions/<lab>/`` with one change inside one ``# BEGIN SOLUTION`` block.
+Each mutant is graded through the real grading path (``geomlib grade --impl COPY --lab LAB --task N``:
+sandboxed workers, the course's stubs merged in, public and hidden tests) on the graded tests of the
+block's task, and it is
+
+- *killed* when it loses points there (a *does-nothing* mutant is only counted killed when it
+  scores 0 on that task; one that keeps some points is reported as *partly killed*);
+- *survived* otherwise: the tests cannot tell it from the reference solution;
+- *equivalent* when ``tests/graded/<lab>/equivalent_mutants.toml`` declares it so, with a reason
+  (an equivalent mutant that a test kills is an error of the declaration).
+
+Two kinds of mutants, both generated from the solution's syntax tree (:mod:`ast`) and applied as
+text at the node's position, so that each is a one-line diff of the source:
+
+- *does nothing* (``nothing``): the block's results (its ``return`` values and the names it binds or
+  changes that the rest of the function reads) are replaced, after the block ran, by zeros of the
+  same shape and dtype (``zeros``), by the function's input of the same kind (``input``: ``V`` for
+  a new ``V``, ``(V, F)`` for a remeshed ``(V, F)``), or by a constant of the right shape
+  (``constant``: the mean value for floats, ones for integers, True for booleans). Blocks inside
+  numba-compiled kernels get no does-nothing mutant (the helper that builds the replacement is
+  Python); they are listed in the report;
+- *operators* inside the block: numeric constants (0↔1, ×2, ½, +1), ``+``↔``-``, ``*``↔``/``
+  (also in ``+=`` and friends), ``<``↔``<=``, ``>``↔``>=``, an index ``a[i]`` → ``a[i + 1]``,
+  ``True``↔``False``, the first two positional arguments of a call swapped.
+
+Why not mutmut or cosmic-ray: both mutate a package in place and run a test command per mutant
+against that one tree, and both pick mutation sites over whole modules. Here a mutant must be a
+*separate folder* graded with ``--impl FOLDER`` (the sandbox snapshots the folder and merges it
+with the course's stubs), only code inside solution blocks may change, and each mutant must be
+traced to its task; with either tool the copy, the restriction to blocks and the task mapping
+would all be rewritten around it. Blocks in GLSL shaders (the relief lab's ``.frag`` files) are
+not mutated; the report says how many there are.
+
+Grading many mutants: ``--jobs`` worker processes each grade mutants one after another in one
+interpreter (the sandbox's zygote and pytest's imports are reused: about 1.5 s per task instead of
+8 s for a fresh ``geomlib grade``). A mutant's run gets a time budget of five times the solution's
+(at least 60 s): a mutant that loops forever is killed by the budget, and the report says so.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import os
+import queue
+import random
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import zlib
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from geomlib.grading import impl as _impl
+
+__all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
+
+_MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
+_HELPER = "_geomlib_audit_nothing"
+NOTHING_MODES = ("zeros", "input", "constant")
+#: How many mutants per lab ``--quick`` grades (a fixed, seeded sample).
+QUICK_PER_LAB = 4
+
+
+class AuditError(ValueError):
+    """A lab that cannot be audited (unknown, no blocks, solution not at full marks, bad declaration)."""
+
+
+@dataclass
+class Mutant:
+    id: str  # "<file>:<line>:<col>:<op>" (stable while the solution's line does not move)
+    lab: str
+    file: str  # relative to solutions/<lab>/
+    line: int
+    task: int
+    title: str
+    kind: str  # "nothing" or "operator"
+    op: str  # "zeros", "+ → -", "3 → 6", ...
+    diff: str  # "- old line" / "+ new line", one line each
+    source: str = field(repr=False, default="")
+
+
+# ---------------------------------------------------------------------------------- finding the blocks
+
+
+@dataclass
+class _Block:
+    file: str
+    start: int  # line of BEGIN (1-based)
+    end: int  # line of END
+    task: int
+    title: str
+
+
+def _blocks(lab_dir: Path) -> tuple[list[_Block], list[str]]:
+    """The Python solution blocks of a lab and the names of the (skipped) shader files with blocks."""
+    from geomlib.grading import stubs
+
+    out, shaders = [], []
+    for f in sorted(lab_dir.rglob("*")):
+        if "__pycache__" in f.parts or f.suffix not in stubs.STUB_SUFFIXES:
+            continue
+        rel = str(f.relative_to(lab_dir))
+        blocks, _ = stubs._scan(f.read_text(), rel)
+        if not blocks:
+            continue
+        if f.suffix != ".py":
+            shaders.append(f"{rel} ({len(blocks)} block{'s' if len(blocks) != 1 else ''})")
+            continue
+        for b in blocks:
+            m = _MARK.search(b.task)
+            if not m:
+                raise AuditError(f"{rel}, line {b.start}: a solution block without 'Task N (title)' in its marker")
+            out.append(_Block(rel, b.start, b.end, int(m.group(1)), m.group(2).strip()))
+    return out, shaders
+
+
+# ---------------------------------------------------------------------------------- text edits
+
+
+def _offset(lines: list[str], line: int, col: int) -> int:
+    """Character offset in the joined text of (1-based line, UTF-8 byte column)."""
+    before = sum(len(s) + 1 for s in lines[: line - 1])
+    return before + len(lines[line - 1].encode("utf-8")[:col].decode("utf-8", errors="replace"))
+
+
+def _span(lines, node) -> tuple[int, int]:
+    return _offset(lines, node.lineno, node.col_offset), _offset(lines, node.end_lineno, node.end_col_offset)
+
+
+def _diff(old: str, new: str) -> str:
+    """The first changed line of two texts, as ``- old`` / ``+ new`` (stripped)."""
+    a, b = old.splitlines(), new.splitlines()
+    for i, (x, y) in enumerate(zip(a, b, strict=False)):
+        if x != y:
+            j = len(b) - (len(a) - i)  # a change that adds lines: show the added ones
+            added = " ⏎ ".join(s.strip() for s in b[i : max(i + 1, j + 1)])
+            return f"- {x.strip()}\n+ {added}"
+    return "(no change)"
+
+
+# ---------------------------------------------------------------------------------- operator mutants
+
+_BINOPS = {
+    ast.Add: (ast.Sub, "+", "-"),
+    ast.Sub: (ast.Add, "-", "+"),
+    ast.Mult: (ast.Div, "*", "/"),
+    ast.Div: (ast.Mult, "/", "*"),
+}
+_CMPOPS = {ast.Lt: "<=", ast.LtE: "<", ast.Gt: ">=", ast.GtE: ">"}
+_CMPSYM = {ast.Lt: "<", ast.LtE: "<=", ast.Gt: ">", ast.GtE: ">="}
+#: Calls whose first two arguments commute: swapping them is an equivalent mutant, never generated.
+_COMMUTATIVE = {
+    "max", "min", "maximum", "minimum", "fmax", "fmin", "hypot", "add", "multiply", "logical_and",
+    "logical_or", "logical_xor", "bitwise_and", "bitwise_or", "bitwise_xor", "union1d", "intersect1d",
+    "array_equal", "isclose", "allclose", "equal", "not_equal",
+}  # fmt: skip
+
+
+def _number_variants(v) -> list[tuple[str, str]]:
+    """(new literal, label) for a numeric constant: 0↔1, ×2, ½, +1 (distinct values only)."""
+    out = []
+    if isinstance(v, int):
+        cands = [1 if v == 0 else 0, v * 2, v // 2, v + 1]
+    else:
+        cands = [1.0 if v == 0 else 0.0, v * 2, v / 2, v + 1]
+    seen = {v}
+    for c in cands:
+        if c in seen:
+            continue
+        seen.add(c)
+        out.append((repr(c), f"{v!r} → {c!r}"))
+    return out
+
+
+def _in_block(node, b: _Block) -> bool:
+    return hasattr(node, "lineno") and b.start < node.lineno and node.end_lineno < b.end
+
+
+def _operator_edits(text: str, tree: ast.AST, b: _Block) -> list[tuple[int, int, str, str, int, int]]:
+    """(start, end, replacement, label, line, col) text edits for the operator mutants of one block."""
+    lines = text.split("\n")
+    seg = lambda n: text[slice(*_span(lines, n))]  # noqa: E731
+    edits = []
+
+    def gap_edit(left, right, sym, new, label, node):
+        a, z = _span(lines, left)[1], _span(lines, right)[0]
+        gap = text[a:z]
+        k = gap.find(sym)
+        if k < 0:
+            return
+        edits.append((a + k, a + k + len(sym), new, label, node.lineno, node.col_offset))
+
+    for node in ast.walk(tree):
+        if not _in_block(node, b):
+            continue
+        if isinstance(node, ast.Constant) and type(node.value) in (int, float):
+            s, e = _span(lines, node)
+            for new, label in _number_variants(node.value):
+                edits.append((s, e, new, label, node.lineno, node.col_offset))
+        elif isinstance(node, ast.Constant) and isinstance(node.value, bool):
+            s, e = _span(lines, node)
+            new = "False" if node.value else "True"
+            edits.append((s, e, new, f"{node.value} → {new}", node.lineno, node.col_offset))
+        elif isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
+            _, old, new = _BINOPS[type(node.op)]
+            gap_edit(node.left, node.right, old, new, f"{old} → {new}", node)
+        elif isinstance(node, ast.AugAssign) and type(node.op) in _BINOPS:
+            _, old, new = _BINOPS[type(node.op)]
+            gap_edit(node.target, node.value, old + "=", new + "=", f"{old}= → {new}=", node)
+        elif isinstance(node, ast.Compare):
+            left = node.left
+            for op, right in zip(node.ops, node.comparators, strict=True):
+                if type(op) in _CMPOPS:
+                    old, new = _CMPSYM[type(op)], _CMPOPS[type(op)]
+                    a, z = _span(lines, left)[1], _span(lines, right)[0]
+                    gap = text[a:z]
+                    m = re.search(re.escape(old) + r"(?![=<>])", gap)
+                    if m:
+                        edits.append((a + m.start(), a + m.end(), new, f"{old} → {new}", node.lineno, node.col_offset))
+                left = right
+        elif isinstance(node, ast.Subscript):
+            idx = node.slice.elts if isinstance(node.slice, ast.Tuple) else [node.slice]
+            for i in idx:
+                if isinstance(i, ast.Name):
+                    s, e = _span(lines, i)
+                    edits.append((s, e, f"({i.id} + 1)", f"[{i.id}] → [{i.id} + 1]", i.lineno, i.col_offset))
+        elif (
+            isinstance(node, ast.Call)
+            and len(node.args) >= 2
+            and not any(isinstance(a, ast.Starred) for a in node.args[:2])
+        ):
+            a0, a1 = node.args[0], node.args[1]
+            s0, e0 = _span(lines, a0)
+            s1, e1 = _span(lines, a1)
+            fname = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
+            if seg(a0) != seg(a1) and fname not in _COMMUTATIVE:
+                new = text[s1:e1] + text[e0:s1] + text[s0:e0]
+                name = ast.unparse(node.func)
+                label = f"{name}(a, b) → {name}(b, a)"
+                edits.append((s0, e1, new, label, node.lineno, node.col_offset))
+    return edits
+
+
+# ---------------------------------------------------------------------------------- does-nothing mutants
+
+_HELPER_SOURCE = f'''
+
+def {_HELPER}(x, mode, inputs=(), inplace=False):
+    """geomlib audit: a does-nothing replacement for a task's result ``x`` (zeros, an input, a constant)."""
+    import numpy as _np
+    import scipy.sparse as _sp
+
+    if isinstance(x, tuple | list):
+        if mode == "input":
+            like = [a for a in inputs if isinstance(a, _np.ndarray)]
+            out = []
+            for v in x:
+                same = [a for a in like if isinstance(v, _np.ndarray) and a.ndim == v.ndim and a.dtype.kind == v.dtype.kind and a.shape[1:] == v.shape[1:]]
+                out.append(same[0].copy() if same else {_HELPER}(v, "zeros"))
+                if same:
+                    like.remove(same[0])
+        else:
+            out = [{_HELPER}(v, mode, inputs) for v in x]
+        if inplace and isinstance(x, list):
+            x[:] = out
+            return x
+        return type(x)(out) if isinstance(x, tuple) else out
+    if isinstance(x, dict):
+        return {{k: {_HELPER}(v, mode, inputs) for k, v in x.items()}}
+    if _sp.issparse(x):
+        return x * 0 if mode != "constant" else _sp.csr_matrix(_np.full(x.shape, 1.0 / max(1, x.shape[1]), dtype=x.dtype)) if x.shape[0] * x.shape[1] < 1 << 22 else x * 0
+    if isinstance(x, _np.ndarray):
+        new = None
+        if mode == "input":
+            for a in inputs:
+                if isinstance(a, _np.ndarray) and a.ndim == x.ndim and a.dtype.kind == x.dtype.kind and a.shape[1:] == x.shape[1:]:
+                    new = a.copy() if a.shape == x.shape or not inplace else None
+                    break
+        if new is None and mode == "constant":
+            if x.dtype.kind == "b":
+                new = _np.ones_like(x)
+            elif x.dtype.kind in "iu":
+                new = _np.ones_like(x)
+            elif x.dtype.kind in "fc":
+                fin = x[_np.isfinite(x)] if x.size else x
+                new = _np.full_like(x, fin.mean() if fin.size else 0)
+        if new is None:
+            new = _np.zeros_like(x)
+        if inplace and new.shape == x.shape and x.flags.writeable:
+            x[...] = new
+            return x
+        return new
+    if isinstance(x, bool | _np.bool_):
+        return mode == "constant"
+    if isinstance(x, int | float | _np.number):
+        if mode == "input":
+            for a in inputs:
+                if type(a) is type(x):
+                    return a
+        return type(x)(1 if mode == "constant" else 0)
+    return x
+'''
+
+
+def _is_compiled(fn: ast.AST) -> bool:
+    for d in getattr(fn, "decorator_list", []):
+        target = d.func if isinstance(d, ast.Call) else d
+        name = target.attr if isinstance(target, ast.Attribute) else getattr(target, "id", "")
+        if name in ("njit", "jit", "vectorize", "guvectorize", "stencil"):
+            return True
+    return False
+
+
+def _enclosing(tree: ast.Module, b: _Block) -> list[ast.AST]:
+    """The function definitions that contain the block, outermost first."""
+    chain = []
+    node = tree
+    while True:
+        inner = [
+            n
+            for n in ast.iter_child_nodes(node)
+            if n.__class__.__name__ != "ClassDef"
+            and hasattr(n, "lineno")
+            and n.lineno < b.start
+            and n.end_lineno > b.start
+        ]
+        if not inner:
+            return chain
+        node = inner[0]
+        if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+            chain.append(node)
+
+
+def _walk_no_defs(node):
+    """Nodes under ``node`` without entering nested functions, lambdas or comprehensions."""
+    todo = list(ast.iter_child_nodes(node))
+    while todo:
+        n = todo.pop()
+        yield n
+        if isinstance(
+            n,
+            ast.FunctionDef
+            | ast.AsyncFunctionDef
+            | ast.Lambda
+            | ast.ListComp
+            | ast.SetComp
+            | ast.DictComp
+            | ast.GeneratorExp,
+        ):
+            continue
+        todo.extend(ast.iter_child_nodes(n))
+
+
+def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
+    """Text edits that make a block's results trivial, with ``{mode}`` left to fill in; or ([], why not)."""
+    chain = _enclosing(tree, b)
+    if not chain:
+        return [], "the block is not inside a function"
+    fn = chain[-1]
+    if any(_is_compiled(f) for f in chain):
+        return [], "compiled kernel (numba): no does-nothing mutant"
+    lines = text.split("\n")
+    stmts = [s for s in _walk_no_defs(fn) if isinstance(s, ast.stmt) and _in_block(s, b)]
+    params = [a.arg for a in (*fn.args.posonlyargs, *fn.args.args) if a.arg not in ("self", "cls")]
+    inputs = "(" + "".join(f"{p}, " for p in params) + ")"
+    edits = []
+    # Returns inside the block give trivial values.
+    for s in stmts:
+        if isinstance(s, ast.Return) and s.value is not None:
+            a, z = _span(lines, s.value)
+            edits.append((a, z, f"{_HELPER}(({text[a:z]}), {{mode!r}}, {inputs})"))
+    # Names the block binds or changes in place, read elsewhere in the function, become trivial after it.
+    bound, changed = [], []
+    for s in stmts:
+        for n in _walk_no_defs(s) if not isinstance(s, ast.Return) else ():
+            if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store) and n.id not in bound:
+                bound.append(n.id)
+            elif isinstance(n, ast.Subscript | ast.Attribute) and isinstance(n.ctx, ast.Store):
+                base = n.value
+                while isinstance(base, ast.Subscript | ast.Attribute):
+                    base = base.value
+                if isinstance(base, ast.Name) and base.id not in changed:
+                    changed.append(base.id)
+            elif isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and isinstance(n.func.value, ast.Name):
+                if (
+                    n.func.attr in ("append", "extend", "insert", "update", "add", "fill", "sort")
+                    and n.func.value.id not in changed
+                ):
+                    changed.append(n.func.value.id)
+    read_outside = {
+        n.id
+        for n in _walk_no_defs(fn)
+        if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load) and not (b.start < n.lineno < b.end)
+    }
+    # Closures read names too (relief's f(k, d)): count loads in nested functions as well.
+    read_outside |= {n.id for n in ast.walk(fn) if isinstance(n, ast.Name) and not (b.start < n.lineno < b.end)}
+    indent = re.match(r"\s*", lines[b.start - 1]).group(0)
+    resets = []
+    for name in bound:
+        if name in read_outside and name not in changed:
+            resets.append(f"{indent}{name} = {_HELPER}({name}, {{mode!r}}, {inputs})")
+    for name in changed:
+        resets.append(f"{indent}{name} = {_HELPER}({name}, {{mode!r}}, {inputs}, inplace=True)")
+    last = stmts and max(s.end_lineno for s in stmts)
+    if resets and not (
+        stmts and any(isinstance(s, ast.Return) for s in stmts if s.end_lineno == last and s.col_offset == len(indent))
+    ):
+        at = _offset(lines, b.end, 0)
+        edits.append((at, at, "\n".join(resets) + "\n"))
+    if not edits:
+        return [], "the block has no result the function uses"
+    return edits, ""
+
+
+def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
+    for a, z, new in sorted(edits, key=lambda e: e[0], reverse=True):
+        text = text[:a] + new + text[z:]
+    return text
+
+
+# ---------------------------------------------------------------------------------- generation
+
+
+def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[str]]:
+    """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated."""
+    lab_dir = Path(lab_dir or _impl.course_root() / "solutions" / lab)
+    if not lab_dir.is_dir():
+        raise AuditError(f"no solution folder {lab_dir}")
+    blocks, shaders = _blocks(lab_dir)
+    notes = [f"GLSL blocks not mutated: {', '.join(shaders)}"] if shaders else []
+    out: list[Mutant] = []
+    seen: set[str] = set()
+    texts: dict[str, tuple[str, ast.Module]] = {}
+    for b in blocks:
+        if b.file not in texts:
+            text = (lab_dir / b.file).read_text()
+            texts[b.file] = (text, ast.parse(text))
+        text, tree = texts[b.file]
+        edits, why = _nothing_edits(text, tree, b)
+        if not edits:
+            notes.append(f"{b.file}:{b.start} (Task {b.task}): {why}")
+        for mode in NOTHING_MODES if edits else ():
+            filled = [(a, z, new.format(mode=mode)) for a, z, new in edits]
+            src = _apply(text, filled).rstrip("\n") + "\n" + _HELPER_SOURCE
+            diff = f"- (block at line {b.start + 1}: its results)\n+ {mode} of the same shape and dtype"
+            if mode == "input":
+                diff = f"- (block at line {b.start + 1}: its results)\n+ the function's input of the same kind (else zeros)"
+            mid = f"{b.file}:{b.start}:nothing-{mode}"
+            out.append(Mutant(mid, lab, b.file, b.start, b.task, b.title, "nothing", mode, diff, src))
+        for a, z, new, label, line, col in _operator_edits(text, tree, b):
+            src = _apply(text, [(a, z, new)])
+            if src in seen or src == text:
+                continue
+            try:
+                compile(src, b.file, "exec", dont_inherit=True)
+            except SyntaxError:
+                continue
+            seen.add(src)
+            mid = f"{b.file}:{line}:{col}:{label}"
+            k = 2
+            while any(m.id == mid for m in out):
+                mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
+            out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), src))
+    return out, notes
+
+
+def quick_sample(mutants: list[Mutant], lab: str, n: int = QUICK_PER_LAB) -> list[Mutant]:
+    """A fixed sample (seeded by the lab's name): one does-nothing mutant first, then operators."""
+    rng = random.Random(zlib.crc32(lab.encode()))
+    nothing = [m for m in mutants if m.kind == "nothing" and m.op == "zeros"]
+    ops = [m for m in mutants if m.kind == "operator"]
+    pick = rng.sample(nothing, min(len(nothing), max(1, n // 2)))
+    pick += rng.sample(ops, min(len(ops), n - len(pick)))
+    order = {m.id: i for i, m in enumerate(mutants)}
+    return sorted(pick, key=lambda m: order[m.id])
+
+
+# ---------------------------------------------------------------------------------- equivalent mutants
+
+
+def equivalents(lab: str) -> dict[str, str]:
+    """``{mutant id: reason}`` from ``tests/graded/<lab>/equivalent_mutants.toml``::
+
+    [[equivalent]]
+    id = "loop.py:168:20:3 → 6"
+    reason = "why no test can tell it from the solution"
+    """
+    import tomllib
+
+    path = _impl.tests_dir() / "graded" / lab / "equivalent_mutants.toml"
+    if not path.is_file():
+        return {}
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as e:
+        raise AuditError(f"{path}: {e}") from None
+    out = {}
+    for i, entry in enumerate(data.get("equivalent", []), start=1):
+        if not isinstance(entry, dict) or not entry.get("id") or not str(entry.get("reason", "")).strip():
+            raise AuditError(f"{path}: entry {i} needs an id and a reason")
+        out[str(entry["id"])] = str(entry["reason"]).strip()
+    return out
+
+
+# ---------------------------------------------------------------------------------- grading
+
+
+def _worker_main() -> int:
+    """``python -m geomlib.grading.audit --worker``: grade requests (JSON lines on stdin), one per line out."""
+    reply = os.fdopen(os.dup(1), "w", buffering=1)
+    os.dup2(2, 1)  # anything else written to stdout goes to the log, not into the replies
+    from geomlib.grading.grade import grade
+
+    for line in sys.stdin:
+        req = json.loads(line)
+        t = time.time()
+        os.environ["GEOMLIB_TIME_BUDGET"] = str(req.get("budget") or "")
+        try:
+            data = grade(req["impl"], [req["lab"]], task=req["task"], feedback_dir="")
+            tests = [
+                {"name": x["name"], "score": x["score"], "max": x["max_score"], "passed": x["status"] == "passed",
+                 "output": x.get("output", "")[:300]}
+                for x in data["tests"]
+            ]  # fmt: skip
+            out = {"ok": True, "tests": tests}
+        except BaseException as e:  # noqa: BLE001  (the audit keeps going; the mutant's row says what happened)
+            out = {"ok": False, "error": f"{type(e).__name__}: {e}"}
+        out["seconds"] = time.time() - t
+        reply.write(json.dumps(out) + "\n")
+    return 0
+
+
+class _Pool:
+    """``jobs`` worker processes that grade one request at a time each."""
+
+    def __init__(self, jobs: int, log_dir: Path):
+        self.jobs, self.log_dir = jobs, log_dir
+        self.procs: dict[int, subprocess.Popen] = {}
+
+    def _start(self, k: int) -> subprocess.Popen:
+        env = {**os.environ, "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
+        log = open(self.log_dir / f"worker-{k}.log", "ab")  # noqa: SIM115
+        return subprocess.Popen(
+            [sys.executable, "-m", "geomlib.grading.audit", "--worker"],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=log, text=True, env=env,
+            start_new_session=True, cwd=str(_impl.course_root()),
+        )  # fmt: skip
+
+    def run(self, requests: list[dict], on_done) -> None:
+        """Grade ``requests`` (a request may hold ``prepare``: a function that returns the real one);
+        ``on_done(index, request, reply)`` is called from the worker threads as replies arrive."""
+        todo: queue.Queue = queue.Queue()
+        for i, r in enumerate(requests):
+            todo.put((i, r))
+
+        def serve(k):
+            while True:
+                try:
+                    i, r = todo.get_nowait()
+                except queue.Empty:
+                    return
+                if "prepare" in r:
+                    r = r["prepare"]()
+                p = self.procs.get(k)
+                if p is None or p.poll() is not None:
+                    p = self.procs[k] = self._start(k)
+                try:
+                    p.stdin.write(json.dumps(r) + "\n")
+                    p.stdin.flush()
+                    line = p.stdout.readline()
+                    res = json.loads(line) if line else {"ok": False, "error": "the audit worker stopped"}
+                except (OSError, ValueError) as e:
+                    res = {"ok": False, "error": f"the audit worker failed: {e}"}
+                on_done(i, r, res)
+
+        threads = [threading.Thread(target=serve, args=(k,), daemon=True) for k in range(self.jobs)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+
+    def close(self):
+        for p in self.procs.values():
+            try:
+                p.stdin.close()
+                p.wait(30)
+            except (OSError, subprocess.TimeoutExpired):
+                p.kill()
+                p.wait()
+
+
+class _Progress:
+    def __init__(self, total: int, stream=sys.stderr):
+        self.total, self.done, self.survived, self.t0, self.stream = total, 0, 0, time.time(), stream
+
+    def step(self, survived: bool, what: str = "") -> None:
+        self.done += 1
+        self.survived += survived
+        width = 30
+        fill = int(width * self.done / max(1, self.total))
+        el = time.time() - self.t0
+        eta = el / self.done * (self.total - self.done)
+        line = (
+            f"\r[{'#' * fill}{'.' * (width - fill)}] {self.done}/{self.total} mutants, "
+            f"{self.survived} survived, {el:.0f} s (about {eta:.0f} s left) {what[:40]:<40}"
+        )
+        self.stream.write(line)
+        self.stream.flush()
+
+    def end(self) -> None:
+        self.stream.write("\n")
+        self.stream.flush()
+
+
+def _copy_lab(src: Path, dest: Path) -> None:
+    shutil.copytree(src, dest, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+
+
+def _score(res: dict) -> tuple[float, float]:
+    tests = res.get("tests", [])
+    return sum(t["score"] for t in tests), sum(t["max"] for t in tests)
+
+
+def _first_failure(res: dict) -> str:
+    if not res.get("ok"):
+        return res.get("error", "")
+    for t in res.get("tests", []):
+        if not t["passed"]:
+            return f"{t['name']}: {' '.join(t['output'].split())}"[:200]
+    return ""
+
+
+def audit(
+    labs: list[str] | None = None,
+    *,
+    quick: bool = False,
+    jobs: int = 1,
+    progress: bool = True,
+    log=print,
+) -> dict:
+    """Grade the mutants of each lab; returns the report as a dict (see :func:`markdown`)."""
+    names = labs or _impl.lab_names()
+    known = _impl.lab_names()
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
+    root = _impl.course_root()
+    work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
+    os.chmod(work, 0o755)
+    t_start = time.time()
+    report: dict = {"labs": {}, "quick": quick, "jobs": jobs}
+    pool = _Pool(max(1, jobs), work)
+    try:
+        plan = []  # (lab, mutant)
+        for lab in names:
+            muts, notes = generate(lab)
+            eq = equivalents(lab)
+            ids = {m.id for m in muts}
+            stale = [i for i in eq if i not in ids]
+            if quick:
+                muts = quick_sample(muts, lab)
+            tasks = sorted({m.task for m in muts})
+            report["labs"][lab] = {
+                "notes": notes,
+                "stale_equivalents": stale,
+                "equivalent_declared": eq,
+                "tasks": {},
+                "mutants": [],
+                "baseline": {},
+                "errors": [],
+            }
+            plan.append((lab, muts, tasks))
+        # Baseline: the unchanged solution, graded task by task the same way. --quick skips it (the
+        # test suite already checks that the solutions score full marks): a mutant is killed when it
+        # scores less than the maximum.
+        base_reqs = []
+        for lab, _muts, tasks in [] if quick else plan:
+            d = work / "baseline"
+            if not (d / lab).exists():
+                _copy_lab(root / "solutions" / lab, d / lab)
+            base_reqs += [{"impl": str(d), "lab": lab, "task": t, "budget": None} for t in tasks]
+        base: dict = {}
+
+        def base_done(i, r, res):
+            base[(r["lab"], r["task"])] = res
+
+        if progress and base_reqs:
+            sys.stderr.write(f"grading the solution ({len(base_reqs)} task runs)...\n")
+        pool.run(base_reqs, base_done)
+        reqs = []
+        for lab, muts, tasks in plan:
+            lr = report["labs"][lab]
+            for t in [] if quick else tasks:
+                res = base.get((lab, t), {})
+                got, top = _score(res)
+                lr["baseline"][t] = {"score": got, "max": top, "seconds": round(res.get("seconds", 0.0), 2)}
+                if not res.get("ok") or got < top:
+                    lr["errors"].append(
+                        f"Task {t}: the solution itself scores {got:g}/{top:g} ({_first_failure(res)}); its mutants are not graded"
+                    )
+            for k, m in enumerate(muts):
+                b = lr["baseline"].get(m.task, {})
+                if not quick and (b.get("score", 0) < b.get("max", 0) or not base[(lab, m.task)].get("ok")):
+                    continue
+                budget = max(60.0, 5 * b.get("seconds", 0.0)) if not quick else 120.0
+                d = work / f"{lab}-{k}"
+
+                def prepare(m=m, d=d, budget=budget):
+                    _copy_lab(root / "solutions" / m.lab, d / m.lab)
+                    (d / m.lab / m.file).write_text(m.source)
+                    return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
+
+                reqs.append({"prepare": prepare, "mutant": m})
+        prog = _Progress(len(reqs)) if progress else None
+        rows: dict[int, dict] = {}
+
+        def done(i, r, res):
+            m: Mutant = reqs[i]["mutant"]
+            shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
+            lr = report["labs"][m.lab]
+            got, top = _score(res)
+            full = lr["baseline"][m.task]["score"] if m.task in lr["baseline"] else top
+            if not res.get("ok"):
+                status = "error"
+            elif top == 0:
+                status = "survived"  # no graded test of the task at all
+            elif m.kind == "nothing":
+                status = "killed" if got == 0 else ("partly killed" if got < full else "survived")
+            else:
+                status = "killed" if got < full else "survived"
+            eq = lr["equivalent_declared"].get(m.id)
+            if eq is not None:
+                status = "equivalent" if status == "survived" else f"ERROR: declared equivalent but {status}"
+            failure = _first_failure(res)
+            timeout = bool(re.search(r"time budget|timed out|took longer|time limit", failure, re.I))
+            row = {
+                **{k: v for k, v in asdict(m).items() if k != "source"},
+                "status": status,
+                "score": got,
+                "max": top,
+                "seconds": round(res.get("seconds", 0.0), 2),
+                "why": failure,
+                "by_time": timeout,
+            }
+            if eq is not None:
+                row["reason"] = eq
+            rows[i] = row
+            if prog:
+                prog.step(status in ("survived", "partly killed"), m.id)
+
+        pool.run(reqs, done)
+        if prog:
+            prog.end()
+        for i in sorted(rows):
+            report["labs"][rows[i]["lab"]]["mutants"].append(rows[i])
+        for lr in report["labs"].values():
+            lr["tasks"] = _task_summary(lr)
+            for s in lr["stale_equivalents"]:
+                lr["errors"].append(f"equivalent_mutants.toml names {s!r}, which is not a mutant of the solution")
+            for r in lr["mutants"]:
+                if r["status"].startswith("ERROR"):
+                    lr["errors"].append(f"{r['id']}: {r['status']} ({r['why']})")
+                elif r["status"] == "error":
+                    lr["errors"].append(f"{r['id']}: could not be graded ({r['why']})")
+    finally:
+        pool.close()
+        shutil.rmtree(work, ignore_errors=True)
+    report["seconds"] = round(time.time() - t_start, 1)
+    return report
+
+
+def _task_summary(lr: dict) -> dict:
+    out: dict = {}
+    for r in lr["mutants"]:
+        t = out.setdefault(
+            str(r["task"]),
+            {"title": r["title"], "mutants": 0, "killed": 0, "survived": 0, "equivalent": 0, "nothing": 0,
+             "nothing_killed": 0, "operators": 0, "operators_killed": 0, "by_time": 0},
+        )  # fmt: skip
+        t["mutants"] += 1
+        kind = "nothing" if r["kind"] == "nothing" else "operators"
+        t[kind] += 1
+        if r["status"] == "killed":
+            t["killed"] += 1
+            t[kind + "_killed"] += 1
+            t["by_time"] += r["by_time"]
+        elif r["status"] == "equivalent":
+            t["equivalent"] += 1
+        elif r["status"] in ("survived", "partly killed"):
+            t["survived"] += 1
+    return dict(sorted(out.items(), key=lambda kv: int(kv[0])))
+
+
+def _pct(k: int, n: int) -> str:
+    return f"{100 * k / n:.0f}%" if n else "–"
+
+
+def markdown(report: dict) -> str:
+    """The report as Markdown: one table per lab (a row per task), then every survivor with its diff."""
+    out = [f"# Mutation audit{' (quick sample)' if report.get('quick') else ''}", ""]
+    out.append(f"{report.get('seconds', 0):.0f} s with {report.get('jobs', 1)} job(s).")
+    out.append("")
+    out.append(
+        "| lab | task | mutants | killed | survived | equivalent | does-nothing killed | operators killed | operator score |"
+    )
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+    for lab, lr in report["labs"].items():
+        for t, s in lr["tasks"].items():
+            ops_n = s["operators"] - sum(
+                1
+                for r in lr["mutants"]
+                if str(r["task"]) == t and r["kind"] == "operator" and r["status"] == "equivalent"
+            )
+            out.append(
+                f"| {lab} | {t} ({s['title']}) | {s['mutants']} | {s['killed']} | {s['survived']} | {s['equivalent']} "
+                f"| {s['nothing_killed']}/{s['nothing']} | {s['operators_killed']}/{s['operators']} "
+                f"| {_pct(s['operators_killed'], ops_n)} |"
+            )
+        ops = [r for r in lr["mutants"] if r["kind"] == "operator" and r["status"] != "equivalent"]
+        k = sum(r["status"] == "killed" for r in ops)
+        nothing = [r for r in lr["mutants"] if r["kind"] == "nothing"]
+        kn = sum(r["status"] == "killed" for r in nothing)
+        out.append(
+            f"| **{lab}** | **all** | **{len(lr['mutants'])}** | | | | **{kn}/{len(nothing)}** | **{k}/{len(ops)}** "
+            f"| **{_pct(k, len(ops))}** |"
+        )
+    for lab, lr in report["labs"].items():
+        surv = [r for r in lr["mutants"] if r["status"] in ("survived", "partly killed")]
+        if lr["errors"]:
+            out += ["", f"## {lab}: errors", ""]
+            out += [f"- {e}" for e in lr["errors"]]
+        if surv:
+            out += ["", f"## {lab}: {len(surv)} survivor(s)", ""]
+            for r in surv:
+                d = r["diff"].replace("\n", " ⟶ ")
+                what = f" ({r['score']:g}/{r['max']:g} points kept)" if r["status"] == "partly killed" else ""
+                out.append(f"- Task {r['task']} `{r['id']}`{what}: `{d}`")
+        if lr["notes"]:
+            out += ["", f"## {lab}: not mutated", ""]
+            out += [f"- {n}" for n in lr["notes"]]
+    return "\n".join(out) + "\n"
+
+
+def failed(report: dict) -> bool:
+    """True when the audit itself found errors (a bad declaration, a solution not at full marks)."""
+    return any(lr["errors"] for lr in report["labs"].values())
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv == ["--worker"]:
+        return _worker_main()
+    raise SystemExit("use `geomlib audit`")
+
+
+if __name__ == "__main__":
+    sys.exit(main())

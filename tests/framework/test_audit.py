@@ -1,0 +1,139 @@
+"""`geomlib audit`: mutants of the solutions, graded through the sandbox, and what the report says.
+
+The end-to-end test runs `geomlib audit --quick` on a copy of the sample course with a second lab,
+``weak``: the same solution with the midpoint tests planted weak (the midpoints ``M`` are never
+compared). Its does-nothing mutant of Task 2 must survive, while the same mutant of the intact lab
+is killed: the audit measures the tests' power, not the solution's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading import audit, stubs
+from geomlib.grading import impl as _impl
+
+from .course import run_geomlib
+
+LABS = sorted(p.name for p in (_impl.course_root() / "solutions").iterdir() if (p / "__init__.py").is_file())
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_every_mutant_changes_one_block_only_and_compiles(lab):
+    """Mutants differ from the solution only inside solution blocks (their stubs are the solution's),
+    every Python block has mutants, ids are unique and every mutant compiles."""
+    root = _impl.course_root() / "solutions" / lab
+    mutants, notes = audit.generate(lab)
+    assert mutants, f"{lab}: no mutants"
+    assert len({m.id for m in mutants}) == len(mutants), f"{lab}: duplicate mutant ids"
+    blocks, _ = audit._blocks(root)
+    covered = {(m.file, b.start) for m in mutants for b in blocks if b.file == m.file and b.start <= m.line < b.end}
+    missing = [f"{b.file}:{b.start}" for b in blocks if (b.file, b.start) not in covered]
+    assert not missing, f"{lab}: blocks without a mutant: {missing}"
+    stub_of = {}
+    for m in mutants:
+        original = (root / m.file).read_text()
+        if m.file not in stub_of:
+            stub_of[m.file] = stubs.make_stub(original, m.file)
+        compile(m.source, m.file, "exec", dont_inherit=True)
+        src = m.source
+        if m.kind == "nothing":
+            assert audit._HELPER_SOURCE in src, m.id
+            src = src.replace(audit._HELPER_SOURCE, "").rstrip("\n") + "\n"
+        assert stubs.make_stub(src, m.file).rstrip("\n") == stub_of[m.file].rstrip("\n"), (
+            f"{m.id} changes code outside its solution block"
+        )
+        assert m.source != original and m.diff.startswith("- "), m.id
+    kinds = {m.kind for m in mutants}
+    assert "operator" in kinds and "nothing" in kinds, f"{lab}: mutant kinds {kinds}"
+
+
+def test_operator_mutants_cover_every_listed_operator():
+    src = (
+        "import numpy as np\n\n\ndef f(a, b, i, ok=True):\n"
+        "    # BEGIN SOLUTION: Task 1 (all): everything\n"
+        "    x = a + b - 2 * a / 3.0\n"
+        "    x += 1\n"
+        "    y = a[i] if (a < b and b >= a) else np.maximum(a, b) + np.subtract(a, b)\n"
+        "    return x, y, True\n"
+        "    # END SOLUTION\n"
+    )
+    blocks, _ = stubs._scan(src, "f.py")
+    b = audit._Block("f.py", blocks[0].start, blocks[0].end, 1, "all")
+    import ast
+
+    labels = {e[3] for e in audit._operator_edits(src, ast.parse(src), b)}
+    for want in ["+ → -", "- → +", "* → /", "/ → *", "+= → -=", "< → <=", ">= → >", "True → False",
+                 "2 → 0", "2 → 4", "2 → 1", "2 → 3", "3.0 → 6.0", "3.0 → 1.5", "[i] → [i + 1]",
+                 "np.subtract(a, b) → np.subtract(b, a)"]:  # fmt: skip
+        assert want in labels, f"{want!r} not among {sorted(labels)}"
+    assert "np.maximum(a, b) → np.maximum(b, a)" not in labels, "swapping commuting arguments is equivalent"
+
+
+@pytest.fixture
+def two_lab_course(sample_course, tmp_path) -> Path:
+    """The sample course plus ``weak``: the same lab whose midpoint tests never look at ``M``."""
+    base = tmp_path / "audit"
+    root = base / "course"
+    shutil.copytree(sample_course, root, ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(root / "solutions" / "sample", root / "solutions" / "weak")
+    shutil.copytree(root / "tests" / "graded" / "sample", root / "tests" / "graded" / "weak")
+    cases = root / "tests" / "graded" / "weak" / "cases.py"
+    text = cases.read_text()
+    assert 'checks.All(checks.Equal("E"), checks.Allclose("M"))' in text
+    cases.write_text(text.replace('checks.All(checks.Equal("E"), checks.Allclose("M"))', 'checks.Equal("E")'))
+    test = root / "tests" / "graded" / "weak" / "test_sample.py"
+    text = test.read_text()
+    start = text.index('@graded(points=1, part="midpoints")')
+    end = text.index("@graded", start + 1)
+    test.write_text(text[:start] + text[end:])
+    # A declaration the audit must refuse: the intact lab's does-nothing mutant of Task 1 is killed.
+    (root / "tests" / "graded" / "sample" / "equivalent_mutants.toml").write_text(
+        '[[equivalent]]\nid = "ops.py:22:nothing-zeros"\nreason = "planted: wrongly declared"\n\n'
+        '[[equivalent]]\nid = "ops.py:99:0:gone"\nreason = "planted: names no mutant"\n'
+    )
+    run_geomlib(root, "refs", "build")
+    run_geomlib(root, "stubs", "build")
+    for dirpath, _dirs, files in os.walk(base):
+        os.chmod(dirpath, 0o755)
+        for f in files:
+            os.chmod(os.path.join(dirpath, f), 0o644)
+    return root
+
+
+@pytest.mark.slow
+def test_audit_quick_reports_a_planted_weak_test(two_lab_course, tmp_path):
+    out = tmp_path / "report"
+    p = run_geomlib(two_lab_course, "audit", "--quick", "--jobs", "2", "--out", str(out), check=False, timeout=600)
+    assert p.returncode == 1, f"a wrong equivalent declaration must fail the audit:\n{p.stdout}\n{p.stderr}"
+    assert "mutants" in p.stderr and "survived" in p.stderr, "no progress bar on stderr"
+    data = json.loads((out / "audit.json").read_text())
+    md = (out / "audit.md").read_text()
+    assert md == p.stdout.split("wrote ")[0], "audit.md differs from the table printed"
+    assert set(data["labs"]) == {"sample", "weak"}
+    for lab, lr in data["labs"].items():
+        assert set(lr["tasks"]) == {"1", "2"}, lab
+        assert lr["baseline"] == {}, f"{lab}: --quick grades no baseline (the suite checks the solutions)"
+        for r in lr["mutants"]:
+            assert {"id", "task", "kind", "op", "diff", "status", "score", "max"} <= set(r), r
+        assert sum(t["mutants"] for t in lr["tasks"].values()) == len(lr["mutants"]) == audit.QUICK_PER_LAB
+    by_id = {lab: {r["id"]: r for r in lr["mutants"]} for lab, lr in data["labs"].items()}
+    # The planted weak test: the midpoints can be anything, so doing nothing survives...
+    weak = by_id["weak"]["ops.py:41:nothing-zeros"]
+    assert weak["status"] == "survived" and weak["score"] == weak["max"] > 0, weak
+    assert "| weak | 2 (midpoints) |" in md and "ops.py:41:nothing-zeros" in md.split("## weak")[1]
+    # ...while the intact tests kill the same mutant.
+    assert by_id["sample"]["ops.py:41:nothing-zeros"]["status"] == "killed"
+    # A declared-equivalent mutant that a test kills, and a declaration naming no mutant, are errors.
+    errors = "\n".join(data["labs"]["sample"]["errors"])
+    assert "ops.py:22:nothing-zeros: ERROR: declared equivalent but killed" in errors, errors
+    assert "'ops.py:99:0:gone', which is not a mutant" in errors, errors
+    assert not data["labs"]["weak"]["errors"]
+    # Deterministic sample: the same mutants every run.
+    again = [m.id for m in audit.quick_sample(audit.generate("weak", two_lab_course / "solutions" / "weak")[0], "weak")]
+    assert again == [r["id"] for r in data["labs"]["weak"]["mutants"]]
