@@ -206,6 +206,8 @@ class _Zygote:
             raise GraderError(f"the sandbox could not start ({e}): {self.log_tail()}") from None
         # GEOMLIB_LANDLOCK=0 turns Landlock off (to test the protection of a kernel without it).
         self.landlock = 0 if os.environ.get("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
+        # GEOMLIB_SECCOMP=0 turns the network filter off (to test what it blocks).
+        self.seccomp = bool(ready.get("seccomp")) and os.environ.get("GEOMLIB_SECCOMP") != "0"
         self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
@@ -244,6 +246,7 @@ class _Zygote:
             **req,
             "user": self.user,
             "landlock": self.landlock > 0,
+            "seccomp": self.seccomp,
             "read": _readable_paths() + req.get("read", []),
         }
         return req
@@ -416,12 +419,13 @@ def status() -> str:
         parts.append(f"runs as user {z.user}")
     if z.landlock:
         parts.append(f"Landlock file-system confinement (ABI {z.landlock})")
+    net = " and no network sockets (seccomp)" if z.seccomp else ""
     if not parts:
         return (
-            "student code is process-isolated only (not root and no Landlock): it can read and write "
+            f"student code is process-isolated only{net} (not root and no Landlock): it can read and write "
             "whatever this user can"
         )
-    return "student code " + " with ".join(parts)
+    return "student code " + " with ".join(parts) + net
 
 
 def shutdown() -> None:

@@ -14,7 +14,10 @@ For each request the zygote forks a worker that
 3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``);
 4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
    and its own lab, write only a private scratch folder (and the run's shared numba cache), and neither open TCP connections nor signal
-   processes outside its sandbox.
+   processes outside its sandbox;
+5. (Linux x86_64/aarch64) can open no network socket: a seccomp filter lets ``socket()`` create
+   ``AF_UNIX`` sockets only (:mod:`geomlib.grading.seccomp`), so no UDP, TCP, IPv6 or raw packet
+   leaves the worker, with or without Landlock.
 
 The zygote is a child subreaper: anything the student's code started and detached is re-parented
 to it, and after each call it kills and reaps every remaining descendant before it tells the grader
@@ -35,7 +38,7 @@ import struct
 import sys
 import time
 
-from geomlib.grading import landlock
+from geomlib.grading import landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -198,6 +201,8 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
         os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the run's workers (geomlib.jit)
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
+    if req.get("seccomp"):
+        seccomp.deny_network()  # no socket but AF_UNIX: no UDP, raw or IPv6 either (Landlock blocks TCP only)
     os.chdir(req.get("cwd") or "/")
 
 
@@ -259,7 +264,9 @@ def serve(sock: socket.socket) -> None:
             importlib.import_module(name)
         except Exception:  # noqa: BLE001 - a missing optional module only makes workers slower
             pass
-    send_msg(sock, {"ready": True, "pid": os.getpid(), "landlock": landlock.abi_version()})
+    send_msg(
+        sock, {"ready": True, "pid": os.getpid(), "landlock": landlock.abi_version(), "seccomp": seccomp.available()}
+    )
     while True:
         try:
             req, blob, fds = recv_msg(sock, with_fds=True)
