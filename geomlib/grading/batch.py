@@ -127,44 +127,139 @@ def sandbox_user() -> str:
     return os.environ.get("GEOMLIB_SANDBOX_USER", default)
 
 
-def check_sandbox_user(user: str) -> None:
-    """Fail clearly unless ``user`` can run this Python and import the grader's worker.
+#: Where the private uids of ``grade-all`` come from (``GEOMLIB_SANDBOX_UIDS=FIRST-LAST`` overrides;
+#: ``GEOMLIB_SANDBOX_UIDS=none`` runs every submission as the one sandbox user). The first range is
+#: unused by convention (above systemd's container range, below 2^31); the second serves containers
+#: whose user namespace maps only 65536 ids (Debian allocates it on demand only; taken ids are skipped).
+UID_RANGES = ((2_000_000_000, 2_000_999_999), (60_000, 64_999))
+
+
+def _mapped(n: int) -> bool:
+    """Whether uid and gid ``n`` exist in this user namespace (all of them outside one)."""
+    for kind in ("uid_map", "gid_map"):
+        try:
+            rows = [line.split() for line in Path(f"/proc/self/{kind}").read_text().splitlines()]
+        except OSError:
+            continue
+        if not any(int(inside) <= n < int(inside) + int(count) for inside, _, count in rows):
+            return False
+    return True
+
+
+def _ids_in_use() -> set[int]:
+    """uids and gids that are named (passwd, group) or run a process now."""
+    import grp
+    import pwd
+
+    used = {p.pw_uid for p in pwd.getpwall()} | {p.pw_gid for p in pwd.getpwall()} | {g.gr_gid for g in grp.getgrall()}
+    for name in os.listdir("/proc"):
+        if name.isdigit():
+            with contextlib.suppress(OSError):
+                st = os.stat(f"/proc/{name}")
+                used |= {st.st_uid, st.st_gid}
+    return used
+
+
+def private_uids(count: int) -> list[int]:
+    """``count`` uids (each with the gid of the same number) that nothing else uses, one per submission.
+
+    Raises
+    ------
+    BatchError
+        ``GEOMLIB_SANDBOX_UIDS`` is malformed, or its range holds fewer free ids than submissions.
+    """
+    spec = os.environ.get("GEOMLIB_SANDBOX_UIDS", "")
+    if spec:
+        m = re.fullmatch(r"\s*(\d+)\s*-\s*(\d+)\s*", spec)
+        if not m or int(m.group(1)) < 1000 or int(m.group(1)) > int(m.group(2)):
+            raise BatchError(f"GEOMLIB_SANDBOX_UIDS={spec!r} is not a range FIRST-LAST of uids (FIRST >= 1000)")
+        ranges = [(int(m.group(1)), int(m.group(2)))]
+    else:
+        ranges = [r for r in UID_RANGES if _mapped(r[0]) and _mapped(r[1])]
+    used = _ids_in_use()
+    out: list[int] = []
+    for first, last in ranges:
+        n = first
+        while len(out) < count and n <= last:
+            if n not in used and _mapped(n):
+                out.append(n)
+            n += 1
+        if len(out) == count:
+            return out
+    raise BatchError(
+        f"found only {len(out)} free uids for {count} submissions in {spec or UID_RANGES}; "
+        f"set GEOMLIB_SANDBOX_UIDS=FIRST-LAST to a free range"
+    )
+
+
+def _kill_uid(uid: int) -> None:
+    """SIGKILL every process of ``uid`` (a submission's private uid, after its grading)."""
+    for _ in range(20):
+        pids = []
+        for name in os.listdir("/proc"):
+            if name.isdigit():
+                with contextlib.suppress(OSError):
+                    if os.stat(f"/proc/{name}").st_uid == uid:
+                        pids.append(int(name))
+        if not pids:
+            return
+        for pid in pids:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.kill(pid, signal.SIGKILL)
+        time.sleep(0.05)
+
+
+def check_sandbox_user(user: str, python: str | None = None) -> None:
+    """Fail clearly unless ``user`` (a name or a uid) can run ``python`` and import the grader's worker.
 
     A Python the sandbox user cannot read (one installed under ``/root``, say) would otherwise make
     student code fail on its first import, and the message would blame the student.
     """
     if not user or os.geteuid() != 0:
         return
+    from geomlib.grading.zygote import sandbox_ids
+
+    python = python or sys.executable
+    # The zygote's own search path (geomlib.grading.sandbox): this geomlib first.
+    here = str(Path(__file__).resolve().parents[2])
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([here, os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)}
     try:
+        uid, gid = sandbox_ids(user)
         p = subprocess.run(
-            ["runuser", "-u", user, "--", sys.executable, "-c", "import numpy, geomlib.grading.worker"],
-            cwd="/", capture_output=True, text=True, timeout=120,
+            [python, "-s", "-c", "import numpy, geomlib.grading.worker"], cwd="/", env=env,
+            capture_output=True, text=True, timeout=120, user=uid, group=gid, extra_groups=[],
         )  # fmt: skip
         ok, why = p.returncode == 0, (p.stderr.strip().splitlines() or ["?"])[-1]
+    except KeyError:
+        ok, why = False, "no such user"
     except (OSError, subprocess.TimeoutExpired) as e:
         ok, why = False, str(e)
     if not ok:
         raise BatchError(
-            f"the sandbox user {user!r} cannot run {sys.executable} ({why}); install the course where {user} "
+            f"the sandbox user {user!r} cannot run {python} ({why}); install the course where {user} "
             f"can read it (see docs/autograder.md), or set GEOMLIB_SANDBOX_USER= to grade without a sandbox user"
         )
 
 
-def _grade_one(sub: Submission, lab: str, out: Path, timeout: float) -> tuple[dict, str]:
-    """Grade one submission in its own process; returns (results, status) and writes them under ``out``."""
+def _grade_one(sub: Submission, lab: str, out: Path, timeout: float, user: str | None = None) -> tuple[dict, str]:
+    """Grade one submission in its own process; returns (results, status) and writes them under ``out``.
+
+    ``user`` is the sandbox user of this submission (a private uid as root), else :func:`sandbox_user`.
+    """
     out.mkdir(parents=True, exist_ok=True)
     results = out / "results.json"
     results.unlink(missing_ok=True)
+    # Private (0700, the grading user's): the grader reads the copy and makes the worker's snapshot.
     work = Path(tempfile.mkdtemp(prefix="geomlib-grade-all-"))
+    user = sandbox_user() if user is None else user
     try:
-        os.chmod(work, 0o755)
         try:
             skipped = copy_lab(find_lab(sub.folder, lab), work / "labs" / lab)
         except SubmissionError as e:
             data = _failure(f"Nothing was graded: {e}.")
             results.write_text(json.dumps(data, indent=1) + "\n")
             return data, "no lab"
-        env = {**os.environ, "GEOMLIB_SANDBOX_USER": sandbox_user()}
+        env = {**os.environ, "GEOMLIB_SANDBOX_USER": user}
         env.setdefault("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
         cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work / "labs"), "--lab", lab]
         cmd += ["--results", str(results), "--feedback", str(out / "feedback")]
@@ -193,6 +288,8 @@ def _grade_one(sub: Submission, lab: str, out: Path, timeout: float) -> tuple[di
             status = status if status != "ok" else "no results.json"
         return data, status
     finally:
+        if user.isdigit() and os.geteuid() == 0:
+            _kill_uid(int(user))  # nothing of this submission outlives its grading
         shutil.rmtree(work, ignore_errors=True)
 
 
@@ -213,9 +310,24 @@ def grade_all(
     if lab not in _impl.lab_names():
         raise BatchError(f"unknown lab {lab!r}; known: {', '.join(_impl.lab_names())}")
     subs = discover(Path(submissions))
-    check_sandbox_user(sandbox_user())
+    user = sandbox_user()
+    check_sandbox_user(user)
+    users = {s.id: user for s in subs}
     out = Path(out)
+    private = bool(user) and os.geteuid() == 0 and os.environ.get("GEOMLIB_SANDBOX_UIDS", "").lower() != "none"
+    if private:
+        # Every submission's workers run as a uid of their own (and the gid of the same number), so
+        # no submission's processes can read, write or signal another's, with or without Landlock.
+        uids = private_uids(len(subs))
+        check_sandbox_user(str(uids[0]))
+        users = {s.id: str(u) for s, u in zip(subs, uids, strict=True)}
     out.mkdir(parents=True, exist_ok=True)
+    if private:
+        for folder in (Path(submissions), out):
+            mode = folder.stat().st_mode
+            if mode & 0o007:
+                folder.chmod(mode & ~0o007)
+                log(f"made {folder} private (chmod o-rwx): each submission's code runs as a user of its own")
     parts = points_by_part([lab]).get(lab, {})
     jobs = jobs or min(4, os.cpu_count() or 1)
     ids: dict[str, str] = {}
@@ -230,7 +342,7 @@ def grade_all(
     failed: list[str] = []
     log(f"grading {len(subs)} submission(s) of {lab} with {jobs} job(s) into {out}")
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(_grade_one, s, lab, out / ids[s.id], timeout): s for s in subs}
+        futures = {pool.submit(_grade_one, s, lab, out / ids[s.id], timeout, users[s.id]): s for s in subs}
         for done, fut in enumerate(as_completed(futures), start=1):
             s = futures[fut]
             try:

@@ -212,8 +212,11 @@ class _Zygote:
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
             self.user = None  # only root can switch users; say so in status()
+        # Private to this run: only root and (when there is one) the sandbox user's group may enter,
+        # so no other user's processes (another submission's workers under grade-all, each with its
+        # own uid and gid) can reach this run's snapshots, scratch folders or numba cache.
         self.scratch_root = Path(tempfile.mkdtemp(prefix="geomlib-sandbox-"))
-        self.scratch_root.chmod(0o711)
+        self.scratch_root.chmod(0o700)
         # One numba cache for every worker of this run (NUMBA_CACHE_DIR in the worker, see
         # geomlib.jit): the first call compiles a lab's kernels, later calls load them. Each call's
         # own scratch folder would make every call compile again (seconds per call). Workers run
@@ -223,11 +226,13 @@ class _Zygote:
         self.snapshots: dict[str, Path] = {}
         self.problems: list[str] = []
         if self.user:
-            try:
-                import pwd
+            from geomlib.grading.zygote import sandbox_ids
 
-                pw = pwd.getpwnam(self.user)
-                os.chown(self.jit_cache, pw.pw_uid, pw.pw_gid)
+            try:
+                uid, gid = sandbox_ids(self.user)
+                os.chown(self.jit_cache, uid, gid)
+                os.chown(self.scratch_root, -1, gid)
+                self.scratch_root.chmod(0o710)
             except KeyError:
                 self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
             _protect_hidden()

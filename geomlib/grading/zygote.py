@@ -11,7 +11,8 @@ For each request the zygote forks a worker that
    and the file its prints go to;
 2. limits its address space, CPU time, file size, core dumps and (as a user other than root) the
    number of processes;
-3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``);
+3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``, or a private uid per
+   submission under ``geomlib grade-all``);
 4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
    and its own lab, write only a private scratch folder (and the run's shared numba cache), and neither open TCP connections nor signal
    processes outside its sandbox;
@@ -149,6 +150,21 @@ def kill_descendants() -> int:
 # ---------------------------------------------------------------------------------- the worker
 
 
+def sandbox_ids(user: str) -> tuple[int, int]:
+    """The uid and gid student code runs as for ``GEOMLIB_SANDBOX_USER=user``.
+
+    A user name gives that user's ids (``nobody``); a number gives that uid with the gid of the same
+    number, which need no passwd entry: ``geomlib grade-all`` gives every submission its own
+    (see :mod:`geomlib.grading.batch`). Raises KeyError for an unknown name.
+    """
+    if user.isdigit():
+        return int(user), int(user)
+    import pwd
+
+    pw = pwd.getpwnam(user)
+    return pw.pw_uid, pw.pw_gid
+
+
 def confine(req: dict, result_fd: int, out_fd: int) -> None:
     """Everything a worker does to itself before student code runs (see the module docstring)."""
     os.setsid()
@@ -180,16 +196,14 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
     user = req.get("user")
     uid = os.geteuid()
     if user and uid == 0:
-        import pwd
-
-        pw = pwd.getpwnam(user)
+        new_uid, new_gid = sandbox_ids(user)
         if scratch:
-            os.chown(scratch, pw.pw_uid, pw.pw_gid)
-        n = _worker.tasks_of_user(pw.pw_uid) + NPROC_EXTRA
+            os.chown(scratch, new_uid, new_gid)
+        n = _worker.tasks_of_user(new_uid) + NPROC_EXTRA
         resource.setrlimit(resource.RLIMIT_NPROC, (n, n))
         os.setgroups([])
-        os.setgid(pw.pw_gid)
-        os.setuid(pw.pw_uid)
+        os.setgid(new_gid)
+        os.setuid(new_uid)
         os.environ["HOME"] = scratch or "/nonexistent"
         os.environ["USER"] = os.environ["LOGNAME"] = user
     elif uid != 0:

@@ -85,10 +85,10 @@ def test_a_crash_costs_only_its_own_submission(sample_course, tmp_path, monkeypa
     exp = _export(sample_course, tmp_path)
     real = batch._grade_one
 
-    def flaky(sub, lab, out, timeout):
+    def flaky(sub, lab, out, timeout, *user):
         if sub.id == "submission_102":
             raise MemoryError("the grader ran out of memory")
-        return real(sub, lab, out, timeout)
+        return real(sub, lab, out, timeout, *user)
 
     monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
     monkeypatch.setenv("GEOMLIB_SANDBOX_USER", "")

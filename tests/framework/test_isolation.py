@@ -9,15 +9,19 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import socket
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
 
-from geomlib.grading import seccomp
+from geomlib.grading import landlock, seccomp
+from geomlib.grading.results import plain_text
 
-from .course import grade
+from .course import grade, sandbox_python, sandbox_user_problem
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")
 
@@ -119,3 +123,102 @@ def test_the_seccomp_filter_leaves_unix_sockets_and_takes_every_other_family():
         "AF_UNIX": "ok",
         "socketpair": "ok",
     }
+
+
+# ---------------------------------------------------------------------------------- grade-all (item 2)
+
+#: The victim's task holds a secret and stays in the sandbox long enough to be spied on.
+VICTIM = """    import time as _time
+
+    _secret = "VICTIM-SECRET-1234"
+    _time.sleep(2.0)
+"""
+
+#: The spy waits until the victim is being graded beside it (a second grade-all work folder in the
+#: temporary folder they share), then tries to read the victim's code, write into every other
+#: numba cache and signal every other worker; it reports what it managed in its exception.
+SPY = """    import glob as _glob
+    import json as _json
+    import os as _os
+    import time as _time
+
+    _base = _os.path.dirname(_os.path.dirname(_os.path.dirname(_os.getcwd())))  # TMPDIR: sandbox/lab-*/sample
+    _report = {"alive": False, "read": [], "wrote": [], "signalled": []}
+    _t0 = _time.time()
+    while _time.time() - _t0 < 5 and not _report["alive"]:
+        try:
+            _report["alive"] = sum(n.startswith("geomlib-grade-all-") for n in _os.listdir(_base)) >= 2
+        except OSError:
+            break  # cannot even list the folder (Landlock)
+        _time.sleep(0.1)
+    for _p in _glob.glob(_os.path.join(_base, "geomlib-grade-all-*", "labs", "sample", "ops.py")):
+        try:
+            if "VICTIM-" + "SECRET" in open(_p).read():  # not its own copy
+                _report["read"].append(_p)
+        except OSError:
+            pass
+    for _d in _glob.glob(_os.path.join(_base, "geomlib-sandbox-*", "numba-cache")):
+        if _d != _os.environ.get("NUMBA_CACHE_DIR"):
+            try:
+                with open(_os.path.join(_d, "spy-was-here"), "w") as _f:
+                    _f.write("x")
+                _report["wrote"].append(_d)
+            except OSError:
+                pass
+    for _pid in _os.listdir("/proc"):
+        if _pid.isdigit() and int(_pid) != _os.getpid():
+            try:
+                if b"geomlib.grading.zygote" in open(f"/proc/{_pid}/cmdline", "rb").read():
+                    _os.kill(int(_pid), 0)
+                    _report["signalled"].append(int(_pid))
+            except OSError:
+                pass
+    raise RuntimeError("SPY-REPORT " + _json.dumps(_report) + " END")
+"""
+
+
+def _spy_reports(results: dict) -> list[dict]:
+    import re
+
+    found = []
+    for t in results["tests"]:
+        for m in re.finditer(r"SPY-REPORT (\{.*?\}) END", plain_text(t.get("output", ""))):
+            found.append(json.loads(m.group(1)))
+    return found
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="separate users per submission need root")
+@pytest.mark.parametrize("landlock_on", ["0", "1"], ids=["without-landlock", "with-landlock"])
+def test_grade_all_keeps_a_spying_submission_away_from_its_neighbour(sample_course, tmp_path, landlock_on):
+    if landlock_on == "1" and not landlock.abi_version():
+        pytest.skip("this kernel has no Landlock")
+    found = sandbox_python("nobody")
+    if found is None:
+        pytest.skip(sandbox_user_problem("nobody"))
+    python, extra = found
+    shared_tmp = Path(tempfile.mkdtemp(prefix="geomlib-spy-tmp-"))  # where both submissions' folders go
+    shared_tmp.chmod(0o755)
+    subs = Path(tempfile.mkdtemp(prefix="geomlib-spy-subs-"))
+    try:
+        _submission(subs, "a-spy", _planted(SPY))
+        _submission(subs, "b-victim", _planted(VICTIM))
+        out = subs / "out"
+        env = {"GEOMLIB_LANDLOCK": landlock_on, "TMPDIR": str(shared_tmp), **extra}
+        env["PYTHONPATH"] = os.pathsep.join([str(sample_course), extra.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+        e = {k: v for k, v in os.environ.items() if k != "GEOMLIB_SANDBOX_USER"}
+        p = subprocess.run(
+            [python, "-m", "geomlib.cli", "grade-all", str(subs), "--lab", "sample", "--out", str(out), "--jobs", "2"],
+            cwd=sample_course, capture_output=True, text=True, timeout=600,
+            env={**e, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1", **env},
+        )  # fmt: skip
+        assert p.returncode == 0, p.stdout + p.stderr
+        victim = json.loads((out / "b-victim" / "results.json").read_text())
+        reports = _spy_reports(json.loads((out / "a-spy" / "results.json").read_text()))
+    finally:
+        shutil.rmtree(subs, ignore_errors=True)
+        shutil.rmtree(shared_tmp, ignore_errors=True)
+    assert victim["score"] == 7
+    assert reports, "the spy never ran"
+    if landlock_on == "0":
+        assert any(r["alive"] for r in reports), "the spy never saw the victim being graded beside it"
+    assert [r for r in reports if r["read"] or r["wrote"] or r["signalled"]] == [], reports
