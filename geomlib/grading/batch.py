@@ -241,7 +241,82 @@ def check_sandbox_user(user: str, python: str | None = None) -> None:
         )
 
 
-def _grade_one(sub: Submission, lab: str, out: Path, timeout: float, user: str | None = None) -> tuple[dict, str]:
+#: Where ``grade-all`` builds an environment the sandbox user can run, when the grader's own
+#: Python lives where that user cannot read it (``uv sync`` links ``.venv`` to a Python under /root).
+SANDBOX_VENV = ".venv-sandbox"
+#: The autograder's choice of Python (``setup.sh``, :mod:`geomlib.grading.release`), in order.
+PYTHON_CANDIDATES = ("/usr/bin/python3.11", "/usr/local/bin/python3.11")
+
+
+def _uv() -> list[str]:
+    """How to run uv: ``$UV`` (set by ``uv run``), ``uv`` on the PATH, else ``python3 -m uv``."""
+    if os.environ.get("UV") and os.access(os.environ["UV"], os.X_OK):
+        return [os.environ["UV"]]
+    if shutil.which("uv"):
+        return [shutil.which("uv")]
+    return [shutil.which("python3") or "python3", "-m", "uv"]
+
+
+def _runs(user: str, python: str) -> bool:
+    try:
+        check_sandbox_user(user, python)
+    except BatchError:
+        return False
+    return True
+
+
+def sandbox_interpreter(user: str, log=print) -> str:
+    """A Python that both root and the sandbox user can grade with: this one if the user can run it.
+
+    Else the course's ``.venv-sandbox``, made as the autograder's ``setup.sh`` makes its environment:
+    ``GEOMLIB_AUTOGRADER_PYTHON``, else a system ``python3.11``, else ``uv python install 3.11`` into
+    ``.python-sandbox`` (all readable by everyone), then ``uv sync --frozen --no-dev --group grading``.
+    """
+    from geomlib.grading.zygote import sandbox_ids
+
+    try:
+        sandbox_ids(user)
+    except KeyError:
+        return sys.executable  # no such user: check_sandbox_user says so
+    if not user or os.geteuid() != 0 or _runs(user, sys.executable):
+        return sys.executable
+    from geomlib.grading import impl as _impl
+
+    root = _impl.course_root()
+    venv = root / SANDBOX_VENV
+    python = venv / "bin" / "python"
+    if not ((root / "pyproject.toml").is_file() and (root / "uv.lock").is_file()):
+        return sys.executable  # not a checkout: check_sandbox_user says what is wrong
+    log(f"the sandbox user cannot run {sys.executable}; making {venv} as the autograder's setup.sh does")
+    env = {**os.environ, "UV_PROJECT_ENVIRONMENT": str(venv)}
+    env.pop("VIRTUAL_ENV", None)
+    base = os.environ.get("GEOMLIB_AUTOGRADER_PYTHON") or next(
+        (c for c in PYTHON_CANDIDATES if os.access(c, os.X_OK)), ""
+    )
+    try:
+        if not base:
+            env["UV_PYTHON_INSTALL_DIR"] = str(root / ".python-sandbox")
+            subprocess.run([*_uv(), "python", "install", "3.11"], env=env, check=True, capture_output=True, text=True)
+            base = subprocess.run(
+                [*_uv(), "python", "find", "3.11"], env=env, check=True, capture_output=True, text=True
+            ).stdout.strip()
+            subprocess.run(["chmod", "-R", "a+rX", env["UV_PYTHON_INSTALL_DIR"]], check=True)
+        subprocess.run(
+            [*_uv(), "sync", "--frozen", "--no-dev", "--group", "grading", "--compile-bytecode", "--python", base,
+             "--no-python-downloads", "--quiet"],
+            cwd=root, env=env, check=True, capture_output=True, text=True,
+        )  # fmt: skip
+        subprocess.run(["chmod", "-R", "a+rX", str(venv)], check=True)
+    except (OSError, subprocess.CalledProcessError) as e:
+        why = (getattr(e, "stderr", "") or str(e)).strip().splitlines()[-1:] or [str(e)]
+        raise BatchError(f"could not make {venv} for the sandbox user {user!r}: {why[0]}") from None
+    log(f"grading with {python} (Python {base})")
+    return str(python)
+
+
+def _grade_one(
+    sub: Submission, lab: str, out: Path, timeout: float, user: str | None = None, python: str | None = None
+) -> tuple[dict, str]:
     """Grade one submission in its own process; returns (results, status) and writes them under ``out``.
 
     ``user`` is the sandbox user of this submission (a private uid as root), else :func:`sandbox_user`.
@@ -261,7 +336,7 @@ def _grade_one(sub: Submission, lab: str, out: Path, timeout: float, user: str |
             return data, "no lab"
         env = {**os.environ, "GEOMLIB_SANDBOX_USER": user}
         env.setdefault("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
-        cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work / "labs"), "--lab", lab]
+        cmd = [python or sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work / "labs"), "--lab", lab]
         cmd += ["--results", str(results), "--feedback", str(out / "feedback")]
         with open(out / "grader-output.txt", "w") as log:
             if skipped:
@@ -311,7 +386,8 @@ def grade_all(
         raise BatchError(f"unknown lab {lab!r}; known: {', '.join(_impl.lab_names())}")
     subs = discover(Path(submissions))
     user = sandbox_user()
-    check_sandbox_user(user)
+    python = sandbox_interpreter(user, log)
+    check_sandbox_user(user, python)
     users = {s.id: user for s in subs}
     out = Path(out)
     private = bool(user) and os.geteuid() == 0 and os.environ.get("GEOMLIB_SANDBOX_UIDS", "").lower() != "none"
@@ -319,7 +395,7 @@ def grade_all(
         # Every submission's workers run as a uid of their own (and the gid of the same number), so
         # no submission's processes can read, write or signal another's, with or without Landlock.
         uids = private_uids(len(subs))
-        check_sandbox_user(str(uids[0]))
+        check_sandbox_user(str(uids[0]), python)
         users = {s.id: str(u) for s, u in zip(subs, uids, strict=True)}
     out.mkdir(parents=True, exist_ok=True)
     if private:
@@ -342,7 +418,7 @@ def grade_all(
     failed: list[str] = []
     log(f"grading {len(subs)} submission(s) of {lab} with {jobs} job(s) into {out}")
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(_grade_one, s, lab, out / ids[s.id], timeout, users[s.id]): s for s in subs}
+        futures = {pool.submit(_grade_one, s, lab, out / ids[s.id], timeout, users[s.id], python): s for s in subs}
         for done, fut in enumerate(as_completed(futures), start=1):
             s = futures[fut]
             try:

@@ -133,3 +133,35 @@ def test_a_sandbox_user_that_cannot_run_the_grader_stops_grade_all_with_one_line
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert p.stderr.startswith("geomlib grade-all: error: the sandbox user 'no-such-user-xyz' cannot run")
     assert not (tmp_path / "out" / "alice").exists()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the sandbox user is used as root only")
+def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user(tmp_path):
+    """docs/autograder.md: `uv run geomlib grade-all ...` in the course, as root, with the `.venv` that
+    `./run` or `uv sync` made (its Python may live under /root, which the sandbox user cannot open)."""
+    import subprocess
+    import sys
+    import tempfile
+
+    course = Path(__file__).resolve().parents[2]
+    venv_python = course / ".venv" / "bin" / "python"
+    if not venv_python.exists():
+        pytest.skip("no .venv in this checkout (made by ./run or uv sync)")
+    subs = Path(tempfile.mkdtemp(prefix="geomlib-grade-all-root-"))
+    try:
+        shutil.copytree(course / "labs" / "subdivision", subs / "stubs-student" / "subdivision")
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("GEOMLIB_", "PYTHON", "VIRTUAL_ENV"))}
+        p = subprocess.run(
+            [str(venv_python), "-m", "geomlib.cli", "grade-all", str(subs), "--lab", "subdivision",
+             "--out", str(subs / "out"), "--jobs", "1"],
+            cwd=course, env={**env, "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}, capture_output=True, text=True, timeout=900,
+        )  # fmt: skip
+        assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+        results = json.loads((subs / "out" / "stubs-student" / "results.json").read_text())
+        validate_results(results)
+        outputs = [t.get("output", "") for t in results["tests"] if t["max_score"] > 0]
+        assert outputs and not any("grader problem" in o for o in outputs), outputs[:3]
+        assert sum("not implemented yet" in o for o in outputs) > len(outputs) // 2  # the stubs ran
+        assert not (subs / "out" / "stubs-student" / "feedback").exists()  # no empty folder left behind
+    finally:
+        shutil.rmtree(subs, ignore_errors=True)
