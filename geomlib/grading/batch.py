@@ -314,6 +314,15 @@ def sandbox_interpreter(user: str, log=print) -> str:
     return str(python)
 
 
+def _prune_empty(folder: Path) -> None:
+    """Remove ``folder`` and its sub-folders where they hold no file (no pictures were drawn)."""
+    if not folder.is_dir() or folder.is_symlink():
+        return
+    for dirpath, _, _ in sorted(os.walk(folder), key=lambda w: -len(w[0])):
+        with contextlib.suppress(OSError):
+            os.rmdir(dirpath)  # fails, as it should, on a folder that is not empty
+
+
 def _grade_one(
     sub: Submission, lab: str, out: Path, timeout: float, user: str | None = None, python: str | None = None
 ) -> tuple[dict, str]:
@@ -363,6 +372,7 @@ def _grade_one(
             status = status if status != "ok" else "no results.json"
         return data, status
     finally:
+        _prune_empty(out / "feedback")
         if user.isdigit() and os.geteuid() == 0:
             _kill_uid(int(user))  # nothing of this submission outlives its grading
         shutil.rmtree(work, ignore_errors=True)

@@ -140,7 +140,6 @@ def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandb
     """docs/autograder.md: `uv run geomlib grade-all ...` in the course, as root, with the `.venv` that
     `./run` or `uv sync` made (its Python may live under /root, which the sandbox user cannot open)."""
     import subprocess
-    import sys
     import tempfile
 
     course = Path(__file__).resolve().parents[2]
@@ -165,3 +164,16 @@ def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandb
         assert not (subs / "out" / "stubs-student" / "feedback").exists()  # no empty folder left behind
     finally:
         shutil.rmtree(subs, ignore_errors=True)
+
+
+def test_grade_all_leaves_no_empty_feedback_folders(sample_course, tmp_path):
+    """Issue 26 item 8: grade-all draws no pictures unless asked, so it leaves no feedback/ folder."""
+    subs = tmp_path / "subs"
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "wrong" / "sample")
+    ops = subs / "wrong" / "sample" / "ops.py"
+    ops.write_text(ops.read_text().replace("return c + s * (V - c)", "return s * V"))
+    out = tmp_path / "out"
+    run_geomlib(sample_course, "grade-all", str(subs), "--lab", "sample", "--out", str(out), env=NO_SANDBOX)
+    results = json.loads((out / "wrong" / "results.json").read_text())
+    assert any(t["status"] == "failed" for t in results["tests"])
+    assert not (out / "wrong" / "feedback").exists(), list((out / "wrong").rglob("*"))
