@@ -188,10 +188,17 @@ def _spy_reports(results: dict) -> list[dict]:
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="separate users per submission need root")
-@pytest.mark.parametrize("landlock_on", ["0", "1"], ids=["without-landlock", "with-landlock"])
-def test_grade_all_keeps_a_spying_submission_away_from_its_neighbour(sample_course, tmp_path, landlock_on):
-    if landlock_on == "1" and not landlock.abi_version():
-        pytest.skip("this kernel has no Landlock")
+@pytest.mark.parametrize(
+    "landlock_on, user",
+    [("0", None), ("1", None), ("1", "")],
+    ids=["private-uids-without-landlock", "private-uids-with-landlock", "landlock-only"],
+)
+def test_grade_all_keeps_a_spying_submission_away_from_its_neighbour(sample_course, tmp_path, landlock_on, user):
+    """The spy reads nothing of the victim's, writes nothing of its and signals none of its processes:
+    as root each submission runs as a uid of its own (with or without Landlock); with Landlock and no
+    sandbox user (what a non-root instructor gets) Landlock alone keeps them apart (signals: ABI 6+)."""
+    if landlock_on == "1" and landlock.abi_version() < (6 if user == "" else 1):
+        pytest.skip("this kernel's Landlock is missing or too old (signal scoping needs ABI 6)")
     found = sandbox_python("nobody")
     if found is None:
         pytest.skip(sandbox_user_problem("nobody"))
@@ -206,6 +213,8 @@ def test_grade_all_keeps_a_spying_submission_away_from_its_neighbour(sample_cour
         env = {"GEOMLIB_LANDLOCK": landlock_on, "TMPDIR": str(shared_tmp), **extra}
         env["PYTHONPATH"] = os.pathsep.join([str(sample_course), extra.get("PYTHONPATH", "")]).rstrip(os.pathsep)
         e = {k: v for k, v in os.environ.items() if k != "GEOMLIB_SANDBOX_USER"}
+        if user is not None:
+            e["GEOMLIB_SANDBOX_USER"] = user
         p = subprocess.run(
             [python, "-m", "geomlib.cli", "grade-all", str(subs), "--lab", "sample", "--out", str(out), "--jobs", "2"],
             cwd=sample_course, capture_output=True, text=True, timeout=600,
