@@ -20,9 +20,11 @@ import os
 import re
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -160,36 +162,81 @@ def _ids_in_use() -> set[int]:
     return used
 
 
-def private_uids(count: int) -> list[int]:
-    """``count`` uids (each with the gid of the same number) that nothing else uses, one per submission.
-
-    Raises
-    ------
-    BatchError
-        ``GEOMLIB_SANDBOX_UIDS`` is malformed, or its range holds fewer free ids than submissions.
-    """
+def _uid_ranges() -> list[tuple[int, int]]:
     spec = os.environ.get("GEOMLIB_SANDBOX_UIDS", "")
     if spec:
         m = re.fullmatch(r"\s*(\d+)\s*-\s*(\d+)\s*", spec)
         if not m or int(m.group(1)) < 1000 or int(m.group(1)) > int(m.group(2)):
             raise BatchError(f"GEOMLIB_SANDBOX_UIDS={spec!r} is not a range FIRST-LAST of uids (FIRST >= 1000)")
-        ranges = [(int(m.group(1)), int(m.group(2)))]
-    else:
-        ranges = [r for r in UID_RANGES if _mapped(r[0]) and _mapped(r[1])]
-    used = _ids_in_use()
-    out: list[int] = []
-    for first, last in ranges:
-        n = first
-        while len(out) < count and n <= last:
-            if n not in used and _mapped(n):
-                out.append(n)
-            n += 1
-        if len(out) == count:
-            return out
-    raise BatchError(
-        f"found only {len(out)} free uids for {count} submissions in {spec or UID_RANGES}; "
-        f"set GEOMLIB_SANDBOX_UIDS=FIRST-LAST to a free range"
-    )
+        return [(int(m.group(1)), int(m.group(2)))]
+    return [r for r in UID_RANGES if _mapped(r[0]) and _mapped(r[1])]
+
+
+class UidPool:
+    """Private uids for the submissions of one ``grade-all`` run, never two at once for one uid.
+
+    A uid is taken by holding an exclusive ``flock`` on ``/run/geomlib-sandbox-uids/<uid>`` (a
+    root-only folder) while its submission is graded, so concurrent ``grade-all`` runs (or test
+    workers) never share one; the kernel drops the lock if the process dies. Within one run no uid is
+    given twice.
+    """
+
+    def __init__(self):
+        self.ranges = _uid_ranges()
+        base = Path("/run") if Path("/run").is_dir() else Path("/var/tmp")
+        self.locks = base / "geomlib-sandbox-uids"
+        with contextlib.suppress(FileExistsError):
+            self.locks.mkdir(mode=0o700)
+        st = os.lstat(self.locks)
+        if not stat.S_ISDIR(st.st_mode) or st.st_uid != 0 or st.st_mode & 0o022:
+            raise BatchError(f"{self.locks} must be a folder of root's that only root can write")
+        self.given: set[int] = set()
+        self.mutex = threading.Lock()
+
+    def take(self) -> tuple[int, int]:
+        """A free uid and the descriptor holding its lock (give it back with :meth:`release`)."""
+        import fcntl
+
+        with self.mutex:
+            in_use = _ids_in_use()
+            for first, last in self.ranges:
+                for n in range(first, last + 1):
+                    if n in in_use or n in self.given:
+                        continue
+                    fd = os.open(self.locks / str(n), os.O_CREAT | os.O_RDWR | os.O_NOFOLLOW | os.O_CLOEXEC, 0o600)
+                    try:
+                        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                    except OSError:
+                        os.close(fd)
+                        continue
+                    self.given.add(n)
+                    return n, fd
+        raise BatchError(
+            f"no free uid left in {os.environ.get('GEOMLIB_SANDBOX_UIDS') or UID_RANGES}; "
+            f"set GEOMLIB_SANDBOX_UIDS=FIRST-LAST to a free range"
+        )
+
+    @staticmethod
+    def release(fd: int) -> None:
+        os.close(fd)
+
+
+def _remove_files_of(uid: int) -> None:
+    """Remove what ``uid`` left in the world-writable folders (possible without Landlock only)."""
+    for top in ("/tmp", "/var/tmp", "/dev/shm"):
+        todo = [Path(top)]
+        for folder in todo:
+            with contextlib.suppress(OSError):
+                for entry in os.scandir(folder):
+                    with contextlib.suppress(OSError):
+                        st = entry.stat(follow_symlinks=False)
+                        if st.st_uid == uid:
+                            if entry.is_dir(follow_symlinks=False):
+                                shutil.rmtree(entry.path, ignore_errors=True)
+                            else:
+                                os.unlink(entry.path)
+                        elif stat.S_ISDIR(st.st_mode) and st.st_mode & 0o002 and folder == Path(top):
+                            todo.append(Path(entry.path))  # a world-writable folder one level down
 
 
 def _kill_uid(uid: int) -> None:
@@ -375,6 +422,7 @@ def _grade_one(
         _prune_empty(out / "feedback")
         if user.isdigit() and os.geteuid() == 0:
             _kill_uid(int(user))  # nothing of this submission outlives its grading
+            _remove_files_of(int(user))
         shutil.rmtree(work, ignore_errors=True)
 
 
@@ -398,15 +446,18 @@ def grade_all(
     user = sandbox_user()
     python = sandbox_interpreter(user, log)
     check_sandbox_user(user, python)
-    users = {s.id: user for s in subs}
     out = Path(out)
     private = bool(user) and os.geteuid() == 0 and os.environ.get("GEOMLIB_SANDBOX_UIDS", "").lower() != "none"
+    pool = None
     if private:
         # Every submission's workers run as a uid of their own (and the gid of the same number), so
         # no submission's processes can read, write or signal another's, with or without Landlock.
-        uids = private_uids(len(subs))
-        check_sandbox_user(str(uids[0]), python)
-        users = {s.id: str(u) for s, u in zip(subs, uids, strict=True)}
+        pool = UidPool()
+        uid, fd = pool.take()
+        try:
+            check_sandbox_user(str(uid), python)
+        finally:
+            pool.release(fd)
     out.mkdir(parents=True, exist_ok=True)
     if private:
         for folder in (Path(submissions), out):
@@ -427,8 +478,18 @@ def grade_all(
     rows: dict[str, dict] = {}
     failed: list[str] = []
     log(f"grading {len(subs)} submission(s) of {lab} with {jobs} job(s) into {out}")
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {pool.submit(_grade_one, s, lab, out / ids[s.id], timeout, users[s.id], python): s for s in subs}
+
+    def job(s: Submission) -> tuple[dict, str]:
+        if pool is None:
+            return _grade_one(s, lab, out / ids[s.id], timeout, user, python)
+        uid, fd = pool.take()
+        try:
+            return _grade_one(s, lab, out / ids[s.id], timeout, str(uid), python)
+        finally:
+            pool.release(fd)
+
+    with ThreadPoolExecutor(max_workers=jobs) as workers:
+        futures = {workers.submit(job, s): s for s in subs}
         for done, fut in enumerate(as_completed(futures), start=1):
             s = futures[fut]
             try:

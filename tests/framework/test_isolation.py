@@ -231,3 +231,25 @@ def test_grade_all_keeps_a_spying_submission_away_from_its_neighbour(sample_cour
     if landlock_on == "0":
         assert any(r["alive"] for r in reports), "the spy never saw the victim being graded beside it"
     assert [r for r in reports if r["read"] or r["wrote"] or r["signalled"]] == [], reports
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="private uids are given as root only")
+def test_two_concurrent_grade_all_runs_never_share_a_private_uid(tmp_path):
+    from geomlib.grading.batch import UidPool, _remove_files_of
+
+    a, b = UidPool(), UidPool()  # two runs at once (two instructors, two test workers)
+    ua, fa = a.take()
+    ub, fb = b.take()
+    assert ua != ub
+    a.release(fa)
+    ua2, fa2 = a.take()
+    assert ua2 not in (ua, ub)  # a run never gives a uid twice; b still holds ub
+    # What a submission left in /tmp under its uid goes with it.
+    left = Path(tempfile.mkdtemp(prefix="geomlib-left-by-uid-", dir="/tmp"))
+    (left / "data").write_text("x")
+    for p in (left, left / "data"):
+        os.chown(p, ua2, ua2)
+    _remove_files_of(ua2)
+    assert not left.exists()
+    for pool, fd in ((a, fa2), (b, fb)):
+        pool.release(fd)
