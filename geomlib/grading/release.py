@@ -27,6 +27,7 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import stubs
+from geomlib.grading.batch import PYTHON_CANDIDATES
 
 __all__ = ["release", "student_files", "autograder_files", "leaked_lines", "secret_lines", "ReleaseError"]
 
@@ -90,7 +91,7 @@ fi
 # A Python the sandbox user can read (not one under /root, which it cannot open): the one named by
 # GEOMLIB_AUTOGRADER_PYTHON, else a system python3.11, else uv installs 3.11 under $ROOT/python.
 PY="${GEOMLIB_AUTOGRADER_PYTHON:-}"
-for cand in /usr/bin/python3.11 /usr/local/bin/python3.11; do
+for cand in @PYTHON_CANDIDATES@; do
   if [ -n "$PY" ]; then break; fi
   if [ -x "$cand" ]; then PY="$cand"; break; fi
 done
@@ -432,7 +433,8 @@ def release(out: str | os.PathLike, labs: list[str] | None = None, *, log=print)
             (staging / "README.md").write_text(_AUTOGRADER_README.format(lab=lab))
             name = f"autograder-{lab}.zip"
             with zipfile.ZipFile(tmp / name, "w") as z:
-                _script(z, "setup.sh", SETUP_SH.replace("@LAB@", lab))
+                candidates = " ".join(PYTHON_CANDIDATES)  # the same choice as grade-all's (batch.py)
+                _script(z, "setup.sh", SETUP_SH.replace("@LAB@", lab).replace("@PYTHON_CANDIDATES@", candidates))
                 _script(z, "run_autograder", RUN_AUTOGRADER.replace("@LAB@", lab))
                 _zip_tree(z, staging)
             shutil.rmtree(staging)
