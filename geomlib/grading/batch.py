@@ -7,6 +7,10 @@ per submission (the metadata gives the students' names, ids and e-mails). Each s
 graded by ``geomlib grade`` in its own process, several at once (``--jobs``). A submission that
 crashes, hangs past ``--timeout`` or holds no lab costs only its own row.
 
+As root, every submission's student code runs as a uid of its own (:class:`UidPool`), with a Python
+every such uid can run (:func:`sandbox_interpreter`): no submission can read, write or signal
+another's, with or without Landlock (docs/autograder.md explains why one shared user would not do).
+
 Writes ``DIR/<submission>/results.json`` (and ``grader-output.txt``) per submission and
 ``DIR/scores.csv``: a row per submission, a column per part (public and hidden points together).
 """
