@@ -210,12 +210,17 @@ class _Zygote:
         self.notes = [n for n in ready.get("notes", []) if "Landlock" not in n]
         for note in self.notes:  # once per run, on stderr: the sandbox works, with less
             print(f"geomlib sandbox: {note}", file=sys.stderr)
+        # GEOMLIB_SECCOMP=0 turns the network filter off (to test what it blocks).
+        self.seccomp = bool(ready.get("seccomp")) and os.environ.get("GEOMLIB_SECCOMP") != "0"
         self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
             self.user = None  # only root can switch users; say so in status()
+        # Private to this run: only root and (when there is one) the sandbox user's group may enter,
+        # so no other user's processes (another submission's workers under grade-all, each with its
+        # own uid and gid) can reach this run's snapshots, scratch folders or numba cache.
         self.scratch_root = Path(tempfile.mkdtemp(prefix="geomlib-sandbox-"))
-        self.scratch_root.chmod(0o711)
+        self.scratch_root.chmod(0o700)
         # One numba cache for every worker of this run (NUMBA_CACHE_DIR in the worker, see
         # geomlib.jit): the first call compiles a lab's kernels, later calls load them. Each call's
         # own scratch folder would make every call compile again (seconds per call). Workers run
@@ -225,11 +230,13 @@ class _Zygote:
         self.snapshots: dict[str, Path] = {}
         self.problems: list[str] = []
         if self.user:
-            try:
-                import pwd
+            from geomlib.grading.zygote import sandbox_ids
 
-                pw = pwd.getpwnam(self.user)
-                os.chown(self.jit_cache, pw.pw_uid, pw.pw_gid)
+            try:
+                uid, gid = sandbox_ids(self.user)
+                os.chown(self.jit_cache, uid, gid)
+                os.chown(self.scratch_root, -1, gid)
+                self.scratch_root.chmod(0o710)
             except KeyError:
                 self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
             _protect_hidden()
@@ -248,6 +255,7 @@ class _Zygote:
             **req,
             "user": self.user,
             "landlock": self.landlock > 0,
+            "seccomp": self.seccomp,
             "read": _readable_paths() + req.get("read", []),
         }
         return req
@@ -423,13 +431,14 @@ def status() -> str:
         parts.append(f"runs as user {z.user}")
     if z.landlock:
         parts.append(f"Landlock file-system confinement (ABI {z.landlock})")
+    net = " and no network sockets (seccomp)" if z.seccomp else ""
     if not parts:
         text = (
-            "student code is process-isolated only (not root and no Landlock): it can read and write "
+            f"student code is process-isolated only{net} (not root and no Landlock): it can read and write "
             "whatever this user can"
         )
     else:
-        text = "student code " + " with ".join(parts)
+        text = "student code " + " with ".join(parts) + net
     return text + "".join(f"; {n}" for n in z.notes)
 
 

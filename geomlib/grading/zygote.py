@@ -11,10 +11,14 @@ For each request the zygote forks a worker that
    and the file its prints go to;
 2. limits its address space, CPU time, file size, core dumps and (as a user other than root) the
    number of processes;
-3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``);
+3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``, or a private uid per
+   submission under ``geomlib grade-all``);
 4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
    and its own lab, write only a private scratch folder (and the run's shared numba cache), and neither open TCP connections nor signal
-   processes outside its sandbox.
+   processes outside its sandbox;
+5. (Linux x86_64/aarch64) can open no network socket: a seccomp filter lets ``socket()`` create
+   ``AF_UNIX`` sockets only (:mod:`geomlib.grading.seccomp`), so no UDP, TCP, IPv6 or raw packet
+   leaves the worker, with or without Landlock.
 
 The zygote is a child subreaper: anything the student's code started and detached is re-parented
 to it, and after each call it kills and reaps every remaining descendant before it tells the grader
@@ -35,7 +39,7 @@ import struct
 import sys
 import time
 
-from geomlib.grading import landlock
+from geomlib.grading import landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -203,6 +207,21 @@ def platform_notes() -> list[str]:
 # ---------------------------------------------------------------------------------- the worker
 
 
+def sandbox_ids(user: str) -> tuple[int, int]:
+    """The uid and gid student code runs as for ``GEOMLIB_SANDBOX_USER=user``.
+
+    A user name gives that user's ids (``nobody``); a number gives that uid with the gid of the same
+    number, which need no passwd entry: ``geomlib grade-all`` gives every submission its own
+    (see :mod:`geomlib.grading.batch`). Raises KeyError for an unknown name.
+    """
+    if user.isdigit():
+        return int(user), int(user)
+    import pwd
+
+    pw = pwd.getpwnam(user)
+    return pw.pw_uid, pw.pw_gid
+
+
 def confine(req: dict, result_fd: int, out_fd: int) -> None:
     """Everything a worker does to itself before student code runs (see the module docstring)."""
     os.setsid()
@@ -225,17 +244,15 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
     user = req.get("user")
     uid = os.geteuid()
     if user and uid == 0:
-        import pwd
-
-        pw = pwd.getpwnam(user)
+        new_uid, new_gid = sandbox_ids(user)
         if scratch:
-            os.chown(scratch, pw.pw_uid, pw.pw_gid)
-        n = _worker.tasks_of_user(pw.pw_uid)
+            os.chown(scratch, new_uid, new_gid)
+        n = _worker.tasks_of_user(new_uid)
         if n is not None:
             _set_limit("NPROC", n + NPROC_EXTRA, n + NPROC_EXTRA)
         os.setgroups([])
-        os.setgid(pw.pw_gid)
-        os.setuid(pw.pw_uid)
+        os.setgid(new_gid)
+        os.setuid(new_uid)
         os.environ["HOME"] = scratch or "/nonexistent"
         os.environ["USER"] = os.environ["LOGNAME"] = user
     elif uid != 0 and (n := _worker.tasks_of_user(uid)) is not None:
@@ -246,6 +263,8 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
         os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the run's workers (geomlib.jit)
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
+    if req.get("seccomp"):
+        seccomp.deny_network()  # no socket but AF_UNIX: no UDP, raw or IPv6 either (Landlock blocks TCP only)
     os.chdir(req.get("cwd") or "/")
 
 
@@ -325,7 +344,16 @@ def serve(sock: socket.socket) -> None:
             importlib.import_module(name)
         except Exception:  # noqa: BLE001 - a missing optional module only makes workers slower
             pass
-    send_msg(sock, {"ready": True, "pid": os.getpid(), "landlock": landlock.abi_version(), "notes": platform_notes()})
+    send_msg(
+        sock,
+        {
+            "ready": True,
+            "pid": os.getpid(),
+            "landlock": landlock.abi_version(),
+            "seccomp": seccomp.available(),
+            "notes": platform_notes(),
+        },
+    )
     while True:
         try:
             req, blob, fds = recv_msg(sock, with_fds=True)

@@ -85,10 +85,10 @@ def test_a_crash_costs_only_its_own_submission(sample_course, tmp_path, monkeypa
     exp = _export(sample_course, tmp_path)
     real = batch._grade_one
 
-    def flaky(sub, lab, out, timeout):
+    def flaky(sub, lab, out, timeout, *user):
         if sub.id == "submission_102":
             raise MemoryError("the grader ran out of memory")
-        return real(sub, lab, out, timeout)
+        return real(sub, lab, out, timeout, *user)
 
     monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
     monkeypatch.setenv("GEOMLIB_SANDBOX_USER", "")
@@ -133,3 +133,47 @@ def test_a_sandbox_user_that_cannot_run_the_grader_stops_grade_all_with_one_line
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert p.stderr.startswith("geomlib grade-all: error: the sandbox user 'no-such-user-xyz' cannot run")
     assert not (tmp_path / "out" / "alice").exists()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the sandbox user is used as root only")
+def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user(tmp_path):
+    """docs/autograder.md: `uv run geomlib grade-all ...` in the course, as root, with the `.venv` that
+    `./run` or `uv sync` made (its Python may live under /root, which the sandbox user cannot open)."""
+    import subprocess
+    import tempfile
+
+    course = Path(__file__).resolve().parents[2]
+    venv_python = course / ".venv" / "bin" / "python"
+    if not venv_python.exists():
+        pytest.skip("no .venv in this checkout (made by ./run or uv sync)")
+    subs = Path(tempfile.mkdtemp(prefix="geomlib-grade-all-root-"))
+    try:
+        shutil.copytree(course / "labs" / "subdivision", subs / "stubs-student" / "subdivision")
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("GEOMLIB_", "PYTHON", "VIRTUAL_ENV"))}
+        p = subprocess.run(
+            [str(venv_python), "-m", "geomlib.cli", "grade-all", str(subs), "--lab", "subdivision",
+             "--out", str(subs / "out"), "--jobs", "1"],
+            cwd=course, env={**env, "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}, capture_output=True, text=True, timeout=900,
+        )  # fmt: skip
+        assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+        results = json.loads((subs / "out" / "stubs-student" / "results.json").read_text())
+        validate_results(results)
+        outputs = [t.get("output", "") for t in results["tests"] if t["max_score"] > 0]
+        assert outputs and not any("grader problem" in o for o in outputs), outputs[:3]
+        assert sum("not implemented yet" in o for o in outputs) > len(outputs) // 2  # the stubs ran
+        assert not (subs / "out" / "stubs-student" / "feedback").exists()  # no empty folder left behind
+    finally:
+        shutil.rmtree(subs, ignore_errors=True)
+
+
+def test_grade_all_leaves_no_empty_feedback_folders(sample_course, tmp_path):
+    """Issue 26 item 8: grade-all draws no pictures unless asked, so it leaves no feedback/ folder."""
+    subs = tmp_path / "subs"
+    shutil.copytree(sample_course / "solutions" / "sample", subs / "wrong" / "sample")
+    ops = subs / "wrong" / "sample" / "ops.py"
+    ops.write_text(ops.read_text().replace("return c + s * (V - c)", "return s * V"))
+    out = tmp_path / "out"
+    run_geomlib(sample_course, "grade-all", str(subs), "--lab", "sample", "--out", str(out), env=NO_SANDBOX)
+    results = json.loads((out / "wrong" / "results.json").read_text())
+    assert any(t["status"] == "failed" for t in results["tests"])
+    assert not (out / "wrong" / "feedback").exists(), list((out / "wrong").rglob("*"))
