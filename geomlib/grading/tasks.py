@@ -198,9 +198,8 @@ def _lab_calls(fn) -> list[str]:
     """Lab functions a hand-written test uses: ``lab.name(...)``, ``lab.call("name", ...)`` and
     ``lab.name`` passed on (``applied(lab.split_edge, ...)``), directly or through a helper defined
     in the same test module."""
-    try:
-        tree = ast.parse(_dedent(fn))
-    except (OSError, TypeError, SyntaxError):
+    tree = _tree(fn)
+    if tree is None:
         return []
     out = _lab_calls_direct(fn, tree)
     module = sys.modules.get(getattr(fn, "__module__", ""), None)
@@ -220,12 +219,18 @@ def _dedent(fn) -> str:
     return textwrap.dedent(inspect.getsource(fn))
 
 
+def _tree(fn):
+    """The syntax tree of ``fn``'s source, or None where it has no readable source."""
+    try:
+        return ast.parse(_dedent(fn))
+    except (OSError, TypeError, SyntaxError):
+        return None
+
+
 def _lab_calls_direct(fn, tree=None) -> list[str]:
+    tree = _tree(fn) if tree is None else tree
     if tree is None:
-        try:
-            tree = ast.parse(_dedent(fn))
-        except (OSError, TypeError, SyntaxError):
-            return []
+        return []
     out = []
     for n in ast.walk(tree):
         name = None
@@ -248,9 +253,8 @@ def _lab_calls_direct(fn, tree=None) -> list[str]:
 
 def _named_functions(fn, tab: TaskTable) -> list[str]:
     """Lab functions a test names in a string (``check_glsl_case(lab, case, "glsl_parallax_uv")``)."""
-    try:
-        tree = ast.parse(_dedent(fn))
-    except (OSError, TypeError, SyntaxError):
+    tree = _tree(fn)
+    if tree is None:
         return []
     out = []
     for n in ast.walk(tree):
