@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
+import tempfile
+import textwrap
 from pathlib import Path
 
 SAMPLE = Path(__file__).parent / "sample_course"
@@ -114,3 +117,27 @@ def sandbox_user_problem(user: str = "nobody") -> str | None:
     if sandbox_python(user) is None:
         return f"no Python here that user {user!r} can read (this one is {sys.executable}); see docs/autograder.md"
     return None
+
+
+def planted_solution(lab: str, edit) -> Path:
+    """A world-readable copy of the real course's ``solutions/<lab>`` (the sandbox may run student
+    code as ``nobody``), changed by ``edit(folder)``; returns the lab folder. Remove its parent after use."""
+    from geomlib.grading import impl as _impl
+
+    base = Path(tempfile.mkdtemp(prefix=f"geomlib-plant-{lab}-"))
+    dest = base / lab
+    shutil.copytree(_impl.course_root() / "solutions" / lab, dest, ignore=shutil.ignore_patterns("__pycache__"))
+    edit(dest)
+    for p in [base, *base.rglob("*")]:
+        os.chmod(p, 0o755 if p.is_dir() else 0o644)
+    return dest
+
+
+def appended(module: str, source: str, who: str):
+    """An ``edit`` for :func:`planted_solution` that appends ``source`` to ``<module>.py`` (rebinding a function)."""
+
+    def edit(dest: Path) -> None:
+        with open(dest / f"{module}.py", "a") as f:
+            f.write(f"\n\n# planted error ({who})\n" + textwrap.dedent(source))
+
+    return edit

@@ -7,10 +7,7 @@ way; the composite case is then run through the grader exactly as ``geomlib grad
 
 from __future__ import annotations
 
-import os
 import shutil
-import tempfile
-import textwrap
 from pathlib import Path
 
 import pytest
@@ -21,18 +18,12 @@ from geomlib.grading.cases import load_cases, run_case
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.sandbox import LabProxy
 
+from .course import appended, planted_solution
+
 
 def _plant(lab: str, module: str, source: str) -> Path:
     """A copy of solutions/<lab> with ``source`` appended to ``module``.py (rebinding a function)."""
-    base = Path(tempfile.mkdtemp(prefix="geomlib-plant-"))
-    os.chmod(base, 0o755)  # the sandbox may run student code as `nobody`
-    dest = base / lab
-    shutil.copytree(_impl.course_root() / "solutions" / lab, dest, ignore=shutil.ignore_patterns("__pycache__"))
-    with open(dest / f"{module}.py", "a") as f:
-        f.write("\n\n# planted error (tests/framework/test_diagnose.py)\n" + textwrap.dedent(source))
-    for p in base.rglob("*"):
-        os.chmod(p, 0o755 if p.is_dir() else 0o644)
-    return dest
+    return planted_solution(lab, appended(module, source, "tests/framework/test_diagnose.py"))
 
 
 def _message(lab: str, folder: Path, case_id: str) -> str:

@@ -7,20 +7,17 @@ Task 1 with the odd-vertex hint, not as "Task 4 · boundary rules" with the boun
 
 from __future__ import annotations
 
-import os
 import shutil
-import tempfile
-import textwrap
-from pathlib import Path
 
 import pytest
 
-from geomlib.grading import impl as _impl
 from geomlib.grading.cases import load_cases, run_case
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.grade import report_lines
 from geomlib.grading.results import Record
 from geomlib.grading.sandbox import LabProxy
+
+from .course import appended, planted_solution
 
 SWAPPED_ODD_WEIGHTS = """
 _true_loop_odd_matrix = loop_odd_matrix
@@ -43,16 +40,8 @@ def loop_odd_matrix(V, F, *, topo=None):
 
 
 def _message(source: str, case_id: str) -> str:
-    base = Path(tempfile.mkdtemp(prefix="geomlib-rows-"))
-    os.chmod(base, 0o755)  # the sandbox may run student code as `nobody`
-    dest = base / "subdivision"
-    shutil.copytree(
-        _impl.course_root() / "solutions" / "subdivision", dest, ignore=shutil.ignore_patterns("__pycache__")
-    )
-    with open(dest / "loop.py", "a") as f:
-        f.write("\n\n# planted error (tests/framework/test_rows_task.py)\n" + textwrap.dedent(source))
-    for p in base.rglob("*"):
-        os.chmod(p, 0o755 if p.is_dir() else 0o644)
+    dest = planted_solution("subdivision", appended("loop", source, "tests/framework/test_rows_task.py"))
+    base = dest.parent
     case = next(c for c in load_cases("subdivision") if c.id == case_id)
     try:
         with pytest.raises(Mismatch) as e:
