@@ -16,12 +16,13 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import pytest
 
 from geomlib.grading.results import plain_text
+
+from .course import planted_solution
 
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")]
 
@@ -30,13 +31,7 @@ COURSE = Path(__file__).resolve().parents[2]
 
 def _planted(lab: str, edit) -> Path:
     """A world-readable submission folder holding a copy of ``solutions/<lab>`` changed by ``edit(folder)``."""
-    work = Path(tempfile.mkdtemp(prefix=f"geomlib-planted-{lab}-"))
-    work.chmod(0o755)
-    shutil.copytree(COURSE / "solutions" / lab, work / lab, ignore=shutil.ignore_patterns("__pycache__"))
-    edit(work / lab)
-    for p in [work, *work.rglob("*")]:
-        p.chmod(0o755 if p.is_dir() else 0o644)
-    return work
+    return planted_solution(lab, edit).parent
 
 
 def _grade(impl: Path, lab: str, *extra: str, timeout: float = 600, env_extra: dict | None = None) -> dict:
