@@ -36,6 +36,7 @@ __all__ = [
     "look_at",
     "pose_from_view",
     "perspective",
+    "perspective_look_at",
     "orthographic",
     "viewport",
     "project",
@@ -238,6 +239,34 @@ def perspective(fov_y_deg: float, aspect: float, near: float, far: float) -> np.
     P[2, 3] = 2 * far * near / (near - far)
     P[3, 2] = -1.0
     return P
+
+
+def perspective_look_at(eye, target, up, fov_y_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
+    """Clip-from-world matrix of a perspective camera at ``eye`` looking at ``target``.
+
+    The one place the course composes ``perspective(fov_y_deg, aspect, near, far) @ look_at(eye, target, up)``
+    (figures, the shadows lab's eye pass); a light matrix a student writes spells it out.
+
+    Parameters
+    ----------
+    eye, target, up : array_like, shape (3,)
+        As :func:`look_at`.
+    fov_y_deg, aspect, near, far : float
+        As :func:`perspective`.
+
+    Returns
+    -------
+    (4, 4) float64
+        ``perspective(...) @ look_at(...)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> M = perspective_look_at((0, 0, 3), (0, 0, 0), (0, 1, 0), 60, 1.0, 0.1, 10)
+    >>> bool(np.allclose(M, perspective(60, 1.0, 0.1, 10) @ look_at((0, 0, 3), (0, 0, 0))))
+    True
+    """
+    return perspective(fov_y_deg, aspect, near, far) @ look_at(eye, target, up)
 
 
 def orthographic(left: float, right: float, bottom: float, top: float, near: float, far: float) -> np.ndarray:

@@ -11,7 +11,12 @@ gives every lab the same ``make_figures(out_dir, lab=None, quick=False)`` and
 file is copied into ``labs/<lab>/`` with the stubs, so there it draws the student's own functions:
 a builder stopped by a task that is not implemented yet leaves a "Task N not implemented yet"
 picture under its figure's name (:func:`figures_or_placeholders`), and a figure that can draw
-some of its panels names the missing task in its caption (:func:`partial_figure`).
+some of its panels draws a grey stand-in (:func:`missing_panel`) for the others, notes their tasks
+in a :class:`MissingTasks` and names the first in its caption (:func:`partial_figure`).
+
+A caption's numbers are measured, never typed: a builder formats its caption from a template and
+the numbers it computed (:meth:`Claims.caption`, :meth:`Drawn.claimed`), and
+``tests/test_figure_captions.py`` checks every caption against them.
 
 The pictures themselves are composed with :mod:`geomlib.plot`; the pages are written with
 :mod:`geomlib.viewer`.
@@ -19,7 +24,9 @@ The pictures themselves are composed with :mod:`geomlib.plot`; the pages are wri
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import re
+import string
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +35,11 @@ from geomlib.plot import Figure, _font, panels, save_png
 from geomlib.validate import MeshError
 
 __all__ = [
+    "Claims",
     "Drawn",
+    "MissingTasks",
+    "missing_panel",
+    "task_label",
     "MeshView",
     "figure_name",
     "lab_figure_makers",
@@ -37,6 +48,55 @@ __all__ = [
     "missing_task_figure",
     "partial_figure",
 ]
+
+
+@dataclass(frozen=True)
+class Claims:
+    """A caption's template and the numbers its builder measured, so the caption is never typed.
+
+    ``caption()`` is ``template.format(**numbers)``: every number the caption states is one of
+    ``numbers``, computed by the builder (a constant the builder itself uses, like a scale, counts:
+    it is what the picture was drawn with). ``tests/test_figure_captions.py`` checks that the
+    template's own text holds no digits (:meth:`typed_numbers`).
+
+    Attributes
+    ----------
+    template : str
+        The caption with ``{name}`` / ``{name:.2f}`` fields.
+    numbers : dict of str to int or float
+        The measured values, by field name.
+    """
+
+    template: str
+    numbers: dict = field(default_factory=dict)
+
+    #: Digits the template's own text may hold: task numbers, the texture square [0, 1] and "3D".
+    ALLOWED = (
+        re.compile(r"Tasks? \d+[a-z]?((, | and |-)\d+[a-z]?)*"),
+        re.compile(r"\[0, 1\]"),
+        re.compile(r"\b[23]D\b"),
+    )
+
+    def caption(self) -> str:
+        return self.template.format(**self.numbers)
+
+    def typed_numbers(self) -> list[str]:
+        """The numbers written into the template's text instead of measured (should be empty)."""
+        text = "".join(literal for literal, *_ in string.Formatter().parse(self.template))
+        for allowed in self.ALLOWED:
+            text = allowed.sub(" ", text)
+        return re.findall(r"\d+(?:[.,]\d+)*", text)
+
+    def problems(self, caption: str) -> list[str]:
+        """What is wrong with ``caption`` as a figure's caption made from these claims."""
+        out = [f"number {n!r} typed into the caption template, not measured" for n in self.typed_numbers()]
+        fields = {name for _, name, _, _ in string.Formatter().parse(self.template) if name}
+        out += [f"caption field {{{name}}} has no measured number" for name in sorted(fields - set(self.numbers))]
+        bad = [k for k, v in self.numbers.items() if isinstance(v, bool) or not isinstance(v, (int, float, np.number))]
+        out += [f"claim {k!r} is not a number" for k in bad]
+        if not out and not caption.endswith(self.caption()):
+            out.append("the caption is not the template formatted with the measured numbers")
+        return out
 
 
 @dataclass(frozen=True)
@@ -58,6 +118,13 @@ class Drawn:
 
     image: object
     caption: str
+    claims: Claims | None = None
+
+    @classmethod
+    def claimed(cls, image, template: str, **numbers) -> Drawn:
+        """A picture whose caption is ``template`` formatted with the measured ``numbers``."""
+        claims = Claims(template, numbers)
+        return cls(image, claims.caption(), claims)
 
 
 class MeshView:
@@ -71,14 +138,17 @@ class MeshView:
     V, faces, scalars
         The mesh and its optional per-vertex values, as :func:`geomlib.viewer.html_page` takes them
         (``(n, 3)`` positions, ``(m, 3)`` triangles, ``(n,)`` values coloured with ``cmap``).
-    caption : str
-        One or two sentences saying what the page shows (the index prints it under the frame).
+    caption : str or Claims
+        One or two sentences saying what the page shows (the index prints it under the frame); a
+        :class:`Claims` when it states measured numbers.
     **options
         Passed on to :func:`geomlib.viewer.html_page` (``title``, ``up``, ``cmap``, ``scalar_name``, ...).
     """
 
-    def __init__(self, V, faces, scalars=None, *, caption: str, **options):
-        self.V, self.faces, self.scalars, self.caption, self.options = V, faces, scalars, caption, options
+    def __init__(self, V, faces, scalars=None, *, caption: str | Claims, **options):
+        self.claims = caption if isinstance(caption, Claims) else None
+        self.caption = caption.caption() if isinstance(caption, Claims) else caption
+        self.V, self.faces, self.scalars, self.options = V, faces, scalars, options
 
 
 def lab_package(lab, package: str):
@@ -100,6 +170,45 @@ def lab_package(lab, package: str):
     return lab
 
 
+def task_label(error: BaseException) -> str:
+    """The task a stub's ``NotImplementedError`` names (``"2"``, ``"1a"``), or ``"?"``."""
+    m = re.search(r"Task\s+(\d+[a-z]?)", str(error))
+    return m.group(1) if m else "?"
+
+
+class MissingTasks(list):
+    """The tasks (labels, ``"3"``) whose panels the figure being drawn had to leave out.
+
+    The one way a figure draws what it can: ``missing.attempt(fn, ...)`` returns ``fn(...)``, or
+    None after noting the task a stub's ``NotImplementedError`` names; the figure draws a
+    :func:`missing_panel` instead, and :func:`partial_figure` (or :meth:`caption_head`) starts its
+    caption with the first missing task.
+    """
+
+    def attempt(self, fn, *args, **kwargs):
+        try:
+            return fn(*args, **kwargs)
+        except NotImplementedError as e:
+            self.append(task_label(e))
+            return None
+
+    def caption_head(self) -> str:
+        """``"Task N not implemented yet; the other panels show: "`` (N the first missing), or ``""``."""
+        return f"Task {self[0]} not implemented yet; the other panels show: " if self else ""
+
+
+def missing_panel(height: int, width: int, text: str = "not implemented yet") -> np.ndarray:
+    """A light grey ``(height, width, 3)`` uint8 panel with ``text``, standing in for a missing picture."""
+    import textwrap
+
+    from PIL import Image, ImageDraw
+
+    im = Image.new("RGB", (int(width), int(height)), (225, 225, 225))
+    lines = [line for part in text.splitlines() for line in textwrap.wrap(part, max(20, int(width) // 7)) or [""]]
+    ImageDraw.Draw(im).multiline_text((10, 10), "\n".join(lines), fill=(90, 90, 90))
+    return np.asarray(im)
+
+
 def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "") -> Figure:
     """A placeholder figure saying which task is missing, written where the real figure would go.
 
@@ -114,8 +223,6 @@ def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "")
     what : str
         What the figure will show once the task is done (goes into the caption).
     """
-    import re
-
     msg = str(error).strip() or type(error).__name__
     m = re.search(r"Task\s+(\d+[a-z]?)", msg)
     head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
@@ -174,7 +281,7 @@ def figures_or_placeholders(builders, out_dir, lab_name: str, *args) -> list[Fig
             )
         for item in items:
             if isinstance(item, Drawn):
-                item = Figure(save_png(path, item.image), item.caption, lab_name)
+                item = Figure(save_png(path, item.image), item.caption, lab_name, item.claims)
             elif not isinstance(item, Figure):
                 raise MeshError(
                     f"figure builder {build.__name__} returned {type(item).__name__}; "
@@ -206,7 +313,7 @@ def figure_name(name: str):
     return mark
 
 
-def partial_figure(build, missing: list[str]):
+def partial_figure(build, missing: MissingTasks):
     """Wrap a figure builder that draws grey panels for missing tasks instead of stopping.
 
     Some figures still show what they can when one of their panels needs a task that is not
@@ -219,8 +326,8 @@ def partial_figure(build, missing: list[str]):
     ----------
     build : callable
         ``build(out_dir, *args)`` returning a :class:`Drawn`, one :class:`Figure` or a list of them.
-    missing : list of str
-        The list the builder's stand-in panels append to.
+    missing : MissingTasks
+        The list the builder's stand-in panels append to (a plain list of labels works too).
 
     Returns
     -------
@@ -233,8 +340,8 @@ def partial_figure(build, missing: list[str]):
         missing.clear()
         out = build(out_dir, *args)
         figs = out if isinstance(out, list) else [out]
-        if missing:
-            head = f"Task {missing[0]} not implemented yet; the other panels show: "
+        head = MissingTasks.caption_head(missing)
+        if head:
             figs = [replace(f, caption=head + f.caption) for f in figs]
         return figs
 
@@ -361,7 +468,7 @@ def lab_figure_makers(
 
         shown = view(*args)
         path = write_html(out_dir / f"{stem}.html", shown.V, shown.faces, shown.scalars, **shown.options)
-        return Figure(path, shown.caption, lab_name)
+        return Figure(path, shown.caption, lab_name, shown.claims)
 
     def make_view(out_dir, lab=None, quick: bool = False) -> Figure:
         return run((page,), out_dir, lab, quick)[0]

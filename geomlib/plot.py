@@ -64,11 +64,15 @@ class Figure:
         One or two sentences saying what the figure shows.
     lab : str
         The lab it belongs to (``"gallery"`` for the dataset gallery).
+    claims : Claims, optional
+        The caption's template and the numbers its builder measured (:class:`geomlib.labfigures.Claims`);
+        None for a caption without numbers.
     """
 
     path: Path
     caption: str
     lab: str
+    claims: object = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "path", Path(self.path))

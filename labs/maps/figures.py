@@ -58,7 +58,7 @@ def _view(V: np.ndarray, direction, size: int, fov: float = 30.0, margin: float 
     d /= np.linalg.norm(d)
     dist = margin * r / np.sin(np.radians(fov) / 2)
     eye = c + dist * d
-    M = camera.perspective(fov, 1.0, max(dist - 1.2 * r, 1e-3), dist + 1.2 * r) @ camera.look_at(eye, c, (0, 0, 1))
+    M = camera.perspective_look_at(eye, c, (0, 0, 1), fov, 1.0, max(dist - 1.2 * r, 1e-3), dist + 1.2 * r)
     return eye, M
 
 

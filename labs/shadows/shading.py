@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geomlib.camera import look_at, perspective
+from geomlib.camera import perspective_look_at
 from geomlib.geometry import face_normals
 from geomlib.raster import rasterize
 from geomlib.validate import MeshError, as_array, check_float, check_int
@@ -102,7 +102,7 @@ def camera_matrix(camera, bounds, size: tuple[int, int], fov_deg: float = 40.0) 
     far = dist + r
     near = max(dist - r, 1e-3 * far)
     w, h = size
-    return perspective(fov_deg, w / h, near, far) @ look_at(eye, target, up)
+    return perspective_look_at(eye, target, up, fov_deg, w / h, near, far)
 
 
 def eye_gbuffer(scene, camera, size: tuple[int, int] = (512, 512), fov_deg: float = 40.0) -> EyeBuffer:

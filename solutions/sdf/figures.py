@@ -103,7 +103,7 @@ def csg_field(P):
 
 
 def _camera(eye, target, size, fov=40.0):
-    return camera.perspective(fov, size[1] / size[0], 0.05, 30.0) @ camera.look_at(eye, target, [0, 0, 1])
+    return camera.perspective_look_at(eye, target, [0, 0, 1], fov, size[1] / size[0], 0.05, 30.0)
 
 
 __all__ = ["make_figures", "make_view"]
