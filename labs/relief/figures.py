@@ -11,13 +11,21 @@ dense grid displaced by the height field, rasterized the same way.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers, partial_figure
+from geomlib.labfigures import (
+    Claims,
+    Drawn,
+    MeshView,
+    MissingTasks,
+    figure_name,
+    lab_figure_makers,
+    missing_panel,
+    partial_figure,
+)
 from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
 
@@ -33,7 +41,7 @@ from .truth import exact_uv, uv_error_texels
 __all__ = ["make_figures", "make_view", "quad_gbuffer", "shade"]
 
 #: Tasks whose panels the figure being drawn had to leave out (its caption then names the first).
-_MISSING: list[str] = []
+_MISSING = MissingTasks()
 
 LAB = "relief"
 SCALE = 0.08
@@ -45,7 +53,7 @@ def quad_gbuffer(size: int, eye=(0.5, -0.55, 0.75)):
     """The unit quad z = 0 seen from ``eye``: per-pixel mask, uv and tangent-space view vectors."""
     V, F, UV = datasets.uv_grid(1)
     eye = np.asarray(eye, float)
-    M = camera.perspective(42, 1.0, 0.1, 10.0) @ camera.look_at(eye, (0.5, 0.45, 0.0), (0, 0, 1))
+    M = camera.perspective_look_at(eye, (0.5, 0.45, 0.0), (0, 0, 1), 42, 1.0, 0.1, 10.0)
     g = rasterize(V, F, M, size, size, attributes={"position": V, "uv": UV})
     view = eye - g.attributes["position"]
     view /= np.maximum(np.linalg.norm(view, axis=-1, keepdims=True), 1e-12)
@@ -74,19 +82,17 @@ def shade(H, kind, mask, uv, normal, visibility=None) -> np.ndarray:
 
 
 def _missing(size: int) -> np.ndarray:
-    return np.full((size, size, 3), 0.8)
+    return missing_panel(size, size) / 255.0
 
 
 def _try(fn, size):
-    try:
-        return fn(), None
-    except NotImplementedError as e:
-        task = re.search(r"Task (\d+[a-z]?)", str(e))
-        _MISSING.append(task.group(1) if task else "?")
-        return None, f" (not implemented yet: {str(e).split(':')[0]})"
+    """``(fn(), None)``, or ``(None, note)`` when ``fn`` needs a task not implemented yet (noted in _MISSING)."""
+    out = _MISSING.attempt(fn)
+    return (out, None) if out is not None else (None, f" (not implemented yet: Task {_MISSING[-1]})")
 
 
-def _method_panels(H, kind, size):
+def _method_panels(H, kind, size, dropped: dict):
+    """The method panels and their labels; ``dropped`` receives where the discard pass cut (pixel counts)."""
     mask, uv, view, _, _ = quad_gbuffer(size)
     m = mask
     up = np.zeros_like(view)
@@ -117,6 +123,15 @@ def _method_panels(H, kind, size):
         hit, depth, _ = relief_uv(H, uv, view, scale=SCALE, refine=refine)
         vis = relief_shadow(H, hit, depth, LIGHT, scale=SCALE)
         keep = m & inside_texture(hit)
+        out = hit[m & ~keep]
+        rows = np.nonzero(m & ~keep)[0]
+        quad_rows = np.nonzero(m.any(axis=1))[0]
+        dropped.update(
+            dropped=len(out), far=int((out[:, 1] > 1).sum()), near=int((out[:, 1] < 0).sum()),
+            left=int((out[:, 0] < 0).sum()), right=int((out[:, 0] > 1).sum()),
+            # how far down the quad's image the cut reaches: 0 = its far (top) edge, 100 = its near edge
+            reach=float(100 * (rows.max() - quad_rows.min()) / max(quad_rows.max() - quad_rows.min(), 1)) if len(rows) else 0.0,
+        )  # fmt: skip
         return shade(H, kind, keep, hit, bump_normal(H, hit, strength=SCALE), vis)
 
     add(f"POM ({'binary' if kind == 'bricks' else 'secant'}) + self-shadow, uv outside [0, 1] discarded", pom_shadow)
@@ -147,7 +162,8 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
     size = 120 if quick else 220
     figs = []
     for kind, H in (("bricks", bricks(128 if quick else 256)), ("bumps", bumps(128 if quick else 256))):
-        imgs, caps = _method_panels(H, kind, size)
+        dropped: dict = {}
+        imgs, caps = _method_panels(H, kind, size, dropped)
         mask, _, view, _, _ = quad_gbuffer(size)
         deg = np.degrees(np.arccos(view[mask][:, 2]))
         img = panels(
@@ -156,17 +172,22 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
             ncols=4,
             title=f"{kind}: from flat to the true relief (scale {SCALE}, seen at {deg.min():.0f}-{deg.max():.0f} degrees)",
         )
-        figs.append(
-            Figure(
-                save_png(out / f"methods_{kind}.png", img),
-                f"The {kind} height map on one quad: flat and bump shading keep the texture in place; parallax shifts "
-                f"it once (far too much at grazing angles), offset limiting caps the shift; steep parallax steps "
-                f"through layers (visible bands), POM refines the hit (linear, secant, binary); self-shadowing darkens "
-                f"what the relief hides from the light, and discarding uv outside [0, 1] carves the near edge. The last "
-                f"two panels are the exact intersection and a rasterized displaced grid.",
-                LAB,
-            )
+        template = (
+            f"The {kind} height map on one quad, scale {{scale}}: flat and bump shading keep the texture in place; "
+            "parallax shifts it once (far too much at grazing angles), offset limiting caps the shift; steep "
+            "parallax steps through layers (bands, one per layer, seen best at the far edge), POM refines the "
+            "hit (linear, secant, binary); self-shadowing darkens what the relief hides from the light."
         )
+        if dropped:
+            template += (
+                " Discarding uv outside [0, 1] carves the FAR edge and the far halves of the sides, where the "
+                "ray, going down and away from the eye, leaves the texture: of the {dropped} pixels dropped, "
+                "{far} left through the far edge (v > 1), {left} and {right} through the sides, {near} through "
+                "the near edge; none lies beyond {reach:.0f}% of the way down the quad's image."
+            )
+        template += " The last two panels are the exact intersection and a rasterized displaced grid."
+        claims = Claims(template, {"scale": SCALE, **dropped})
+        figs.append(Figure(save_png(out / f"methods_{kind}.png", img), claims.caption(), LAB, claims))
     return figs
 
 
@@ -177,7 +198,8 @@ def _fig_errors(out: Path, quick: bool) -> Drawn:
     mask, uv, view, _, _ = quad_gbuffer(size)
     truth, _ = exact_uv(H, uv, view, scale=SCALE, samples=1024)
     rows, caps = [], []
-    vmax = 2.0
+    lo, hi = -3.0, 2.0  # log10 of the error in texels: 0.001 to 100
+    exact, p99 = {}, {}
     for label, fn in (
         ("parallax", lambda: parallax_uv(H, uv, view, scale=SCALE)),
         ("steep", lambda: relief_uv(H, uv, view, scale=SCALE, refine="none")[0]),
@@ -192,18 +214,28 @@ def _fig_errors(out: Path, quick: bool) -> Drawn:
             continue
         e = uv_error_texels(got, truth, 256)
         e[~mask] = np.nan
-        rows.append(heatmap_image(np.minimum(e, vmax), vmin=0, vmax=vmax))
-        caps.append(f"{label}: p99 {np.nanpercentile(e, 99):.3g} texels")
-    rows.append(colorbar(0, vmax, "inferno", label="uv error (texels, clipped at 2)"))
+        key = label.split()[-1]
+        exact[key] = float(100 * np.mean(e[mask] < 0.01))
+        p99[key] = float(np.nanpercentile(e, 99))
+        rows.append(heatmap_image(np.clip(np.log10(np.maximum(e, 1e-12)), lo, hi), vmin=lo, vmax=hi))
+        caps.append(f"{label}: p99 {p99[key]:.3g} texels,\nexact (< 0.01) on {exact[key]:.0f}% of pixels")
+    rows.append(colorbar(lo, hi, "inferno", label="log10 uv error (texels)"))
     caps.append("")
-    img = panels(rows, caps, ncols=3, title="uv error against the exact intersection, bricks (256 x 256 map)")
-    return Drawn(
+    img = panels(rows, caps, ncols=3, title="uv error against the exact hit, bricks (256^2 map)")
+    if "parallax" not in exact or "steep" not in exact:
+        return Drawn(img, "Per-pixel distance (in texels, log scale) between each method's uv and the exact hit.")
+    tops = float(100 * np.mean(height_at(H, uv[mask][:, 0], uv[mask][:, 1]) >= 1.0))
+    return Drawn.claimed(
         img,
-        "Per-pixel distance (in texels) between each method's uv and the exact ray / height-field hit on the bricks. "
-        "Parallax is off by many texels everywhere but straight down; steep parallax by up to a layer; linear POM "
-        "errs along the bevels; after secant or binary refinement only isolated pixels on the bevels stay off "
-        "(the secant step can stall on a bevel's kink; bisection cannot).",
-    )
+        "Per-pixel distance (in texels, log scale) between each method's uv and the exact ray / height-field hit "
+        "on the bricks. Parallax is exact (under 0.01 texel) on {parallax_exact:.0f}% of the pixels: the flat brick "
+        "tops ({tops:.0f}% of the pixels see h = 1 at their entry point), where h = 1 means no shift at all; its "
+        "error lives in the joints and bevels, where it reaches {parallax_p99:.3g} texels (p99) against "
+        "{steep_p99:.3g} for steep parallax (at most a layer). Linear POM errs along the bevels; after secant or "
+        "binary refinement only isolated pixels on the bevels stay off (the secant step can stall on a bevel's "
+        "kink; bisection cannot).",
+        parallax_exact=exact["parallax"], tops=tops, parallax_p99=p99["parallax"], steep_p99=p99["steep"],
+    )  # fmt: skip
 
 
 @figure_name("error_vs_angle")
@@ -212,45 +244,57 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Drawn:
     t = (np.arange(p) + 0.5) / p
     uv = np.stack(np.meshgrid(t, t[::-1]), axis=-1)
     angles = np.array([15, 30, 45, 60, 75, 80] if not quick else [30, 60, 75])
-    curves = {}
+    methods = ("parallax", "offset-limited", *REFINEMENTS)
+    curves: dict = {}
     for kind, H in (("bumps", bumps(256)), ("bricks", bricks(256))):
         for deg in angles:
             a = np.radians(deg)
             V = np.array([np.sin(a) * np.cos(0.3), np.sin(a) * np.sin(0.3), np.cos(a)])
             truth, _ = exact_uv(H, uv, V, scale=SCALE)
-            for m in ("parallax", *REFINEMENTS):
-                try:
-                    got = (
-                        parallax_uv(H, uv, V, scale=SCALE)
-                        if m == "parallax"
-                        else relief_uv(H, uv, V, scale=SCALE, refine=m)[0]
-                    )
-                except NotImplementedError as e:
-                    task = re.search(r"Task (\d+[a-z]?)", str(e))
-                    _MISSING.append(task.group(1) if task else "?")
-                    continue
-                e = np.percentile(uv_error_texels(got, truth, 256), 99)
-                curves.setdefault(f"{m} ({kind})", []).append(max(e, 1e-6))
-    names = [k for k in curves if len(curves[k]) == len(angles)]
-    if not names:
-        img = panels([_missing(200)], ["not implemented yet"])
-    else:
-        img = line_plot(
-            [angles] * len(names),
-            [curves[k] for k in names],
-            names,
-            xlabel="view angle from the normal (degrees)",
-            ylabel="p99 uv error (texels, floor 1e-6)",
-            title="Error against the exact hit vs view angle (scale 0.08, 256 x 256 maps)",
-            logy=True,
-            size=(900, 560),
-        )
-    return Drawn(
+            for m in methods:
+                if m in ("parallax", "offset-limited"):
+                    got = _MISSING.attempt(parallax_uv, H, uv, V, scale=SCALE, offset_limit=m == "offset-limited")
+                else:
+                    got = _MISSING.attempt(relief_uv, H, uv, V, scale=SCALE, refine=m)
+                    got = None if got is None else got[0]
+                if got is not None:
+                    e = np.percentile(uv_error_texels(got, truth, 256), 99)
+                    curves.setdefault(kind, {}).setdefault(m, []).append(max(e, 1e-6))
+    plots = []
+    for kind in ("bumps", "bricks"):
+        done = {m: c for m, c in curves.get(kind, {}).items() if len(c) == len(angles)}
+        if not done:
+            plots.append(_missing(200))
+            continue
+        # every method in every panel, in the same order: the same colour and marker on both maps
+        plots.append(
+            line_plot(
+                [angles] * len(done), list(done.values()), [{"none": "steep (none)"}.get(m, m) for m in done],
+                xlabel="view angle from the normal (degrees)", ylabel="p99 uv error (texels, floor 1e-6)",
+                title=f"{kind}", logy=True, size=(560, 520),
+            )
+        )  # fmt: skip
+    img = panels(plots, None, title=f"Error against the exact hit vs view angle (scale {SCALE}, 256^2 maps)")
+    sec = {k: curves.get(k, {}).get("secant") for k in ("bumps", "bricks")}
+    if sec["bumps"] is None or sec["bricks"] is None or "offset-limited" not in curves.get("bricks", {}):
+        return Drawn(img, "p99 uv error (log scale) of each method against the exact intersection as the view tilts.")
+    i75 = int(np.argmax(angles >= 75))
+    return Drawn.claimed(
         img,
-        "p99 uv error (log scale) of each method against the exact intersection as the view tilts. Every error grows "
-        "with the angle; on the smooth bumps the secant refinement is exact to round-off, on the bricks' sharp steps "
-        "it is not and binary search is the more reliable refinement.",
-    )
+        "p99 uv error (log scale) of each method against the exact intersection as the view tilts, on a "
+        "{pixels} x {pixels} grid of pixels (the handout's table, from bench/relief.py, uses 256 x 256, so single "
+        "stalled pixels move its p99 differently). The errors grow with the angle. On the smooth bumps secant "
+        "refinement is the most accurate: at most {sec_bumps:.1g} texels up to {max_deg} degrees; on the bricks' "
+        "sharp steps it can stall on a bevel ({sec_bricks:.2g} texels at {deg75} degrees) and binary search is "
+        "the more reliable refinement. Offset limiting is not a more accurate parallax: on the bumps it is "
+        "further off than plain parallax at {deg75} degrees ({ol_bumps:.3g} vs {px_bumps:.3g} texels); on the "
+        "bricks it is closer there ({ol_bricks:.3g} vs {px_bricks:.3g}) only because the plain shift overshoots "
+        "by even more.",
+        pixels=p, sec_bumps=max(sec["bumps"]), max_deg=int(angles.max()), sec_bricks=sec["bricks"][i75],
+        deg75=int(angles[i75]), ol_bumps=curves["bumps"]["offset-limited"][i75],
+        px_bumps=curves["bumps"]["parallax"][i75], ol_bricks=curves["bricks"]["offset-limited"][i75],
+        px_bricks=curves["bricks"]["parallax"][i75],
+    )  # fmt: skip
 
 
 @figure_name("steps")
@@ -258,33 +302,50 @@ def _fig_steps(out: Path, quick: bool) -> Drawn:
     size = 120 if quick else 220
     H = bricks(256)
     mask, uv, view, _, _ = quad_gbuffer(size)
-    try:
-        _, _, steps = relief_uv(H, uv, view, scale=SCALE, refine="none")
-    except NotImplementedError as e:
-        task = re.search(r"Task (\d+[a-z]?)", str(e))
-        _MISSING.append(task.group(1) if task else "?")
+    marched = _MISSING.attempt(relief_uv, H, uv, view, scale=SCALE, refine="none", min_layers=8, max_layers=32)
+    if marched is None:
         img = panels([_missing(size)], ["relief_uv: not implemented yet"])
     else:
         from .relief import layer_count
 
+        steps = marched[2]
         n = layer_count(view[..., 2], 8, 32).astype(float)
         n[~mask] = np.nan
         st = steps.astype(float)
         st[~mask] = np.nan
+        lo, hi = int(np.nanmin(n)), int(np.nanmax(n))
+
+        def with_bar(img, vmin, vmax, label):  # each panel its own bar, right next to it
+            bar = colorbar(
+                vmin,
+                vmax,
+                "viridis",
+                label=label,
+                height=img.shape[0],
+                ticks=vmax - vmin + 1 if vmax - vmin <= 8 else 5,
+            )
+            return np.hstack([img, np.full((img.shape[0], 8, 3), 255, np.uint8), bar])
+
         img = panels(
             [
-                heatmap_image(n, "viridis", 8, 32),
-                heatmap_image(st, "viridis", 0, 32),
-                colorbar(0, 32, "viridis", label="layers"),
+                with_bar(heatmap_image(n, "viridis", 8, 32), 8, 32, "n (layers)"),
+                with_bar(heatmap_image(st, "viridis", 0, 32), 0, 32, "layer of the hit"),
             ],
-            ["layer count n (more at grazing angles)", "layers marched to the hit", ""],
+            ["layer count n (more at grazing angles)", "layers marched to the hit"],
             title="Layers of the march (bricks)",
+        )  # fmt: skip
+        return Drawn.claimed(
+            img,
+            "Left: the layer count n = floor(min + (max - min)(1 - view_z) + 1/2) per pixel, with min = {min_layers} "
+            "and max = {max_layers} layers, grows from {lo} at the near edge to {hi} towards the far, grazing part of "
+            "the quad (colour bar {min_layers}-{max_layers}). Right: the layer where the march stopped (colour bar "
+            "0-{max_layers}); the deep mortar joints take the most layers.",
+            min_layers=8,
+            max_layers=32,
+            lo=lo,
+            hi=hi,
         )
-    return Drawn(
-        img,
-        "Left: the layer count n = floor(8 + 24 (1 - view_z) + 1/2) per pixel grows towards the far, grazing part "
-        "of the quad. Right: the layer where the march stopped; the deep mortar joints take the most layers.",
-    )
+    return Drawn(img, "The layer count per pixel and the layer where the march stopped.")
 
 
 # The curved mesh of the silhouette figure: half a cylinder of radius R around the y axis, length W,
@@ -314,7 +375,7 @@ def _arc_render(size, cells, depth=None):
     Vg, F = datasets.grid_patch(cells)
     uv = Vg[:, :2]
     P, *_ = _arc(uv, None if depth is None else depth(uv))
-    M = camera.perspective(30, 1.0, 0.1, 10.0) @ camera.look_at(_ARC_EYE, (0.0, 0.0, 0.3), (0, 0, 1))
+    M = camera.perspective_look_at(_ARC_EYE, (0.0, 0.0, 0.3), (0, 0, 1), 30, 1.0, 0.1, 10.0)
     g = rasterize(P, F, M, size, size, attributes={"uv": uv})
     return g.mask, g.attributes["uv"]
 
@@ -376,14 +437,18 @@ def _fig_silhouette(out: Path, quick: bool) -> Drawn:
         ],
         title="Silhouette on a curved mesh: relief mapping cannot change the outline",
     )
-    return Drawn(
+    return Drawn.claimed(
         img,
-        "Smooth bumps, up to 0.08 deep, on a half cylinder of radius 0.5 seen from the side: the far top edge is "
-        "the silhouette. Relief mapping only moves the texture inside the triangles that are drawn, so its "
+        "Smooth bumps, up to {depth} deep, on a half cylinder of radius {radius} seen from the side: the far top "
+        "edge is the silhouette. Relief mapping only moves the texture inside the triangles that are drawn, so its "
         "outline stays the straight top line of the cylinder, while the truly displaced surface dips between the "
-        "bumps and its outline is wavy (red: pixels POM draws that are empty in reality). Discarding uv outside "
-        "[0, 1] carves only at the patch's ends (blue: the displaced surface is there, POM discarded the pixels). "
-        "Shell mapping would give the relief a volume.",
+        "bumps and its outline is wavy (red, {only_pom} pixels: POM draws them, they are empty in reality). "
+        "Discarding uv outside [0, 1] carves only at the patch's ends (blue, {only_true} pixels: the displaced "
+        "surface is there, POM discarded them). Shell mapping would give the relief a volume.",
+        depth=_ARC_DEPTH,
+        radius=_ARC_R,
+        only_pom=only_pom,
+        only_true=only_true,
     )
 
 

@@ -1,0 +1,82 @@
+"""A figure's caption states only numbers its builder measured, never typed ones.
+
+A builder formats its caption from a template and the numbers it computed
+(:class:`geomlib.labfigures.Claims`, :meth:`geomlib.labfigures.Drawn.claimed`); the figure record
+keeps both. For every lab (small ``quick`` figures: the numbers differ from the committed ones, the
+rule does not) each figure's caption must be its template formatted with its numbers, and the
+template's own text may hold no digits but task numbers, ``[0, 1]`` and ``3D``. A caption
+written as plain text may hold no digits at all. :data:`NOT_YET` lists the figures whose captions
+still state typed numbers (the review of 2026-11-26 did not flag their numbers); converting one
+means removing it here, and the test fails while a listed figure is already converted.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from pathlib import Path
+
+import pytest
+
+from geomlib.labfigures import Claims
+
+ROOT = Path(__file__).resolve().parents[1]
+LABS = sorted(p.parent.name for p in (ROOT / "solutions").glob("*/figures.py"))
+
+#: Figures whose captions are still typed text with numbers in it, per lab (file names).
+NOT_YET: dict[str, set[str]] = {}
+
+
+def caption_problems(fig) -> list[str]:
+    """What is wrong with one figure record's caption (empty: every number in it was measured)."""
+    if fig.claims is None:
+        digits = re.findall(r"\d+(?:[.,]\d+)*", Claims("", {}).ALLOWED[0].sub(" ", fig.caption))
+        return (
+            [f"caption typed with the numbers {digits}; format it from measured ones (Drawn.claimed)"] if digits else []
+        )
+    return fig.claims.problems(fig.caption)
+
+
+def test_a_typed_number_in_a_caption_is_caught():
+    measured = Claims("{n} faces after {its} iterations, min angle {a:.1f} degrees", {"n": 120, "its": 3, "a": 33.71})
+    assert measured.caption() == "120 faces after 3 iterations, min angle 33.7 degrees"
+    assert measured.problems(measured.caption()) == []
+    typed = Claims("{n} faces after 10 iterations", {"n": 120})
+    assert typed.problems(typed.caption()) == ["number '10' typed into the caption template, not measured"]
+    assert Claims("{n} faces", {}).problems("") == ["caption field {n} has no measured number"]
+    assert Claims("{n} faces", {"n": 1}).problems("2 faces") == [
+        "the caption is not the template formatted with the measured numbers"
+    ]
+    assert Claims("Tasks 2-4 in [0, 1], see the 3D view", {}).typed_numbers() == []
+    assert "not a number" in Claims("{x}", {"x": "12"}).problems("12")[0]
+
+
+class _Plain:
+    def __init__(self, caption):
+        self.caption, self.claims = caption, None
+
+
+def test_a_plain_caption_may_hold_no_numbers():
+    assert caption_problems(_Plain("Task 3 not implemented yet; the other panels show: the input")) == []
+    assert caption_problems(_Plain("Parallax is off by 23 texels")) != []
+
+
+@pytest.mark.slow
+@pytest.mark.render
+@pytest.mark.parametrize("lab", LABS)
+def test_every_caption_states_measured_numbers(lab, tmp_path):
+    figures = importlib.import_module(f"solutions.{lab}.figures")
+    made = [*figures.make_figures(tmp_path, quick=True), figures.make_view(tmp_path, quick=True)]
+    waived = NOT_YET.get(lab, set())
+    wrong, converted = [], []
+    for fig in made:
+        problems = caption_problems(fig)
+        if fig.path.name in waived:
+            if not problems:
+                converted.append(fig.path.name)
+            continue
+        wrong += [f"{fig.path.name}: {p}" for p in problems]
+    assert not wrong, f"{lab}: captions with numbers not measured by their builder:\n" + "\n".join(wrong)
+    assert not converted, (
+        f"{lab}: remove {converted} from NOT_YET in {Path(__file__).name}: their captions are measured now"
+    )
