@@ -442,7 +442,7 @@ def fig_view(R, quick: bool) -> MeshView:
     H = topology.halfedge_mesh(G, len(U))
     dev = np.abs(H.valence - np.where(H.boundary_vertex, 4, 6)).astype(float)
     return MeshView(
-        U, G, dev, title=f"Remeshed bunny (L = {L})",
+        U, G, dev, title=f"Remeshed bunny (L = {L})", up="z",
         cmap="viridis", scalar_name="|valence - 6|",
         caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far "
         "its valence is from 6 (0: regular).",
