@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from geomlib.validate import MeshError, check_choice, check_int, check_mesh
+from geomlib.validate import MeshError, as_array, check_choice, check_int, check_mesh
 
 from .connectivity import MeshTopology, mesh_topology
 
@@ -274,7 +274,9 @@ def loop_faces(F, *, n_vertices: int | None = None, topo: MeshTopology | None = 
     # END SOLUTION
 
 
-def loop_matrix(V, F, weights: str = "warren", *, where: str = "loop_matrix") -> tuple[sp.csr_matrix, np.ndarray]:
+def loop_matrix(
+    V, F, weights: str = "warren", *, where: str = "loop_matrix", corners=None
+) -> tuple[sp.csr_matrix, np.ndarray]:
     """One Loop step as a matrix: ``S`` and the refined faces (given; combines Tasks 1-4).
 
     Parameters
@@ -284,6 +286,12 @@ def loop_matrix(V, F, weights: str = "warren", *, where: str = "loop_matrix") ->
     weights : {"warren", "loop"}
     where : str
         Name of the calling function for error messages.
+    corners : array_like of int, optional
+        Boundary vertices marked as corners (Hoppe et al. 1994, "Piecewise smooth surface
+        reconstruction"): a corner stays where it is (its row of ``S`` is the identity), so the
+        boundary curve keeps a sharp corner there instead of rounding it off. Given, not a task:
+        the boundary rule of Task 4 is unchanged elsewhere. The old vertices keep their indices
+        at every level, so the same indices mark the corners of the refined mesh.
 
     Returns
     -------
@@ -295,6 +303,15 @@ def loop_matrix(V, F, weights: str = "warren", *, where: str = "loop_matrix") ->
     V, F, topo = loop_topology(V, F, where=where)
     S_odd = loop_odd_matrix(V, F, topo=topo)
     S_even = loop_even_matrix(V, F, weights, topo=topo)
+    if corners is not None:
+        c = as_array(corners, "corners", shape=(None,), dtype=np.int64, where=where)
+        if c.size and (c.min() < 0 or c.max() >= len(V)):
+            raise MeshError(f"{where}: corners must be vertex indices in [0, {len(V)}), got {c.min()}..{c.max()}")
+        if not topo.boundary_vertex[c].all():
+            raise MeshError(f"{where}: corners must be boundary vertices; {c[~topo.boundary_vertex[c]][:5]} are not")
+        fixed = np.zeros(len(V))
+        fixed[c] = 1.0
+        S_even = (sp.diags(1.0 - fixed) @ S_even + sp.diags(fixed)).tocsr()  # a corner's row: the identity
     F_new = loop_faces(F, topo=topo)
     del topo  # release the connectivity before stacking: keeps the peak memory low
     return sp.vstack([S_even, S_odd], format="csr"), F_new
