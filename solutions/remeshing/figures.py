@@ -13,14 +13,13 @@ boundary loop (:func:`bunny_head`).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.labfigures import Drawn, MeshView, MissingTasks, figure_name, lab_figure_makers, missing_panel
 from geomlib.plot import colorbar, heat_colors, line_plot, panels
 from geomlib.render import render
 
@@ -178,24 +177,8 @@ def _histogram(meshes, labels, size, title) -> np.ndarray:
 
 
 def _blank(size) -> np.ndarray:
-    return np.full((size[1], size[0], 3), 255, np.uint8)
-
-
-def _attempt(missing: list, fn, *args, **kwargs):
-    """``fn(*args, **kwargs)``, or None when it needs a task not implemented yet (noted in ``missing``)."""
-    try:
-        return fn(*args, **kwargs)
-    except NotImplementedError as err:
-        missing.append(err)
-        return None
-
-
-def _todo(missing: list) -> str:
-    """Caption prefix of a figure drawn in part: which task is missing (empty when none is)."""
-    if not missing:
-        return ""
-    first = re.search(r"Task \d+[a-z]?", str(missing[0]))
-    return f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: "
+    """The grey stand-in for a panel whose task is not implemented yet (``size`` = (width, height))."""
+    return missing_panel(size[1], size[0])
 
 
 def _mesh(result):
@@ -214,12 +197,12 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     its = 5 if quick else 10
     size = (260, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True, zoom=0.95)
-    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    missing = MissingTasks()  # tasks whose panels are left blank
     imgs, caps = [], []
     for name, (V, F) in (("bunny (marching cubes)", bunny), ("bunny decimated by QEM", decimated)):
         imgs.append(render(V, F, colors=valence_colors(V, F), **kw))
         caps.append(f"{name}: {_summary(quality(V, F))}")
-        result = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its))
+        result = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its))
         if result is None:
             imgs.append(_blank(size))
             caps.append("isotropic_remesh: not implemented yet")
@@ -233,7 +216,7 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {VALENCE_TITLE}")
     return Drawn(
         img,
-        _todo(missing)
+        missing.caption_head()
         + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
         f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
         f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
@@ -283,10 +266,10 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
     size = (280, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True)
     diag = bbox_diagonal(V)
-    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
-    sharp = _attempt(missing, R.sharp_edges, V, F, angle)
+    missing = MissingTasks()  # tasks whose panels are left blank
+    sharp = missing.attempt(R.sharp_edges, V, F, angle)
     results = [
-        _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, feature_angle=fa)) for fa in (angle, None)
+        _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its, feature_angle=fa)) for fa in (angle, None)
     ]
     # how far each face leaves the input: the distance of its centroid, in % of the diagonal
     errs = [
@@ -315,7 +298,7 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
         grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
     return Drawn(
         grid,
-        _todo(missing)
+        missing.caption_head()
         + "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
         f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
         f"({its} iterations) with feature_angle = {angle:.0f} and without: each face is coloured by the distance of "
@@ -351,9 +334,9 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
     length = float(np.linalg.norm(B - A, axis=1).sum())
     imgs = [render(V, F, colors=valence_colors(V, F), highlight_points=np.unique(E), **kw)]
     caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (dots), boundary length {length:.2f}"]
-    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    missing = MissingTasks()  # tasks whose panels are left blank
     for keep in (True, False):
-        r = _mesh(_attempt(missing, R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
+        r = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
         if r is None:
             imgs.append(_blank(size))
             caps.append(f"preserve_boundary={keep}: not implemented yet")
@@ -369,7 +352,7 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
     img = panels(imgs, caps, ncols=3, title=title)
     return Drawn(
         img,
-        _todo(missing)
+        missing.caption_head()
         + "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
         f"jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
         "iterations) with preserve_boundary True and False. Boundary vertices are dotted, every vertex coloured "
@@ -398,14 +381,14 @@ def fig_operations(out: Path, R, quick: bool) -> Drawn:
     mid = 0.5 * (V[a] + V[b])
     size = (200, 200) if quick else (260, 260)
     kw = dict(camera="top", size=size, supersample=_ss(quick), wireframe=True, flat=True)
-    missing: list[NotImplementedError] = []  # tasks whose panels are left blank
+    missing = MissingTasks()  # tasks whose panels are left blank
     imgs, caps = [render(V, F, highlight_points=[a, b], **kw)], [f"patch, edge ({a}, {b}) marked"]
     for name, op, mark in (
         ("split_edge", R.split_edge, "new vertex marked"),
         ("collapse_edge", R.collapse_edge, "merged vertex marked"),
         ("flip_edge", R.flip_edge, "new edge marked"),
     ):
-        r = _attempt(missing, op, V, H, e)
+        r = missing.attempt(op, V, H, e)
         if r is None:
             imgs.append(_blank(size))
             caps.append(f"{name}: not implemented yet")
@@ -420,13 +403,13 @@ def fig_operations(out: Path, R, quick: bool) -> Drawn:
     J = V + 0.08 * np.random.default_rng(1).normal(size=V.shape) * [1, 1, 0] * ~H.boundary_vertex[:, None]
     imgs.append(render(J, F, **kw))
     caps.append("interior vertices jittered")
-    W = _attempt(missing, R.tangential_relaxation, J, F)
+    W = missing.attempt(R.tangential_relaxation, J, F)
     imgs.append(_blank(size) if W is None else render(np.asarray(W), F, **kw))
     caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
     return Drawn(
         img,
-        _todo(missing)
+        missing.caption_head()
         + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
         "(both ends meet at the midpoint) and flipped to the other diagonal; a patch with jittered interior "
         "vertices before and after one tangential relaxation step (damping 0.5).",
