@@ -612,3 +612,24 @@ def test_the_solution_follows_the_rule(rule):
         n = np.arange(3, 13)
         S, expected = np.asarray(loop_weight(n, weights)), formula(n)
     assert np.allclose(S, expected, atol=1e-14), f"the solution breaks the rule {rule}:\n{S}\nexpected\n{expected}"
+
+
+def test_loop_corner_vertices_stay_fixed_and_nothing_else_changes():
+    """Hoppe et al.'s corner rule, loop_matrix's given option: a corner's row of S is the identity."""
+    from solutions.subdivision import loop_matrix
+
+    V, F = grid()
+    xy = V[:, :2]
+    corners = [int(np.argmin(xy @ d)) for d in ((1, 1), (-1, 1), (1, -1), (-1, -1))]
+    S, F1 = loop_matrix(V, F, "loop")
+    Sc, Fc = loop_matrix(V, F, "loop", corners=corners)
+    np.testing.assert_array_equal(Fc, F1)
+    V1, Vc = S @ V, Sc @ V
+    np.testing.assert_array_equal(Vc[corners], V[corners])  # fixed
+    assert np.linalg.norm(V1[corners] - V[corners], axis=1).min() > 1e-3  # the curve rule rounds them off
+    others = np.setdiff1d(np.arange(S.shape[0]), corners)
+    assert abs(Sc[others] - S[others]).max() == 0  # every other row is the plain rule
+    with pytest.raises(MeshError, match="corners must be boundary vertices"):
+        loop_matrix(V, F, "loop", corners=[int(np.argmin(np.linalg.norm(xy - xy.mean(0), axis=1)))])
+    with pytest.raises(MeshError, match="corners must be vertex indices"):
+        loop_matrix(V, F, "loop", corners=[len(V)])

@@ -247,3 +247,11 @@ def test_view_frame_angles_and_forward():
 def test_pose_from_view_inverts_look_at():
     V = look_at((1.0, 2.0, 3.0), (0.5, -1.0, 0.0), (0, 0, 1))
     np.testing.assert_allclose(pose_from_view(V) @ V, np.eye(4), atol=1e-12)
+
+
+def test_perspective_look_at_is_the_product():
+    eye, target, up = (1.0, -2.0, 1.5), (0.2, 0.1, 0.0), (0, 0, 1)
+    M = camera.perspective_look_at(eye, target, up, 35, 1.5, 0.2, 9.0)
+    np.testing.assert_array_equal(M, camera.perspective(35, 1.5, 0.2, 9.0) @ camera.look_at(eye, target, up))
+    with pytest.raises(MeshError, match="near < far"):
+        camera.perspective_look_at(eye, target, up, 35, 1.5, 2.0, 1.0)

@@ -212,3 +212,33 @@ def test_a_builder_returning_something_else_or_several_drawn_pictures_fails(tmp_
 
     with pytest.raises(MeshError):
         figures_or_placeholders((fig_bad,), tmp_path, "toy", False)
+
+
+def test_missing_tasks_note_the_task_and_draw_a_stand_in():
+    from geomlib.labfigures import MissingTasks, missing_panel, task_label
+
+    missing = MissingTasks()
+
+    def stub(x):
+        raise NotImplementedError("Task 3b (relaxation): not implemented yet")
+
+    assert missing.attempt(lambda x: x + 1, 1) == 2 and missing == [] and missing.caption_head() == ""
+    assert missing.attempt(stub, 1) is None and missing == ["3b"]
+    assert missing.caption_head() == "Task 3b not implemented yet; the other panels show: "
+    assert task_label(NotImplementedError("no task named")) == "?"
+    panel = missing_panel(50, 80, "not implemented yet")
+    assert panel.shape == (50, 80, 3) and panel.dtype == np.uint8 and (panel < 200).any()
+    with pytest.raises(ValueError):  # only a missing task is caught
+        missing.attempt(lambda: int("x"))
+
+
+def test_a_claimed_caption_is_formatted_from_its_numbers(tmp_path):
+    from geomlib.labfigures import Claims
+
+    @figure_name("claimed")
+    def fig_claimed(out, quick):
+        return Drawn.claimed(np.zeros((4, 4, 3), np.uint8), "{n} dots, mean {m:.2f}", n=3, m=0.456)
+
+    (fig,) = figures_or_placeholders((fig_claimed,), tmp_path, "toy", False)
+    assert fig.caption == "3 dots, mean 0.46" and fig.claims == Claims("{n} dots, mean {m:.2f}", {"n": 3, "m": 0.456})
+    assert fig.claims.problems(fig.caption) == []
