@@ -70,26 +70,38 @@ class Claims:
     template: str
     numbers: dict = field(default_factory=dict)
 
-    #: Digits the template's own text may hold: task numbers, the texture square [0, 1] and "3D".
+    #: Digits the template's own text may hold, because they define rather than measure: task
+    #: numbers, the texture square [0, 1], a year cited "(1994)", names with a digit (3D, 4-tap,
+    #: 8-bit, p99, 2r, 8^3, float32) and
+    #: the constants of a formula (``1 - h``, ``v > 1``, ``2r/255``). A measured value (a count, an
+    #: error, a threshold the builder uses) is a field.
     ALLOWED = (
         re.compile(r"Tasks? \d+[a-z]?((, | and |-)\d+[a-z]?)*"),
         re.compile(r"\[0, 1\]"),
-        re.compile(r"\b[23]D\b"),
+        re.compile(
+            r"\((19|20)\d\d\)|\b[a-z]+\d+\b|\b[23]D\b|\b\d+-(tap|bit|point|ring)s?\b|\bp\d+\b|\b\d+[a-z]\b|\b\d+\^\d+"
+        ),
+        re.compile(r"\b\d+/\d+\b|[<>=/^*·+−]\s?\d+(\.\d+)?|\d+(\.\d+)?\s?[/^*·+−]|\b\d+ - [A-Za-z(]"),
     )
+
+    @classmethod
+    def untyped(cls, text: str) -> list[str]:
+        """The numbers in ``text`` once the defining ones (:attr:`ALLOWED`) are taken out."""
+        for allowed in cls.ALLOWED:
+            text = allowed.sub(" ", text)
+        return re.findall(r"\d+(?:[.,]\d+)*", text)
 
     def caption(self) -> str:
         return self.template.format(**self.numbers)
 
     def typed_numbers(self) -> list[str]:
         """The numbers written into the template's text instead of measured (should be empty)."""
-        text = "".join(literal for literal, *_ in string.Formatter().parse(self.template))
-        for allowed in self.ALLOWED:
-            text = allowed.sub(" ", text)
-        return re.findall(r"\d+(?:[.,]\d+)*", text)
+        return self.untyped("".join(literal for literal, *_ in string.Formatter().parse(self.template)))
 
     def problems(self, caption: str) -> list[str]:
         """What is wrong with ``caption`` as a figure's caption made from these claims."""
-        out = [f"number {n!r} typed into the caption template, not measured" for n in self.typed_numbers()]
+        typed = self.typed_numbers()
+        out = [f"numbers {typed} typed into the caption template, not measured"] if typed else []
         fields = {name for _, name, _, _ in string.Formatter().parse(self.template) if name}
         out += [f"caption field {{{name}}} has no measured number" for name in sorted(fields - set(self.numbers))]
         bad = [k for k, v in self.numbers.items() if isinstance(v, bool) or not isinstance(v, (int, float, np.number))]

@@ -13,7 +13,6 @@ means removing it here, and the test fails while a listed figure is already conv
 from __future__ import annotations
 
 import importlib
-import re
 from pathlib import Path
 
 import pytest
@@ -24,13 +23,23 @@ ROOT = Path(__file__).resolve().parents[1]
 LABS = sorted(p.parent.name for p in (ROOT / "solutions").glob("*/figures.py"))
 
 #: Figures whose captions are still typed text with numbers in it, per lab (file names).
-NOT_YET: dict[str, set[str]] = {}
+NOT_YET: dict[str, set[str]] = {
+    "subdivision": {"warren_vs_loop.png", "catmull_clark_levels.png", "subdivision_3d.html"},
+    "simplification": {"series.png", "error_vs_faces.png", "pairs.png", "boundary.png", "simplification_3d.html"},
+    "remeshing": {"before_after.png", "operations.png", "iterations.png", "features.png", "boundary.png",
+                  "remeshing_3d.html"},
+    "maps": {"bias_scale.png", "bake.png", "maps_3d.html"},
+    "denoise": {"lambda_sequence.png", "error_vs_iterations.png", "offset_map.png"},
+    "shadows": {"shadows_frustum.png", "shadows_pcf.png", "shadows_lights.png", "shadows_3d.html"},
+    "vdm": {"vdm_rock_naive_vs_optimised.png", "vdm_box_stages.png", "vdm_diagonals.png", "vdm_background_sweep.png",
+            "vdm_3d.html"},
+}  # fmt: skip
 
 
 def caption_problems(fig) -> list[str]:
     """What is wrong with one figure record's caption (empty: every number in it was measured)."""
     if fig.claims is None:
-        digits = re.findall(r"\d+(?:[.,]\d+)*", Claims("", {}).ALLOWED[0].sub(" ", fig.caption))
+        digits = Claims.untyped(fig.caption)
         return (
             [f"caption typed with the numbers {digits}; format it from measured ones (Drawn.claimed)"] if digits else []
         )
@@ -42,12 +51,13 @@ def test_a_typed_number_in_a_caption_is_caught():
     assert measured.caption() == "120 faces after 3 iterations, min angle 33.7 degrees"
     assert measured.problems(measured.caption()) == []
     typed = Claims("{n} faces after 10 iterations", {"n": 120})
-    assert typed.problems(typed.caption()) == ["number '10' typed into the caption template, not measured"]
+    assert typed.problems(typed.caption()) == ["numbers ['10'] typed into the caption template, not measured"]
     assert Claims("{n} faces", {}).problems("") == ["caption field {n} has no measured number"]
     assert Claims("{n} faces", {"n": 1}).problems("2 faces") == [
         "the caption is not the template formatted with the measured numbers"
     ]
-    assert Claims("Tasks 2-4 in [0, 1], see the 3D view", {}).typed_numbers() == []
+    assert Claims("Tasks 2-4 in [0, 1], see the 3D view of 1 - h, v > 1, 2r/255, p99", {}).typed_numbers() == []
+    assert Claims("parallax is exact on 82% of pixels, off by 23.2 texels", {}).typed_numbers() == ["82", "23.2"]
     assert "not a number" in Claims("{x}", {"x": "12"}).problems("12")[0]
 
 

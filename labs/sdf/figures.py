@@ -120,6 +120,7 @@ __all__ = ["make_figures", "make_view"]
 _MISSING = MissingTasks()
 
 _CACHE: dict = {}
+ISO = 0.1  # the slices' iso-line spacing
 TUBE = 0.35  # the torus's tube radius (it is raised by as much, so it rests on z = 0)
 
 
@@ -127,7 +128,7 @@ def _torus_grid(quick):
     key = ("torus", quick)
     if key not in _CACHE:
         V, F = datasets.torus(1.0, TUBE, 48, 24)
-        V = V + [0, 0, 0.35]
+        V = V + [0, 0, TUBE]
         _CACHE[key] = (V, F, sdf_grid(V, F, 36 if quick else 64))
     return _CACHE[key]
 
@@ -185,22 +186,26 @@ def fig_slices(out: Path, quick: bool) -> Drawn:
         m = 120 if quick else 220
         u = np.linspace(g.origin[0], g.upper[0], m)
         A, B = np.meshgrid(u, u, indexing="ij")
-        top = g.sample(np.c_[A.ravel(), B.ravel(), np.full(A.size, 0.35)]).reshape(m, m)
+        top = g.sample(np.c_[A.ravel(), B.ravel(), np.full(A.size, TUBE)]).reshape(m, m)
         side = g.sample(np.c_[A.ravel(), np.zeros(A.size), B.ravel() - g.origin[0] + g.origin[2]]).reshape(m, m)
-        a = _slice_image(top, r, 0.1, 2 if quick else 1)
-        b = _slice_image(side, r, 0.1, 2 if quick else 1)
+        a = _slice_image(top, r, ISO, 2 if quick else 1)
+        b = _slice_image(side, r, ISO, 2 if quick else 1)
         return [a, _with_bar(b, -r, r, "RdBu", "phi")], g
 
     try:
         imgs, g = make()
-        caps = ["z = 0.35 (through the tube centres)", "y = 0 (across the ring)"]
+        caps = [f"z = {TUBE} (through the tube centres)", "y = 0 (across the ring)"]
         title = f"Mesh SDF of a torus (2,304 faces) on a {g.shape[0]}^3 grid"
     except NotImplementedError as e:
         imgs, caps, title = [_missing((200, 200), f"Tasks 2-4 ({str(e)[:50]})", e)], [""], "Mesh SDF"
-    return Drawn(
+    return Drawn.claimed(
         panels(imgs, caps, title=title),
         "The signed distance of a torus mesh (pseudonormal sign, BVH closest points), looked up trilinearly on "
-        "two slices: red inside, blue outside, iso-lines every 0.1, the surface (zero line) in black.",
+        "two slices: red inside, blue outside, iso-lines every {iso}, the surface (zero line) in black. The "
+        "torus (tube radius {tube}) is raised by {tube} so that it rests on z = 0, which is why z = {tube} "
+        "cuts through the tube centres.",
+        iso=ISO,
+        tube=TUBE,
     )
 
 
@@ -383,13 +388,13 @@ def fig_soft_shadows(out: Path, quick: bool) -> Drawn:
         "Visibility of a spherical light of radius R (rows: {r0}, {r1}, {r2}) on the ground under a sphere mesh, "
         "seen from above (framed: the sampled square; the largest penumbra runs past it): the course formula "
         "min d/(t tan alpha), the improved variant, a Monte-Carlo area-light truth cast with geomlib's watertight "
-        "rays, and the per-pixel error of the formula. The formula reaches 0 wherever the ray to the light's "
+        "rays, and the per-pixel error of the formula. The formula drops to zero wherever the ray to the light's "
         "centre is blocked, so its umbra is the hard shadow of the centre and only the outer half of the true "
         "penumbra survives: the error is a ring on the inner penumbra that widens with R (mean {e0:.3f}, {e1:.3f}, "
         "{e2:.3f}). The improved variant only tightens the estimate (it changes V by at most {dmax:.2f}) and so "
         "darkens the penumbra a little more: it is closer to the truth in {better} of {rows} rows (mean {i0:.3f}, "
         "{i1:.3f}, {i2:.3f}). What it is meant to fix (banding when large steps jump past the closest approach, "
-        "handout section 1.10) does not show in this smooth scene.",
+        "see the handout) does not show in this smooth scene.",
         r0=radii[0], r1=radii[1], r2=radii[2], better=len(radii) - worse, rows=len(radii), **numbers,
     )  # fmt: skip
 
@@ -469,7 +474,7 @@ def fig_view(quick: bool) -> MeshView:
         cmap="viridis", scalar_name="|d| in quantisation steps",
         caption=Claims(
             "Turn it: the torus, each vertex coloured by the distance the 8-bit brick field returns there "
-            "(exactly 0 on the surface), in quantisation steps: up to {bricked:.2f} steps. That is interpolation, "
+            "(exactly zero on the surface), in quantisation steps: up to {bricked:.2f} steps. That is interpolation, "
             "not quantisation: the dense float grid's own trilinear lookup already returns up to {dense:.2f} steps "
             "at the vertices, because a trilinear patch between samples is not the curved surface.",
             {"bricked": float(err.max()), "dense": float(dense.max())},

@@ -47,6 +47,7 @@ LAB = "relief"
 SCALE = 0.08
 LIGHT = np.array([-0.55, 0.45, 0.7])  # tangent space = world: towards the light, up-left
 BACKGROUND = 0.93
+LAYERS = (8, 32)  # min and max layers of the march in the steps figure (relief_uv's defaults)
 
 
 def quad_gbuffer(size: int, eye=(0.5, -0.55, 0.75)):
@@ -199,6 +200,7 @@ def _fig_errors(out: Path, quick: bool) -> Drawn:
     truth, _ = exact_uv(H, uv, view, scale=SCALE, samples=1024)
     rows, caps = [], []
     lo, hi = -3.0, 2.0  # log10 of the error in texels: 0.001 to 100
+    EXACT = 0.01  # texels: below this a pixel counts as exact
     exact, p99 = {}, {}
     for label, fn in (
         ("parallax", lambda: parallax_uv(H, uv, view, scale=SCALE)),
@@ -215,10 +217,10 @@ def _fig_errors(out: Path, quick: bool) -> Drawn:
         e = uv_error_texels(got, truth, 256)
         e[~mask] = np.nan
         key = label.split()[-1]
-        exact[key] = float(100 * np.mean(e[mask] < 0.01))
+        exact[key] = float(100 * np.mean(e[mask] < EXACT))
         p99[key] = float(np.nanpercentile(e, 99))
         rows.append(heatmap_image(np.clip(np.log10(np.maximum(e, 1e-12)), lo, hi), vmin=lo, vmax=hi))
-        caps.append(f"{label}: p99 {p99[key]:.3g} texels,\nexact (< 0.01) on {exact[key]:.0f}% of pixels")
+        caps.append(f"{label}: p99 {p99[key]:.3g} texels,\nexact (< {EXACT}) on {exact[key]:.0f}% of pixels")
     rows.append(colorbar(lo, hi, "inferno", label="log10 uv error (texels)"))
     caps.append("")
     img = panels(rows, caps, ncols=3, title="uv error against the exact hit, bricks (256^2 map)")
@@ -228,13 +230,13 @@ def _fig_errors(out: Path, quick: bool) -> Drawn:
     return Drawn.claimed(
         img,
         "Per-pixel distance (in texels, log scale) between each method's uv and the exact ray / height-field hit "
-        "on the bricks. Parallax is exact (under 0.01 texel) on {parallax_exact:.0f}% of the pixels: the flat brick "
+        "on the bricks. Parallax is exact (under {exact_below} texel) on {parallax_exact:.0f}% of the pixels: the flat brick "
         "tops ({tops:.0f}% of the pixels see h = 1 at their entry point), where h = 1 means no shift at all; its "
         "error lives in the joints and bevels, where it reaches {parallax_p99:.3g} texels (p99) against "
         "{steep_p99:.3g} for steep parallax (at most a layer). Linear POM errs along the bevels; after secant or "
         "binary refinement only isolated pixels on the bevels stay off (the secant step can stall on a bevel's "
         "kink; bisection cannot).",
-        parallax_exact=exact["parallax"], tops=tops, parallax_p99=p99["parallax"], steep_p99=p99["steep"],
+        exact_below=EXACT, parallax_exact=exact["parallax"], tops=tops, parallax_p99=p99["parallax"], steep_p99=p99["steep"],
     )  # fmt: skip
 
 
@@ -282,8 +284,8 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Drawn:
     return Drawn.claimed(
         img,
         "p99 uv error (log scale) of each method against the exact intersection as the view tilts, on a "
-        "{pixels} x {pixels} grid of pixels (the handout's table, from bench/relief.py, uses 256 x 256, so single "
-        "stalled pixels move its p99 differently). The errors grow with the angle. On the smooth bumps secant "
+        "{pixels} x {pixels} grid of pixels (the handout's table, from bench/relief.py, samples a finer grid, so "
+        "single stalled pixels move its p99 differently). The errors grow with the angle. On the smooth bumps secant "
         "refinement is the most accurate: at most {sec_bumps:.1g} texels up to {max_deg} degrees; on the bricks' "
         "sharp steps it can stall on a bevel ({sec_bricks:.2g} texels at {deg75} degrees) and binary search is "
         "the more reliable refinement. Offset limiting is not a more accurate parallax: on the bumps it is "
@@ -302,14 +304,16 @@ def _fig_steps(out: Path, quick: bool) -> Drawn:
     size = 120 if quick else 220
     H = bricks(256)
     mask, uv, view, _, _ = quad_gbuffer(size)
-    marched = _MISSING.attempt(relief_uv, H, uv, view, scale=SCALE, refine="none", min_layers=8, max_layers=32)
+    marched = _MISSING.attempt(
+        relief_uv, H, uv, view, scale=SCALE, refine="none", min_layers=LAYERS[0], max_layers=LAYERS[1]
+    )
     if marched is None:
         img = panels([_missing(size)], ["relief_uv: not implemented yet"])
     else:
         from .relief import layer_count
 
         steps = marched[2]
-        n = layer_count(view[..., 2], 8, 32).astype(float)
+        n = layer_count(view[..., 2], *LAYERS).astype(float)
         n[~mask] = np.nan
         st = steps.astype(float)
         st[~mask] = np.nan
@@ -328,8 +332,8 @@ def _fig_steps(out: Path, quick: bool) -> Drawn:
 
         img = panels(
             [
-                with_bar(heatmap_image(n, "viridis", 8, 32), 8, 32, "n (layers)"),
-                with_bar(heatmap_image(st, "viridis", 0, 32), 0, 32, "layer of the hit"),
+                with_bar(heatmap_image(n, "viridis", *LAYERS), *LAYERS, "n (layers)"),
+                with_bar(heatmap_image(st, "viridis", 0, LAYERS[1]), 0, LAYERS[1], "layer of the hit"),
             ],
             ["layer count n (more at grazing angles)", "layers marched to the hit"],
             title="Layers of the march (bricks)",
@@ -339,9 +343,9 @@ def _fig_steps(out: Path, quick: bool) -> Drawn:
             "Left: the layer count n = floor(min + (max - min)(1 - view_z) + 1/2) per pixel, with min = {min_layers} "
             "and max = {max_layers} layers, grows from {lo} at the near edge to {hi} towards the far, grazing part of "
             "the quad (colour bar {min_layers}-{max_layers}). Right: the layer where the march stopped (colour bar "
-            "0-{max_layers}); the deep mortar joints take the most layers.",
-            min_layers=8,
-            max_layers=32,
+            "from zero to {max_layers}); the deep mortar joints take the most layers.",
+            min_layers=LAYERS[0],
+            max_layers=LAYERS[1],
             lo=lo,
             hi=hi,
         )
