@@ -22,6 +22,23 @@ __all__ = ["build_gallery", "write_index"]
 
 #: Largest number of extraordinary vertices still marked with dots (more would be clutter).
 MAX_MARKED = 60
+#: Datasets with texture coordinates: drawn with a UV texture (red = u, green = v, checker), so
+#: the mapping and its seams (where red or green jumps) can be seen.
+UV_DATASETS = ("uv_sphere", "uv_torus", "uv_grid")
+UV_CELLS = 8
+#: Views that show what a dataset is about better than the three-quarter view: the cage from
+#: below, so its pentagon floor and all six extraordinary vertices (five floor corners, the apex
+#: seen past the wall) are visible.
+CAMERAS = {"polygon_cage": ((2.4, -2.9, -1.5), (0.0, 0.0, 0.55), (0.0, 0.0, 1.0))}
+
+
+def uv_texture(size: int = 256, cells: int = UV_CELLS) -> np.ndarray:
+    """``(size, size, 3)`` uint8: red grows with u, green with v, and a light/dark checker of ``cells``."""
+    t = (np.arange(size) + 0.5) / size
+    u, v = np.meshgrid(t, t[::-1])  # row 0 is v = 1 (the top of the image)
+    check = ((np.floor(u * cells) + np.floor(v * cells)) % 2)[..., None]
+    rgb = np.stack([u, v, np.full_like(u, 0.35)], axis=-1)
+    return np.round(255 * np.clip(rgb * (0.65 + 0.35 * check), 0, 1)).astype(np.uint8)
 
 
 def _thumbnail(img: np.ndarray, width: int) -> np.ndarray:
@@ -79,10 +96,14 @@ def build_gallery(out_dir, quick: bool = False, *, names: list[str] | None = Non
             opts = dict(
                 wireframe=True,
                 highlight_points=marked,
-                camera="three_quarter",
+                camera=CAMERAS.get(name, "three_quarter"),
                 up_axis="z",  # every built-in dataset is z-up
                 size=size,
             )
+            if name in UV_DATASETS:
+                from geomlib import datasets
+
+                opts.update(uv=getattr(datasets, name)()[2], texture=uv_texture())
             img = render(V, faces, **opts) if kind == "tri" else render_polygons(V, faces, **opts)
         except Exception as e:
             raise RuntimeError(f"build_gallery: dataset {name!r} failed: {type(e).__name__}: {e}") from e
@@ -91,11 +112,23 @@ def build_gallery(out_dir, quick: bool = False, *, names: list[str] | None = Non
         caption = f"{name}: {description}. {len(V)} vertices, {n_f} {what}, {len(E)} edges."
         if marked is not None:
             caption += f" Red dots: {len(marked)} extraordinary vertices."
+        elif len(special):
+            caption += f" {len(special)} extraordinary vertices (too many to mark)."
+        if name in UV_DATASETS:
+            caption += (
+                f" Textured by its UVs: red grows with u, green with v, over a {UV_CELLS} x {UV_CELLS} checker; a seam shows "
+                "where the colour jumps (u from 1 back to 0, or v)."
+            )
         path = save_png(out / f"{name}.png", img)
         figures.append(Figure(path, caption, "gallery"))
         thumbs.append(_thumbnail(img, 320))
         labels.append(f"{name} ({len(V)} v, {n_f} f)")
-    sheet = panels(thumbs, labels, title="geomlib built-in datasets", ncols=min(5, max(1, len(thumbs))))
+    sheet = panels(
+        thumbs,
+        labels,
+        title="geomlib built-in datasets (red dots: extraordinary vertices, where there are few)",
+        ncols=min(5, max(1, len(thumbs))),
+    )
     sheet_path = save_png(out / "contact_sheet.png", sheet)
     return [
         Figure(sheet_path, f"All {len(thumbs)} built-in datasets at a glance (wireframe renders).", "gallery"),
