@@ -102,6 +102,13 @@ def _colors(s: np.ndarray, cmap: str, clim):
     return to8(heat_colors(s, vmin=lo, vmax=hi, cmap=cmap)), ramp, lo, hi
 
 
+def _tick(x: float, lo: float, hi: float) -> str:
+    """A colour-bar label: 3 significant digits, and 0 for a value within 0.1% of the range of zero."""
+    if abs(x) <= 1e-3 * max(abs(lo), abs(hi)):
+        return "0"
+    return f"{x:.3g}"
+
+
 def _b64(a: np.ndarray, dtype) -> str:
     return base64.b64encode(np.ascontiguousarray(a, dtype=np.dtype(dtype).newbyteorder("<")).tobytes()).decode("ascii")
 
@@ -307,8 +314,8 @@ def html_page(
         name = _html.escape(scalar_name)
         bar = (
             f'<div id="bar" style="background: linear-gradient({stops});"></div>'
-            f'<div class="tick" style="top: 6px;">{hi:.4g}</div>'
-            f'<div class="tick" style="top: calc(12px + 45% - 8px);">{lo:.4g}</div>'
+            f'<div class="tick" style="top: 6px;">{_tick(hi, lo, hi)}</div>'
+            f'<div class="tick" style="top: calc(12px + 45% - 8px);">{_tick(lo, lo, hi)}</div>'
             + (f'<div class="tick" style="top: calc(12px + 22% - 8px);">{name}</div>' if name else "")
         )
     info = f"{len(V):,} vertices, {len(T):,} triangles"

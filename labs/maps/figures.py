@@ -241,7 +241,7 @@ def _fig_view(L, quick: bool) -> MeshView:
     Vd0, Fd, UVd = datasets.uv_torus(*((144, 48) if quick else (288, 96)), R, r)
     Vd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
     return MeshView(
-        Vd, Fd, title="Displaced torus (your displace)", up="z", edges=False,
+        Vd, Fd, title="Displaced torus (displace, Task 5)", up="z", edges=False,
         caption=f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map "
         "imitates.",
     )  # fmt: skip

@@ -239,12 +239,12 @@ def fig_view(L, quick: bool) -> MeshView:
     V, F = datasets.torus(n_major=64, n_minor=32)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
     X = L.denoise_vertices(Vn, F, N, 0.7)
-    err = 100 * np.asarray(L.surface_error(V, F, X))
+    err = np.asarray(L.surface_error(V, F, X))
     return MeshView(
         X, F, err, title="Denoised torus (one pass, λ = 0.7)", up="z",
-        cmap=CMAP, scalar_name="% of diagonal",
+        cmap=CMAP, scalar_name="dist / diag",
         caption="Turn it: a noisy torus after one denoising pass (λ = 0.7), each vertex coloured by its distance "
-        "to the clean surface (% of the bounding-box diagonal).",
+        "to the clean surface as a fraction of the bounding-box diagonal (dist / diag, as in the figures).",
     )  # fmt: skip
 
 

@@ -168,3 +168,10 @@ def test_with_a_display_a_pyvista_window_opens(monkeypatch):
     V, Q = datasets.quad_cube()
     assert geomlib.view(V, Q, np.arange(len(V), dtype=float)) is None
     assert shown["mesh"].n_cells == 12 and shown["scalars"] == "scalars"  # 6 quads drawn as 12 triangles
+
+
+def test_colour_bar_ticks_are_short_and_a_near_zero_end_reads_zero():
+    V, F = datasets.icosphere(1)
+    s = np.linspace(3.299e-06, 0.0075123, len(V))
+    ticks = re.findall(r'class="tick"[^>]*>([^<]*)<', viewer.html_page(V, F, s, scalar_name="dist / diag"))
+    assert ticks[:2] == ["0.00751", "0"], ticks
