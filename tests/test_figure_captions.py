@@ -24,7 +24,7 @@ LABS = sorted(p.parent.name for p in (ROOT / "solutions").glob("*/figures.py"))
 
 #: Figures whose captions are still typed text with numbers in it, per lab (file names).
 NOT_YET: dict[str, set[str]] = {
-    "subdivision": {"warren_vs_loop.png", "catmull_clark_levels.png", "subdivision_3d.html"},
+    "subdivision": {"catmull_clark_levels.png", "subdivision_3d.html"},
     "simplification": {"series.png", "error_vs_faces.png", "pairs.png", "boundary.png", "simplification_3d.html"},
     "remeshing": {"before_after.png", "operations.png", "iterations.png", "features.png", "boundary.png",
                   "remeshing_3d.html"},
