@@ -30,7 +30,7 @@ NOT_YET: dict[str, set[str]] = {
                   "remeshing_3d.html"},
     "maps": {"bias_scale.png", "bake.png", "maps_3d.html"},
     "denoise": {"lambda_sequence.png", "error_vs_iterations.png", "offset_map.png"},
-    "shadows": {"shadows_frustum.png", "shadows_pcf.png", "shadows_lights.png", "shadows_3d.html"},
+    "shadows": {"shadows_lights.png", "shadows_3d.html"},
     "vdm": {"vdm_rock_naive_vs_optimised.png", "vdm_box_stages.png", "vdm_diagonals.png", "vdm_background_sweep.png",
             "vdm_3d.html"},
 }  # fmt: skip

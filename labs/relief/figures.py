@@ -47,6 +47,7 @@ LAB = "relief"
 SCALE = 0.08
 LIGHT = np.array([-0.55, 0.45, 0.7])  # tangent space = world: towards the light, up-left
 BACKGROUND = 0.93
+ZOOM = 3  # magnification of the methods figures' close-up
 LAYERS = (8, 32)  # min and max layers of the march in the steps figure (relief_uv's defaults)
 
 
@@ -167,6 +168,13 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
         imgs, caps = _method_panels(H, kind, size, dropped)
         mask, _, view, _, _ = quad_gbuffer(size)
         deg = np.degrees(np.arccos(view[mask][:, 2]))
+        # A close-up of the far, grazing edge, where the methods differ most: steep parallax over POM (secant).
+        rows = np.nonzero(mask.any(axis=1))[0]
+        r0, h, c0, w = rows.min() + 2, size // 7, size // 3, size // 3
+        crops = [np.asarray(imgs[i], float)[r0 : r0 + h, c0 : c0 + w] for i in (4, 6)]
+        gap = np.ones((4, w, 3))
+        imgs.append(np.repeat(np.repeat(np.vstack([crops[0], gap, crops[1]]), ZOOM, 0), ZOOM, 1))
+        caps.append(f"x{ZOOM} close-up of the far edge: steep (top, one band per layer) and POM secant (bottom)")
         img = panels(
             imgs,
             caps,
@@ -176,7 +184,8 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
         template = (
             f"The {kind} height map on one quad, scale {{scale}}: flat and bump shading keep the texture in place; "
             "parallax shifts it once (far too much at grazing angles), offset limiting caps the shift; steep "
-            "parallax steps through layers (bands, one per layer, seen best at the far edge), POM refines the "
+            "parallax steps through layers (bands, one per layer: see the close-up of the far edge, last panel), "
+            "POM refines the "
             "hit (linear, secant, binary); self-shadowing darkens what the relief hides from the light."
         )
         if dropped:

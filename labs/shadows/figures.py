@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from geomlib.camera import project
 from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import colorbar, heatmap_image, panels, with_colorbar
 
@@ -105,21 +106,52 @@ def fig_bias(out: Path, L, quick: bool) -> Drawn:
     )
 
 
+def _outline(img: np.ndarray, meas: _Measured, corners: np.ndarray, colour=(255, 200, 0)) -> np.ndarray:
+    """``img`` with the closed polygon ``corners`` (k, 3) of the world drawn in, seen by ``meas``'s camera."""
+    from PIL import Image, ImageDraw
+
+    w, h = meas.size
+    M = meas.L.camera_matrix(meas.camera, meas.scene.bounds, (w, h))
+    xy, _ = project(corners, M, w, h)
+    page = Image.fromarray(img)
+    ImageDraw.Draw(page).line([tuple(p) for p in np.vstack([xy, xy[:1]])], fill=colour, width=2)
+    return np.asarray(page)
+
+
+def _floor_footprint(M: np.ndarray) -> np.ndarray:
+    """(4, 3): where the edges of an orthographic light map ``M`` (clip from world) meet the floor z = 0."""
+    Minv = np.linalg.inv(M)
+    out = []
+    for x, y in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+        a, b = (Minv @ np.array([x, y, z, 1.0]) for z in (-1.0, 1.0))
+        a, b = a[:3] / a[3], b[:3] / b[3]
+        out.append(a + (b - a) * (a[2] / (a[2] - b[2])))  # the light ray through this map corner, at z = 0
+    return np.array(out)
+
+
 @figure_name("shadows_frustum")
 def fig_frustum(out: Path, L, quick: bool) -> Drawn:
-    B = np.array([[-1.5, -1.5, 0.0], [1.5, 1.5, 2.1]])  # the map covers the middle of the floor only
+    half, top = 1.5, 2.1
+    B = np.array([[-half, -half, 0.0], [half, half, top]])  # the map covers the middle of the floor only
     meas = _measured(L, "classic", quick)
     off = meas.panel("frustum fix off: border texels repeat, far side dark", map_size=1024, bounds=B, frustum_fix=False)
     on = meas.panel("fix on: outside is lit (the sphere's shadow too)", map_size=1024, bounds=B, frustum_fix=True)
     full = meas.panel("map fitted to the whole scene", map_size=1024)
-    page = panels([off[0], on[0], full[0]], [off[1], on[1], full[1]], title="Points outside the light's frustum")
-    return Drawn(
-        page,
-        "A directional light whose map covers only the middle 3 x 3 of the floor. Points outside the map "
-        "read clamped border texels (streaks) and points beyond its far plane (z > 1) always compare as "
-        "shadowed; treating both as lit fixes it, but shadows that fall outside the map (the sphere's) are "
-        "lost. Right: the map fitted tightly to the scene's bounds covers everything.",
+    foot = _floor_footprint(L.light_setup(meas.scene, meas.light, bounds=B).matrices[0])
+    imgs = [_outline(off[0], meas, foot), _outline(on[0], meas, foot), full[0]]
+    page = panels(
+        imgs, [off[1], on[1], full[1]], title="Points outside the light's frustum (yellow: where the map ends)"
     )
+    return Drawn.claimed(
+        page,
+        "A directional light whose map is fitted to the box [-{half:g}, {half:g}]² x [{floor:g}, {top:g}] in the middle of "
+        "the floor; yellow outlines where the map's edges meet the floor (the slanted light's view of that box). "
+        "Points outside it read clamped border texels, so the texels along the map's edge repeat outwards as "
+        "dark wedges, and points beyond its far plane (z > 1) always compare as shadowed; treating both as lit "
+        "fixes it, but shadows that fall outside the map (the sphere's) are lost. Right: the map fitted tightly "
+        "to the scene's bounds covers everything.",
+        half=half, floor=B[0, 2], top=top,
+    )  # fmt: skip
 
 
 @figure_name("shadows_resolution")
@@ -146,17 +178,39 @@ def fig_resolution(out: Path, L, quick: bool) -> Drawn:
 @figure_name("shadows_pcf")
 def fig_pcf(out: Path, L, quick: bool) -> Drawn:
     meas = _measured(L, "zoom", quick)
-    rows = [meas.panel(f"PCF {k} x {k}, 512² map", map_size=512, pcf=k) for k in (1, 3, 5)]
-    rows.append(meas.panel("Poisson disk: 16 samples, radius 2.5 texels", map_size=512, pcf=5, pcf_sampling="poisson"))
-    page = panels([r[0] for r in rows], [r[1] for r in rows], ncols=2, title="Percentage-closer filtering")
-    return Drawn(
+    res, sizes = 512, (1, 3, 5)
+    poisson = dict(map_size=res, pcf=sizes[-1], pcf_sampling="poisson")
+    runs = [meas.render(map_size=res, pcf=k) for k in sizes] + [meas.render(**poisson)]
+    labels = [f"PCF {k} x {k}, {res}² map" for k in sizes] + ["Poisson disk: 16 samples, radius 2.5 texels"]
+    # The close-ups: the window where the 1 x 1 and the Poisson pictures differ most (a shadow edge).
+    d = np.abs(runs[0][0].astype(float) - runs[-1][0].astype(float)).sum(axis=2)
+    ch, cw = (d.shape[0] // 6, d.shape[1] // 6)
+    S = np.pad(d.cumsum(0).cumsum(1), ((1, 0), (1, 0)))
+    win = S[ch:, cw:] - S[:-ch, cw:] - S[ch:, :-cw] + S[:-ch, :-cw]
+    r, c = np.unravel_index(np.argmax(win), win.shape)
+    zoom = 4
+    imgs, caps = [], []
+    for (img, m), label in zip(runs, labels):
+        framed = img.copy()
+        framed[r : r + ch, [c, c + cw - 1]] = framed[[r, r + ch - 1], c : c + cw] = (255, 200, 0)
+        crop = np.repeat(np.repeat(img[r : r + ch, c : c + cw], zoom, 0), zoom, 1)
+        imgs += [framed, crop]
+        caps += [f"{label}\nacne {_pct(m['acne'])}, peter-panning {_pct(m['peter_panning'])}", f"x{zoom} close-up"]
+    page = panels(imgs, caps, ncols=4, title="Percentage-closer filtering (yellow box: the close-up)")
+    pp = [m["peter_panning"] for _, m in runs]
+    return Drawn.claimed(
         page,
         "Percentage-closer filtering averages the 0/1 shadow test over a k x k block of texels around the "
-        "point, turning the staircase of a 512² map into a soft edge about k texels wide. It filters the "
-        "test results, not the depths: averaging depths first would blur the occluder, not the shadow. "
-        "The last panel spreads 16 samples over a disk instead, rotated differently at every texel: the "
-        "square block's bands along the edge become fine noise, with 16 lookups instead of 25.",
-    )
+        "point, turning the staircase of a {res}² map into a soft edge about k texels wide (close-ups on the "
+        "right of each panel). It filters the test results, not the depths: averaging depths first would blur "
+        "the occluder, not the shadow. The last panel spreads {samples} samples over a disk instead, rotated "
+        "differently at every texel: the square block's bands along the edge become fine noise, with {samples} "
+        "lookups instead of {block}. The price: a wider filter reaches past the occluder's edge, so "
+        "peter-panning (light where the truth is shadow) grows from {pp1:.1f}% (no filter) to {pp5:.1f}% "
+        "({k5} x {k5}) and {ppp:.1f}% (Poisson).",
+        res=res, samples=len(L.poisson_disk()), block=sizes[-1] ** 2,
+        pp1=100 * pp[0], pp5=100 * pp[2], k5=sizes[-1], ppp=100 * pp[3],
+    )  # fmt: skip
 
 
 @figure_name("shadows_pyrender")

@@ -256,7 +256,7 @@ def fig_convergence(out: Path, lab, quick: bool) -> Drawn:
         labels.append(name)
     xs = [np.arange(1, L + 1)] * len(curves)
     img = line_plot(
-        xs, curves, labels, xlabel="level", ylabel="largest move of an old vertex (model units)", logy=True,
+        xs, curves, labels, xlabel="level", ylabel="largest move of an old vertex (units)", logy=True,
         title="Subdivision converges: moves shrink geometrically", size=(560, 380),
     )  # fmt: skip
     f = [float(c[-2] / c[-1]) for c in curves]  # how much the moves shrink over the last level
