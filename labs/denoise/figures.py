@@ -208,13 +208,19 @@ def fig_seam(out: Path, L, quick: bool) -> Drawn:
     # close-ups look at the middle of that meridian from either side.
     overview = ((4.9, -2.2, 0.5), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))  # near the equator: the poles sit on the outline
     images, captions = [], []
-    for title, X, gap in rows:
+    for i, (title, X, gap) in enumerate(rows):
         nrm = _seam_normals(X, F, group)
-        images.append(
-            render(X, F, normals=nrm, camera=overview, fov_deg=30, size=size, back_color=BACK,
-                   highlight_points=seam, point_color=(0.1, 0.2, 0.7), point_radius=2.5)
-        )  # fmt: skip
-        captions.append(f"{title}: the whole sphere,\nblue dots = the seam u = 0 = 1")
+        if i == 0:  # one overview: the close-ups' region tinted yellow
+            near = np.linalg.norm(X - np.mean([c[1] for c in cams], axis=0), axis=1) < 0.3
+            tint = np.where(near[:, None], (0.95, 0.8, 0.3), (0.78, 0.8, 0.85))
+            images.append(
+                render(X, F, normals=nrm, camera=overview, fov_deg=30, size=size, back_color=BACK, colors=tint,
+                       highlight_points=seam, point_color=(0.1, 0.2, 0.7), point_radius=2.5)
+            )  # fmt: skip
+            captions.append("whole sphere (no fix): seam u = 0 = 1 in blue,\nthe close-ups' region in yellow")
+        else:
+            images.append(np.full((size[1], size[0], 3), 255, np.uint8))
+            captions.append("")
         for j, cam in enumerate(cams):
             images.append(
                 render(X, F, normals=nrm, camera=cam, fov_deg=30, size=size, back_color=BACK,
@@ -225,8 +231,8 @@ def fig_seam(out: Path, L, quick: bool) -> Drawn:
     img = panels(images, captions, ncols=3, title="UV seam of a denoised sphere (map route, λ = 0.7)")
     return Drawn(
         img,
-        "The latitude-longitude sphere is cut along the meridian u = 0 = 1 (left: the whole sphere, the seam in blue; "
-        "middle and right: close-ups of the seam's middle from either side). Every vertex on the seam exists twice (and the "
+        "The latitude-longitude sphere is cut along the meridian u = 0 = 1 (left: the whole sphere, the seam in blue, "
+        "the close-ups' region in yellow; middle and right: close-ups of the seam's middle from either side). Every vertex on the seam exists twice (and the "
         "poles once per triangle). Without the fix (top) each copy sees only its own side's neighbours and reads its "
         "own texels, so the copies move apart and the back faces (red) show through the crack (blue dots: the seam's "
         "vertices). Welding by position "
