@@ -24,15 +24,11 @@ LABS = sorted(p.parent.name for p in (ROOT / "solutions").glob("*/figures.py"))
 
 #: Figures whose captions are still typed text with numbers in it, per lab (file names).
 NOT_YET: dict[str, set[str]] = {
-    "subdivision": {"catmull_clark_levels.png", "subdivision_3d.html"},
     "simplification": {"series.png", "error_vs_faces.png", "pairs.png", "boundary.png", "simplification_3d.html"},
     "remeshing": {"before_after.png", "operations.png", "iterations.png", "features.png", "boundary.png",
                   "remeshing_3d.html"},
     "maps": {"bias_scale.png", "bake.png", "maps_3d.html"},
     "denoise": {"lambda_sequence.png", "error_vs_iterations.png", "offset_map.png"},
-    "shadows": {"shadows_lights.png", "shadows_3d.html"},
-    "vdm": {"vdm_rock_naive_vs_optimised.png", "vdm_box_stages.png", "vdm_diagonals.png", "vdm_background_sweep.png",
-            "vdm_3d.html"},
 }  # fmt: skip
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import datasets, topology
-from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.labfigures import Claims, Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import colorbar, heat_colors, line_plot, panels, with_colorbar
 from geomlib.render import camera_pose, render, render_polygons
 
@@ -141,7 +141,7 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Drawn:
     _, catmull_clark = _functions(lab)
     size = (240, 200) if quick else (330, 270)
     L = 2 if quick else 3
-    images, captions = [], []
+    images, captions, counts, old = [], [], {}, set()
     for name, (V0, faces0) in (("cube", datasets.quad_cube()), ("polygon cage", datasets.polygon_cage())):
         pose = camera_pose(V0, "three_quarter", size=size, zoom=1.05)
         V, faces = V0, faces0
@@ -149,6 +149,11 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Drawn:
             if k:
                 V, faces = catmull_clark(V, faces, 1)
             ext = topology.extraordinary_vertices(faces, len(V), regular=4)
+            counts.setdefault(name, []).append(len(ext))
+            if k == 1:  # the extraordinary old corners: their valence (edges at the vertex)
+                E = topology.unique_edges(topology.to_ragged(faces))
+                valence = np.bincount(E.ravel(), minlength=len(V))
+                old |= {int(valence[v]) for v in ext if v < len(V0)}
             images.append(
                 render_polygons(
                     V, faces, camera=pose, size=size, supersample=_ss(quick), wireframe=True, wire_opacity=0.8 if k < 3 else 0.35,
@@ -157,12 +162,19 @@ def fig_catmull_clark(out: Path, lab, quick: bool) -> Drawn:
             )  # fmt: skip
             captions.append(f"{name}, level {k}: {len(faces):,} faces, {len(ext)} extraordinary")
     img = panels(images, captions, ncols=L + 1, title="Catmull-Clark subdivision (red: extraordinary vertices)")
-    return Drawn(
+    steady = all(len(set(c[1:])) == 1 for c in counts.values())
+    return Drawn.claimed(
         img,
         "Catmull-Clark subdivision of a cube and of a cage of pentagon, quads and triangles. After one level every "
-        "face is a quad; the extraordinary vertices (valence != 4, red) are the old corners of valence 3 or 5 and "
-        "the face points of non-quad faces, and their number stays the same at every later level.",
-    )
+        "face is a quad; the extraordinary vertices (valence != 4, red) are the old corners (valence {lo} "
+        + ("or" if len(old) == 2 else "to")
+        + " {hi}) "
+        "and the face points of non-quad faces, "
+        + ("and their number stays the same at every later level: " if steady else "and their number after the "
+           "first level (it should stay the same, but here it changes): ")
+        + "{cube} on the cube, {cage} on the cage.",
+        lo=min(old), hi=max(old), cube=counts["cube"][-1], cage=counts["polygon cage"][-1],
+    )  # fmt: skip
 
 
 @figure_name("boundary")
@@ -282,8 +294,11 @@ def fig_view(lab, quick: bool) -> MeshView:
     Vs, Fs = loop_subdivide(V, F, levels=levels)
     return MeshView(
         Vs, Fs, title=f"Loop subdivision of the airplane, {levels} levels", up="z",
-        caption=f"Turn it: the airplane after {levels} Loop levels ({len(Fs):,} faces); the wings and the tail are "
-        "open sheets, and their boundary edges stay sharp and straight.",
+        caption=Claims(
+            "Turn it: the airplane after {levels} Loop levels ({faces:,} faces); the wings and the tail are "
+            "open sheets, and their boundary edges stay sharp and straight.",
+            {"levels": levels, "faces": len(Fs)},
+        ),
     )  # fmt: skip
 
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from geomlib import datasets, render
 from geomlib.geometry import mesh_distance
-from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.labfigures import Claims, Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import colorbar, line_plot, panels, with_colorbar
 
 __all__ = ["make_figures", "make_view"]
@@ -182,10 +182,11 @@ def _rock_reconstruction(out: Path, L, quick: bool) -> Drawn:
         label = "naive (uniform grid)" if name == "naive" else "optimised (density + alignment + diagonals)"
         caps.append(f"{res}x{res} {label}: Hausdorff {h:.2e}, Chamfer {c:.2e}")
     img = panels(imgs, caps, title=f"{res}x{res} VDM of the rock: naive vs optimised", font_size=13)
-    return Drawn(
+    return Drawn.claimed(
         _quantized(img),
-        f"The same {res * res} texels reconstruct the rock far better when they are moved toward "
+        "The same {texels} texels reconstruct the rock far better when they are moved toward "
         "creases and snapped onto them (errors relative to the bbox diagonal).",
+        texels=res * res,
     )
 
 
@@ -204,11 +205,12 @@ def _box_stages(out: Path, L, quick: bool) -> Drawn:
         imgs.append(_render(Vr, Fr, size, wireframe=True, edge_width=0.7))
         caps.append(f"{name}: Hausdorff {h:.1e}, Chamfer {c:.1e}")
     img = panels(imgs, caps, ncols=4, title="16x16 VDM of an open box, stage by stage", font_size=13)
-    return Drawn(
+    return Drawn.claimed(
         _quantized(img),
-        "A 16x16 VDM of a box without its bottom: the naive grid rounds every crease; transport "
+        "A {res}x{res} VDM of a box without its bottom: the naive grid rounds every crease; transport "
         "gathers samples at the creases, alignment puts vertices on them and the corners exactly on "
         "the box's corners, and per-quad diagonals make the reconstruction exact.",
+        res=res,
     )
 
 
@@ -250,10 +252,11 @@ def _diagonals(out: Path, L, quick: bool) -> Drawn:
         h, c = _errors(V, F, Vr, Fr, 5000 if quick else 20000)
         caps.append(f"{name} diagonals, close-up of the crease above the corner (1, 0, 0): Hausdorff {h:.1e}")
     img = panels(imgs, caps, ncols=4, title="Global vs per-quad diagonals (16x16 box, aligned grid)", font_size=13)
-    return Drawn(
+    return Drawn.claimed(
         _quantized(img),
-        "The aligned 16x16 grid of the box in uv with its triangles; sharp edges in red. Cells a "
+        "The aligned {res}x{res} grid of the box in uv with its triangles; sharp edges in red. Cells a "
         "crease crosses take the diagonal whose triangles stay on the surface.",
+        res=res,
     )
 
 
@@ -291,14 +294,18 @@ def _background_sweep(out: Path, L, quick: bool) -> Drawn:
     )
     caps.append("errors of the optimised VDM against the background")
     img = panels(imgs, caps, ncols=3, title=f"Background importance sweep (rock, {res}x{res})", font_size=12)
-    return Drawn(
+    return Drawn.claimed(
         _quantized(img),
         "The optimised grids for several background importances. A small background crowds the samples onto "
         "the creases and starves the flat floor (largest Hausdorff error); growing it spreads the samples out "
         "again, toward even sampling of the *surface*, not of the square: the background is weighted by the "
-        "map's area stretch (handout section 1.5), so even at the largest background "
-        f"({values[-1]:g}) the grid stays pulled toward the squeezed rock, which is that limit, not a leftover. "
-        f"Hausdorff error is smallest at background {values[int(np.argmin(haus))]:g} here; Chamfer keeps falling.",
+        "map's area stretch (see the handout's importance field), so even at the largest background "
+        "({largest:g}) the grid stays pulled toward the squeezed rock, which is that limit, not a leftover. "
+        "Hausdorff error is smallest at background {best:g} here ({best_h:.1e}); Chamfer is smallest at {best_c:g}.",
+        largest=values[-1],
+        best=values[int(np.argmin(haus))],
+        best_h=min(haus),
+        best_c=values[int(np.argmin(cham))],
     )
 
 
@@ -309,8 +316,11 @@ def _fig_view(L, quick: bool) -> MeshView:
     Vr, Fr = L.vdm_to_mesh(L.bake_vdm(V, F, res, UV=L.parameterize_square(V, F)))
     return MeshView(
         Vr, Fr, title=f"Rock rebuilt from the optimised {res}x{res} VDM", up="z",
-        caption=f"Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
-        "gather on the crease of the plinth and follow it.",
+        caption=Claims(
+            "Turn it: the rock rebuilt from its optimised {res} x {res} vector displacement map; the grid lines "
+            "gather on the crease of the plinth and follow it.",
+            {"res": res},
+        ),
     )  # fmt: skip
 
 
