@@ -27,7 +27,6 @@ NOT_YET: dict[str, set[str]] = {
     "simplification": {"series.png", "error_vs_faces.png", "pairs.png", "boundary.png", "simplification_3d.html"},
     "remeshing": {"before_after.png", "operations.png", "iterations.png", "features.png", "boundary.png",
                   "remeshing_3d.html"},
-    "maps": {"bias_scale.png", "bake.png", "maps_3d.html"},
     "denoise": {"lambda_sequence.png", "error_vs_iterations.png", "offset_map.png"},
 }  # fmt: skip
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib import camera, datasets
-from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
+from geomlib.labfigures import Claims, Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import Figure, panels, save_png
 from geomlib.textures import triangle_atlas
 
@@ -139,7 +139,8 @@ def _fig_bias_scale(out: Path, L, quick: bool) -> Drawn:
     V, F, UV = datasets.uv_sphere(32, 64) if quick else datasets.uv_sphere(96, 192)
     lam = 0.12
     imgs, caps = [_thumb(_grey(H), size)], ["displacement map h in [0, 1] (black = 0), mid-grey at the poles"]
-    for bias, scale in ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0)):
+    pairs = ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0))
+    for bias, scale in pairs:
         Vd = L.displace(V, F, UV, None, H, lam=lam, bias=bias, scale=scale, wrap="repeat")
         rad = np.linalg.norm(Vd, axis=1)
         imgs.append(render(Vd, F, camera="three_quarter", up_axis="z", size=(size, size)))
@@ -147,12 +148,14 @@ def _fig_bias_scale(out: Path, L, quick: bool) -> Drawn:
             f"(bias, scale) = ({bias:g}, {scale:g}): offsets λ·[{bias:g}, {bias + scale:g}], radius {rad.min():.2f}..{rad.max():.2f}"
         )
     img = panels(imgs, caps, ncols=4, title="Displacement P' = P + λ (bias + scale h) n, λ = 0.12")
-    return Drawn(
+    (b0, s0), (b1, s1), (b2, s2) = pairs
+    return Drawn.claimed(
         img,
-        "One displacement map applied to a UV sphere with three (bias, scale) pairs: (0, 1) only pushes outwards, "
-        "(-1, 2) maps mid-grey to no offset so the surface moves both ways, (-1, 5) exaggerates the peaks. "
-        "Seam copies are welded, so the sphere stays closed.",
-    )
+        "One displacement map applied to a UV sphere with three (bias, scale) pairs: ({b0:g}, {s0:g}) only pushes "
+        "outwards, ({b1:g}, {s1:g}) maps mid-grey to no offset so the surface moves both ways, ({b2:g}, {s2:g}) "
+        "exaggerates the peaks. Seam copies are welded, so the sphere stays closed.",
+        b0=b0, s0=s0, b1=b1, s1=s1, b2=b2, s2=s2,
+    )  # fmt: skip
 
 
 def _rock(L, quick: bool):
@@ -205,16 +208,14 @@ def _fig_bake(out: Path, L, quick: bool) -> list[Figure]:
         ncols=4,
         title="Baking a normal map from a detailed rock onto its decimated version",
     )
-    figs.append(
-        Figure(
-            save_png(out / "bake.png", img),
-            f"The built-in rock ({len(Fh):,} faces) decimated to {len(Fl):,} faces with fast-simplification; every "
-            f"triangle gets its own chart (triangle_atlas) and bake_normal_map casts from each texel along the low "
-            f"normal onto the detailed rock. Read back by the shader, the map restores the ridges and bumps the "
-            f"decimation removed.",
-            LAB,
-        )
+    claims = Claims(
+        "The built-in rock ({high:,} faces) decimated to {low:,} faces with fast-simplification; every "
+        "triangle gets its own chart (triangle_atlas) and bake_normal_map casts from each texel along the low "
+        "normal onto the detailed rock. Read back by the shader, the map restores the ridges and bumps the "
+        "decimation removed.",
+        {"high": len(Fh), "low": len(Fl)},
     )
+    figs.append(Figure(save_png(out / "bake.png", img), claims.caption(), LAB, claims))
     img = panels(
         shots["key"] + shots["grazing"],
         [c + " — key + fill" for c in caps] + [c + " — grazing light" for c in caps],
@@ -242,8 +243,11 @@ def _fig_view(L, quick: bool) -> MeshView:
     Vd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat")
     return MeshView(
         Vd, Fd, title="Displaced torus (displace, Task 5)", up="z", edges=False,
-        caption=f"Turn it: the torus displaced by the bump height map ({len(Fd):,} faces), the geometry a normal map "
-        "imitates.",
+        caption=Claims(
+            "Turn it: the torus displaced by the bump height map ({faces:,} faces, coarser than the figures' mesh), "
+            "the geometry a normal map imitates.",
+            {"faces": len(Fd)},
+        ),
     )  # fmt: skip
 
 
