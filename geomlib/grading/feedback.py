@@ -111,9 +111,14 @@ def without_pictures(message: str, paths) -> str:
     return message
 
 
-def pictures_left() -> bool:
-    """Whether this run may draw another picture (False once its cap is reached)."""
-    return _picture_allowed()
+def picture_wanted() -> bool:
+    """Whether this run draws another picture; False once its cap is reached (the picture is counted
+    as held back). Call it before preparing a costly picture (dense matrices, distances)."""
+    if _picture_allowed():
+        return True
+    if not os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        _HELD[0] += 1
+    return False
 
 
 def _picture_allowed() -> bool:
@@ -136,9 +141,7 @@ def _drawn_in_time(path, draw) -> str | None:
 
     from geomlib.grading import sandbox, tolerances
 
-    if not _picture_allowed():
-        if not os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
-            _HELD[0] += 1
+    if not picture_wanted():
         return None
     limit = tolerances.PICTURE_TIME_S
     left = sandbox.remaining_time()
@@ -523,6 +526,8 @@ def default_picture(ctx: Context, inputs: dict, expected: dict, got: dict, *, at
     ``got`` map output names to arrays. A row is wrong where it differs by more than
     ``atol + rtol * |expected|``. Returns the picture's path, or None when none fits.
     """
+    if ctx.feedback_dir is None or not picture_wanted():
+        return None
     return (
         rows_on_mesh(ctx, inputs, expected, got, atol=atol, rtol=rtol)
         or grid_image(ctx, expected, got)

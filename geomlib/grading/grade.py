@@ -186,8 +186,8 @@ def grade(
     )
     if drawn.held and feedback_dir:
         data["report"] += [
-            f"Pictures of the other failures ({drawn.held} held back, a second each): "
-            '--pictures all (in a notebook: check(..., pictures="all")).'
+            "Pictures of the other failures (about a second each): add --pictures all "
+            '(in a notebook: check(..., pictures="all")).'
         ]
     return data
 

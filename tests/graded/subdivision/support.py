@@ -165,7 +165,7 @@ def matrix_picture(ctx, V, F, expected, got, name: str) -> str | None:
     where the expected rows put it, where the submitted rows put it, and how far apart they are."""
     from geomlib.grading import feedback
 
-    if ctx is None:
+    if ctx is None or ctx.feedback_dir is None or not feedback.picture_wanted():
         return None
     rows = wrong_rows(expected, got, name)
     if rows is None or not len(rows):
