@@ -223,15 +223,18 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
         b = _draw(Vg, Fg, wireframe=len(Fg) < 5000, size=size)
         c = _draw(Vg, Fg, colors=colors, size=size)
         bar = plot.colorbar(0.0, vmax, cmap="inferno", label="distance", height=size[1])
-        captions = ["expected", "submitted", f"distance to the nearest expected vertex (max {d.max():.3g})"]
+        captions = ["expected", "yours", f"difference: distance to the nearest expected vertex (max {d.max():.3g})"]
         img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
 
 
-def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel: np.ndarray) -> str | None:
-    """Expected and submitted images in [0, 1] with a per-pixel difference heat map."""
+def image_picture(
+    ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel: np.ndarray, *, unit: str = ""
+) -> str | None:
+    """Expected and submitted images in [0, 1] with a per-pixel difference heat map (``per_pixel``, in
+    ``unit`` when given: the unit the message uses)."""
     path = ctx.feedback_path()
     if path is None:
         return None
@@ -252,8 +255,9 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
             )
         vmax = max(float(per_pixel.max()), 1e-12)
         heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=vmax)
-        bar = plot.colorbar(0.0, vmax, cmap="inferno", label="|difference|", height=max(128, heat.shape[0]))
-        captions = ["expected", "submitted", "|difference| per pixel"]
+        label = f"|difference| ({unit})" if unit else "|difference|"
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=max(128, heat.shape[0]))
+        captions = ["expected", "yours", f"difference: {label} per pixel"]
         img = plot.panels([to_rgb(expected), to_rgb(got), _beside(heat, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
 
@@ -373,17 +377,16 @@ def rows_picture(
             f"difference: |error| per row (max {vmax:.3g})",
         ]
         fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=True, flat=flat)
-        size = 28 if n <= 50 else 14 if n <= 500 else 6
+        size = 60 if n <= 50 else 16 if n <= 500 else 6
         if values is not None:
             ve, vg = (np.asarray(x, float).ravel() for x in values)
             both = np.concatenate([ve[np.isfinite(ve)], vg[np.isfinite(vg)]]) if n else np.zeros(1)
             vlo, vhi = (float(both.min()), float(both.max())) if both.size else (0.0, 1.0)
         for k, ax in enumerate(axes):
-            ax.add_collection3d(Line3DCollection(W[E], colors="0.45", linewidths=0.5, alpha=0.35, zorder=1))
+            ax.add_collection3d(Line3DCollection(W[E], colors="0.35", linewidths=0.5, alpha=0.4, zorder=1))
             if k == 0:
-                c = "#1f77b4" if values is None else ve
-                sc = ax.scatter(*P.T, s=size, c=c, cmap="viridis", depthshade=False, zorder=3, edgecolors="white",
-                                linewidths=0.4, **({} if values is None else {"vmin": vlo, "vmax": vhi}))  # fmt: skip
+                colour = {"c": "#1f77b4"} if values is None else {"c": ve, "cmap": "viridis", "vmin": vlo, "vmax": vhi}
+                ax.scatter(*P.T, s=size, depthshade=False, zorder=3, edgecolors="white", linewidths=0.4, **colour)
             elif k == 1:
                 if values is None:
                     ax.scatter(*Gc[ok].T, s=size * 1.3, c="#ff7f0e", marker="X", depthshade=False, zorder=3,
@@ -519,18 +522,21 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
 # hand-written graded tests (expect_close, a lab's own comparisons through failure_picture).
 
 
-def default_picture(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: float = 1e-8, rtol: float = 0.0):
+def default_picture(
+    ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: float = 1e-8, rtol: float = 0.0, unit: str = ""
+):
     """A picture for a wrong array: rows on the input mesh, or a grid output as an image, or free points.
 
     ``inputs`` holds the mesh, if any, as ``V`` and ``F`` (or ``faces``, ``Q``); ``expected`` and
     ``got`` map output names to arrays. A row is wrong where it differs by more than
-    ``atol + rtol * |expected|``. Returns the picture's path, or None when none fits.
+    ``atol + rtol * |expected|``; ``unit`` names the unit of the values (a grid's difference heat
+    map says it). Returns the picture's path, or None when none fits.
     """
     if ctx.feedback_dir is None or not picture_wanted():
         return None
     return (
         rows_on_mesh(ctx, inputs, expected, got, atol=atol, rtol=rtol)
-        or grid_image(ctx, expected, got)
+        or grid_image(ctx, expected, got, unit=unit)
         or free_points(ctx, inputs, expected, got, atol=atol, rtol=rtol)
     )
 
@@ -558,7 +564,7 @@ def free_points(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: 
     return None
 
 
-def grid_image(ctx: Context, expected: dict, got: dict):
+def grid_image(ctx: Context, expected: dict, got: dict, *, unit: str = ""):
     """Expected and submitted (h, w, c) grids (displacements, positions, maps) as images, with the
     per-texel error as a heat map; channels are scaled by the expected values' range."""
     for name, e in expected.items():
@@ -596,7 +602,7 @@ def grid_image(ctx: Context, expected: dict, got: dict):
         def up(x, k=k):
             return np.repeat(np.repeat(x, k, axis=0), k, axis=1)
 
-        return image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))))
+        return image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))), unit=unit)
     return None
 
 
@@ -696,7 +702,9 @@ def picture_context(label: str, name: str = "output") -> Context | None:
     return Context(label=label, lab=_TEST["lab"], case_id=case_id, feedback_dir=_TEST["dir"])
 
 
-def failure_picture(label: str, got, expected, *, name: str = "output", mesh=None, atol: float = 1e-8, rtol=0.0):
+def failure_picture(
+    label: str, got, expected, *, name: str = "output", mesh=None, atol: float = 1e-8, rtol=0.0, unit: str = ""
+):
     """The feedback picture of a failed comparison in a hand-written graded test, or None.
 
     Parameters
@@ -712,6 +720,9 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
         grids and images are drawn as images, ``(n, 2)`` and ``(n, 3)`` arrays as points.
     atol, rtol : float
         The comparison's tolerance: rows within it are not marked.
+    unit : str
+        The unit of the values as the message gives them (``"texels"``): pass the values in it, and
+        the picture's difference is labelled with it, so text and picture agree.
     """
     ctx = picture_context(label, name)
     if ctx is None:
@@ -730,7 +741,7 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
                 e, g = full_e, full_g
         if mesh is not None and e.shape == (3,) and len(mesh[0]) != 3 and g is not None and g.shape == (3,):
             e, g = e[None], g[None]  # one point (a vertex, an edge point): marked where it should be
-        return default_picture(ctx, inputs, {name: e}, {name: g}, atol=max(atol, 1e-12), rtol=rtol)
+        return default_picture(ctx, inputs, {name: e}, {name: g}, atol=max(atol, 1e-12), rtol=rtol, unit=unit)
     except Exception:  # noqa: BLE001 - a picture is a help: the message stands alone
         return None
 
