@@ -149,6 +149,7 @@ def grade(
     args += extra_args or []
     os.environ.setdefault("GEOMLIB_IMPL", str(impl))
     selection = _Selection(task=task, part=part)
+    _start_sandbox_early()
     t0 = time.time()
     captured = io.StringIO()
     from geomlib.grading import feedback
@@ -190,6 +191,24 @@ def grade(
             '(in a notebook: check(..., pictures="all")).'
         ]
     return data
+
+
+def _start_sandbox_early() -> None:
+    """Start the sandbox's zygote (an interpreter importing NumPy, SciPy, libigl: about a second) in
+    the background, so that it starts while pytest starts and collects, not after: a student's
+    ``--task N`` waits for the longer of the two, not their sum. Later runs in this process (a
+    notebook's ``check``) reuse it."""
+    import threading
+
+    from geomlib.grading import sandbox
+
+    def start():
+        try:
+            sandbox._zygote()
+        except Exception:  # noqa: BLE001 - the first test starts it again and reports the problem
+            pass
+
+    threading.Thread(target=start, name="geomlib-zygote-start", daemon=True).start()
 
 
 def _remove_stale_pictures(feedback_dir, labs, *, before: float) -> None:
