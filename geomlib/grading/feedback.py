@@ -59,9 +59,10 @@ class pictures_for_run:  # noqa: N801 - used as a function: ``with pictures_for_
             self.cap = {"first": 1, "all": None, "none": 0}[pictures or "first"]
 
     def __enter__(self):
-        self.saved = (_DRAWN[0], _CAP[0], _HELD[0], list(_PENDING), _ASYNC[0])
+        self.saved = (_DRAWN[0], _CAP[0], _HELD[0], list(_PENDING), _ASYNC[0], set(_FAILED))
         _DRAWN[0], _CAP[0], _HELD[0], _ASYNC[0] = 0, self.cap, 0, True
         _PENDING.clear()
+        _FAILED.clear()
         self.held, self.failed = 0, set()
         return self
 
@@ -70,8 +71,10 @@ class pictures_for_run:  # noqa: N801 - used as a function: ``with pictures_for_
         self.held = _HELD[0]
         #: pictures named in messages that were not drawn after all (time limit, a drawing error)
         self.failed = _finish_pending()
-        _DRAWN[0], _CAP[0], _HELD[0], pending, _ASYNC[0] = self.saved
+        _DRAWN[0], _CAP[0], _HELD[0], pending, _ASYNC[0], failed = self.saved
         _PENDING[:] = pending
+        _FAILED.clear()
+        _FAILED.update(failed)
         return False
 
 
@@ -80,13 +83,21 @@ _PENDING: list = []
 _ASYNC = [False]
 
 
-def _finish_pending() -> set:
-    """Wait for the pictures still being drawn (each until its own deadline); the paths (as the
-    messages name them) of those that failed or were too slow."""
+#: Pictures drawn at once while the tests go on (each child holds a plotting library and a mesh:
+#: the autograder's memory is limited, and two cores are busy with the tests and one picture).
+MAX_DRAWING = 1
+#: Pictures of this run that failed or ran out of time (paths as the messages name them).
+_FAILED: set = set()
+
+
+def _finish_pending(keep: int = 0) -> set:
+    """Wait for the pictures still being drawn, oldest first, until at most ``keep`` are (each until
+    its own deadline); the paths (as the messages name them) of all this run's pictures that failed
+    or were too slow."""
     import time
 
-    failed = set()
-    for pid, path, deadline in _PENDING:
+    while len(_PENDING) > keep:
+        pid, path, deadline = _PENDING.pop(0)
         ok = False
         while True:
             done, status = os.waitpid(pid, os.WNOHANG)
@@ -99,9 +110,8 @@ def _finish_pending() -> set:
                 break
             time.sleep(0.01)
         if not ok:
-            failed.add(_relpath(path))
-    _PENDING.clear()
-    return failed
+            _FAILED.add(_relpath(path))
+    return set(_FAILED)
 
 
 def without_pictures(message: str, paths) -> str:
@@ -149,6 +159,8 @@ def _drawn_in_time(path, draw) -> str | None:
         limit = min(limit, left - 1.0)
     if limit <= 0:
         return None
+    if _ASYNC[0]:
+        _finish_pending(keep=MAX_DRAWING - 1)  # one picture at a time beside the tests
     pid = os.fork()
     if pid == 0:  # pragma: no cover - child
         code = 1

@@ -397,3 +397,74 @@ def test_a_wrong_shader_picture_is_in_the_unit_of_its_message(tmp_path, monkeypa
     assert seen.get("unit") == "texels", seen
     worst = np.abs(wrong - uv).max() * s
     assert abs(seen["max"] - worst) < 1e-6 * s and said <= worst + 1e-3, (seen, said, worst)
+
+
+# ------------------------------------------------------------------------------ which pictures a run draws, and when
+
+
+def _image_ctx(tmp_path, case_id):
+    from geomlib.grading.checks import Context
+
+    return Context(label=case_id, lab="run", case_id=case_id, feedback_dir=tmp_path)
+
+
+def test_a_run_draws_the_first_failures_picture_unless_asked_for_all(tmp_path, monkeypatch):
+    """A student fixing one task gets one picture (a picture costs about a second): the first
+    failure's; ``pictures="all"`` draws every one. Each run counts from zero (a notebook's kernel
+    grades many times)."""
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES", raising=False)
+    a, b = np.zeros((8, 8)), np.eye(8)
+    for mode, drawn in (("first", 1), ("first", 1), ("all", 3), ("none", 0)):
+        out = tmp_path / mode
+        with feedback.pictures_for_run(mode) as run:
+            paths = [feedback.image_picture(_image_ctx(out, f"case{i}"), a, b, np.abs(a - b)) for i in range(3)]
+        assert sum(p is not None for p in paths) == drawn, (mode, paths)
+        assert all(Path(p).is_file() for p in paths if p), "a run ends when its pictures are drawn"
+        assert run.held == 3 - drawn and not run.failed, (mode, run.held, run.failed)
+    with pytest.raises(ValueError, match="pictures='some'"):
+        feedback.pictures_for_run("some")
+
+
+def test_a_picture_that_fails_while_the_tests_go_on_leaves_no_dangling_path(tmp_path, monkeypatch):
+    """Pictures are drawn in a child while the next tests run; one that fails (or runs out of time) is
+    taken out of the messages that named it."""
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    path = _image_ctx(tmp_path, "broken").feedback_path()
+
+    def draw():
+        raise RuntimeError("no OpenGL here")
+
+    with feedback.pictures_for_run("all") as run:
+        named = feedback._drawn_in_time(path, draw)
+        assert named  # named at once: the child is still drawing
+    assert run.failed == {named} and not path.exists()
+    msg = f"S_odd row 0 differs (see {named})"
+    assert feedback.without_pictures(msg, run.failed) == "S_odd row 0 differs"
+
+
+@pytest.mark.render
+def test_grade_task_draws_one_picture_and_says_how_to_get_the_others(tmp_path):
+    """``geomlib grade --task 1`` with a wrong Task 1 (odd weight 3/8 -> 0.3): five failures, one
+    picture (the first failure's, named in its message), and the report says ``--pictures all``."""
+    from .course import planted_solution, run_geomlib
+
+    def edit(dest):
+        p = dest / "loop.py"
+        text = p.read_text()
+        p.write_text(text.replace("np.tile([3 / 8, 3 / 8, 1 / 8, 1 / 8]", "np.tile([0.3, 0.3, 1 / 8, 1 / 8]"))
+
+    lab = planted_solution("subdivision", edit)
+    try:
+        env = {"GEOMLIB_NO_FEEDBACK_PICTURES": "", "GEOMLIB_MAX_FEEDBACK_PICTURES": ""}
+        p = run_geomlib(course_root(), "grade", "--impl", str(lab.parent), "--lab", "subdivision", "--task", "1",
+                        "--feedback", str(tmp_path), cwd=tmp_path, env=env)  # fmt: skip
+    finally:
+        shutil.rmtree(lab.parent, ignore_errors=True)
+    out = p.stdout
+    assert re.search(r"What to fix \([2-9] failing tests\)", out), out
+    named = [ln.strip() for ln in out.splitlines() if ln.strip().endswith(".png")]
+    assert "Feedback pictures (1)" in out and len(named) == 1 and (tmp_path / named[0]).is_file(), out
+    assert sorted(x.name for x in (tmp_path / "subdivision").glob("*.png")) == [Path(named[0]).name]
+    assert f"(see {named[0]})" in " ".join(out.split()), "the picture is named in its failure's message"
+    assert "--pictures all" in out and 'pictures="all"' in out, out
