@@ -202,11 +202,17 @@ def _start_sandbox_early() -> None:
 
     from geomlib.grading import sandbox
 
+    if any(t.name == "geomlib-zygote-start" for t in threading.enumerate()):
+        return  # started by an earlier run in this process (and restarted by the sandbox if it died)
+
     def start():
         try:
             sandbox._zygote()
         except Exception:  # noqa: BLE001 - the first test starts it again and reports the problem
-            pass
+            return
+        # The zygote asks for SIGTERM when its parent *thread* ends (PR_SET_PDEATHSIG follows the
+        # thread that started it), so this thread stays, parked, for the life of the process.
+        threading.Event().wait()
 
     threading.Thread(target=start, name="geomlib-zygote-start", daemon=True).start()
 
