@@ -1,14 +1,24 @@
-"""Grading speed: all labs' graded tests against the solutions (target <= 60 s) and the stubs (<= 30 s).
+"""Grading speed: all labs' graded tests against the solutions (target <= 60 s) and the stubs (<= 30 s);
+the sandbox's cost per call (fork + import + result transfer), the price of isolation; and feedback
+speed while a task is wrong (issue #26 item 4).
 
-Also the sandbox's cost per call (fork + import + result transfer), the price of isolation.
+Feedback speed: a planted wrong task in three labs (subdivision's odd weight 3/8 -> 0.3, Task 1;
+vdm's sample_surface 1 % off, Task 2; shadows' light_uvz shifted in u, Task 3) graded as a student
+does, warm (a first run writes the bytecode and numba caches), with the default pictures (the first
+failure's). Targets: ``geomlib grade --task N`` and a notebook's ``check(lab, task=N)`` <= 3 s, the
+whole lab <= 10 s. Printed per run: wall time, the CPU time of the run (this process's children, so
+a loaded machine shows up as wall >> CPU) and the load average.
 
-    uv run python bench/grading.py
+    uv run python bench/grading.py             # everything
+    uv run python bench/grading.py feedback    # feedback speed only
 """
 
 from __future__ import annotations
 
 import json
 import os
+import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -16,6 +26,33 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: lab: (module, planted source, the task it breaks)
+PLANTED = {
+    "subdivision": ("loop", None, 1),  # the odd weight 3/8 -> 0.3 (an edit of the solution, below)
+    "vdm": (
+        "sampling",
+        """
+        _true_sample_surface = sample_surface
+
+        def sample_surface(V, F, UV, uv_points):
+            return 1.01 * _true_sample_surface(V, F, UV, uv_points)
+        """,
+        2,
+    ),
+    "shadows": (
+        "lookup",
+        """
+        _true_light_uvz = light_uvz
+
+        def light_uvz(P, M):
+            return np.asarray(_true_light_uvz(P, M)) + [0.05, 0.0, 0.0]
+        """,
+        3,
+    ),
+}
+TARGET_TASK_S = 3.0
+TARGET_LAB_S = 10.0
 
 
 def grade(impl: str) -> tuple[float, dict]:
@@ -49,7 +86,132 @@ def sandbox_call_cost(n: int = 50) -> float:
     return (time.perf_counter() - t) / n
 
 
+# ------------------------------------------------------------------------------ feedback speed
+
+
+def planted(lab: str) -> Path:
+    """A submission folder holding ``<lab>/``: a copy of ``solutions/<lab>`` with the lab's planted
+    error (tests/framework/course.py's helper)."""
+    sys.path.insert(0, str(ROOT))
+    from tests.framework.course import appended, planted_solution
+
+    module, source, _ = PLANTED[lab]
+    if source is None:
+
+        def edit(dest: Path) -> None:
+            p = dest / f"{module}.py"
+            text = p.read_text()
+            wrong = text.replace("np.tile([3 / 8, 3 / 8, 1 / 8, 1 / 8]", "np.tile([0.3, 0.3, 1 / 8, 1 / 8]")
+            assert wrong != text, "the odd weights of solutions/subdivision/loop.py moved: update the plant"
+            p.write_text(wrong)
+    else:
+        edit = appended(module, source, "bench/grading.py")
+    return planted_solution(lab, edit).parent
+
+
+def _student_env() -> dict:
+    # A student's Python writes bytecode (this machine's sessions may not: that would time compiling).
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "GEOMLIB_NO_FEEDBACK_PICTURES")}
+    env.pop("GEOMLIB_MAX_FEEDBACK_PICTURES", None)
+    return env
+
+
+def _children_cpu() -> float:
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def cli_run(impl: Path, lab: str, task: int | None, feedback: Path) -> tuple[float, float, str]:
+    """Wall and CPU seconds of ``geomlib grade`` as a student types it, and its report."""
+    args = [
+        sys.executable,
+        "-m",
+        "geomlib.cli",
+        "grade",
+        "--impl",
+        str(impl),
+        "--lab",
+        lab,
+        "--feedback",
+        str(feedback),
+    ]
+    if task is not None:
+        args += ["--task", str(task)]
+    cpu0, t = _children_cpu(), time.perf_counter()
+    p = subprocess.run(args, cwd=ROOT, env=_student_env(), capture_output=True, text=True)
+    return time.perf_counter() - t, _children_cpu() - cpu0, p.stdout + p.stderr
+
+
+_NOTEBOOK = """
+import os, resource, sys, time
+from geomlib.grading import check
+impl, lab, task, feedback = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+def cpu():
+    s, c = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return s.ru_utime + s.ru_stime + c.ru_utime + c.ru_stime
+check(lab, task=task, impl=impl, feedback_dir=feedback)   # the kernel's first check (imports, workers)
+c0, t = cpu(), time.perf_counter()
+r = check(lab, task=task, impl=impl, feedback_dir=feedback)  # the student's next try
+print(time.perf_counter() - t, cpu() - c0, sum(1 for line in r if line.strip().endswith(".png")))
+"""
+
+
+def notebook_run(impl: Path, lab: str, task: int, feedback: Path) -> tuple[float, float, int]:
+    """Wall and CPU seconds of a second ``check(lab, task=N)`` in one live process (a notebook kernel)."""
+    p = subprocess.run(
+        [sys.executable, "-c", _NOTEBOOK, str(impl), lab, str(task), str(feedback)],
+        cwd=ROOT,
+        env=_student_env(),
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    wall, cpu, pictures = p.stdout.split()[-3:]
+    return float(wall), float(cpu), int(pictures)
+
+
+def _pictures(report: str) -> int:
+    return sum(1 for line in report.splitlines() if line.strip().endswith(".png"))
+
+
+def feedback_speed() -> bool:
+    print(
+        f"feedback speed, a planted wrong task (targets: one task <= {TARGET_TASK_S:g} s, whole lab <= {TARGET_LAB_S:g} s)"
+    )
+    ok = True
+    for lab, (_, _, task) in PLANTED.items():
+        impl = planted(lab)
+        feedback = Path(tempfile.mkdtemp(prefix="geomlib-bench-feedback-"))
+        try:
+            cli_run(impl, lab, task, feedback)  # warm-up: bytecode, numba caches
+            rows = []
+            for what, n in ((f"grade --task {task}", task), ("grade (whole lab)", None)):
+                load = os.getloadavg()[0]
+                wall, cpu, report = cli_run(impl, lab, n, feedback)
+                failing = next((ln for ln in report.splitlines() if ln.startswith("What to fix")), "What to fix (?)")
+                rows.append((what, wall, cpu, load, TARGET_TASK_S if n else TARGET_LAB_S, _pictures(report), failing))
+            load = os.getloadavg()[0]
+            wall, cpu, pics = notebook_run(impl, lab, task, feedback)
+            rows.insert(1, (f"check({lab!r}, task={task})", wall, cpu, load, TARGET_TASK_S, pics, ""))
+            for what, wall, cpu, load, target, pics, failing in rows:
+                ok &= wall <= target
+                print(
+                    f"  {lab:<12} {what:<28} {wall:5.1f} s wall, {cpu:5.1f} s CPU  (target <= {target:g} s: "
+                    f"{wall / target:.2f}x; load {load:.1f}) {pics} picture{'s' if pics != 1 else ''}"
+                    + (f"; {failing.rstrip(':')}" if failing else "")
+                )
+        finally:
+            shutil.rmtree(impl, ignore_errors=True)
+            shutil.rmtree(feedback, ignore_errors=True)
+    return ok
+
+
 def main() -> None:
+    only = sys.argv[1:]
+    if not only or "feedback" in only:
+        feedback_speed()
+    if only and "grading" not in only:
+        return
     print(f"sandbox: {1000 * sandbox_call_cost():.1f} ms per call (fork, import, 240 kB round trip)")
     for impl, target in (("solutions", 60.0), ("labs", 30.0)):
         seconds, r = grade(impl)

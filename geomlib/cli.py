@@ -137,6 +137,7 @@ def _cmd_grade(a) -> int:
         verbose=a.verbose,
         task=a.task,
         part=a.part,
+        pictures=a.pictures,
     )
     print("\n".join(data["report"]))
     if a.results:
@@ -277,6 +278,12 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--part", help='only the tests of this part, as named in the score table ("boundary rules")')
     g.add_argument("--results", help="write Gradescope results.json here")
     g.add_argument("--feedback", default="feedback", help="folder for feedback pictures (default: feedback/)")
+    g.add_argument(
+        "--pictures",
+        choices=("first", "all", "none"),
+        default=None,
+        help="feedback pictures of the first failure only (default), of every failure, or none",
+    )
     g.add_argument("-v", "--verbose", action="store_true")
     g.set_defaults(func=_cmd_grade)
 

@@ -37,3 +37,21 @@ def test_notebook_runs_on_the_stubs(path, monkeypatch):
     ).execute()
     text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
     assert "not implemented yet" in text
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_setup_is_one_call_and_every_task_has_a_check_cell(path):
+    """The first code cell opens the lab with one call (no copy of the set-up code in nine notebooks),
+    and each task of the handout's table has a cell that runs ``check(lab, task=N)``."""
+    import json
+    import re
+
+    from geomlib.grading import tasks
+
+    lab = path.stem
+    cells = ["".join(c["source"]) for c in json.loads(path.read_text())["cells"] if c["cell_type"] == "code"]
+    setup = cells[0]
+    assert re.search(rf'^\w+, tasks_done = open_lab\("{lab}"\)$', setup, re.M), setup
+    assert "def tasks_done" not in setup and "sys.path" not in setup and "load_lab" not in setup, setup
+    checked = {int(n) for c in cells for n in re.findall(rf'^check\("{lab}", task=(\d+)\)', c, re.M)}
+    assert checked == set(tasks.table(lab).titles), f"{path.name}: check() cells for tasks {sorted(checked)}"

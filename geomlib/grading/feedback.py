@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import re
+import textwrap
 
 import numpy as np
 
@@ -31,17 +32,114 @@ def _relpath(p) -> str:
         return str(p)
 
 
-#: Pictures drawn so far in this process (see :func:`_picture_allowed`).
+#: Pictures drawn so far in this run (see :func:`_picture_allowed`).
 _DRAWN = [0]
+#: This run's cap on pictures (None: no cap), set by :func:`pictures_for_run`.
+_CAP: list = [None]
+#: Pictures this run's cap held back.
+_HELD = [0]
+
+#: ``pictures=`` choices of ``geomlib grade --pictures`` and ``check(..., pictures=)``.
+PICTURE_CHOICES = ("first", "all", "none")
+
+
+class pictures_for_run:  # noqa: N801 - used as a function: ``with pictures_for_run("first"):``
+    """The pictures of one grading run: ``"first"`` (the first failure's picture only: a picture costs
+    about a second, a student fixing one task needs one), ``"all"`` or ``"none"``. None: the cap
+    ``GEOMLIB_MAX_FEEDBACK_PICTURES`` if set (the autograder's), else ``"first"``. Counting starts
+    at zero for every run (a notebook grades many times in one process)."""
+
+    def __init__(self, pictures: str | None = None):
+        if pictures is not None and pictures not in PICTURE_CHOICES:
+            raise ValueError(f"pictures={pictures!r}: expected one of {', '.join(map(repr, PICTURE_CHOICES))}")
+        cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
+        if pictures is None and cap.isdigit():
+            self.cap = int(cap)
+        else:
+            self.cap = {"first": 1, "all": None, "none": 0}[pictures or "first"]
+
+    def __enter__(self):
+        self.saved = (_DRAWN[0], _CAP[0], _HELD[0], list(_PENDING), _ASYNC[0], set(_FAILED))
+        _DRAWN[0], _CAP[0], _HELD[0], _ASYNC[0] = 0, self.cap, 0, True
+        _PENDING.clear()
+        _FAILED.clear()
+        self.held, self.failed = 0, set()
+        return self
+
+    def __exit__(self, *exc):
+        #: failures whose picture the cap held back (the report says how to get them)
+        self.held = _HELD[0]
+        #: pictures named in messages that were not drawn after all (time limit, a drawing error)
+        self.failed = _finish_pending()
+        _DRAWN[0], _CAP[0], _HELD[0], pending, _ASYNC[0], failed = self.saved
+        _PENDING[:] = pending
+        _FAILED.clear()
+        _FAILED.update(failed)
+        return False
+
+
+#: Within a run, pictures are drawn while the next tests run: ``(pid, path, deadline)`` of each child.
+_PENDING: list = []
+_ASYNC = [False]
+
+
+#: Pictures drawn at once while the tests go on (each child holds a plotting library and a mesh:
+#: the autograder's memory is limited, and two cores are busy with the tests and one picture).
+MAX_DRAWING = 1
+#: Pictures of this run that failed or ran out of time (paths as the messages name them).
+_FAILED: set = set()
+
+
+def _finish_pending(keep: int = 0) -> set:
+    """Wait for the pictures still being drawn, oldest first, until at most ``keep`` are (each until
+    its own deadline); the paths (as the messages name them) of all this run's pictures that failed
+    or were too slow."""
+    import time
+
+    while len(_PENDING) > keep:
+        pid, path, deadline = _PENDING.pop(0)
+        ok = False
+        while True:
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                ok = os.waitstatus_to_exitcode(status) == 0 and os.path.exists(path)
+                break
+            if time.monotonic() > deadline:
+                os.kill(pid, 9)
+                os.waitpid(pid, 0)
+                break
+            time.sleep(0.01)
+        if not ok:
+            _FAILED.add(_relpath(path))
+    return set(_FAILED)
+
+
+def without_pictures(message: str, paths) -> str:
+    """``message`` without its ``(see PATH)`` for each of ``paths`` (pictures that were not drawn)."""
+    for p in paths:
+        message = message.replace(f" (see {p})", "")
+    return message
+
+
+def picture_wanted() -> bool:
+    """Whether this run draws another picture; False once its cap is reached (the picture is counted
+    as held back). Call it before preparing a costly picture (dense matrices, distances)."""
+    if _picture_allowed():
+        return True
+    if not os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+        _HELD[0] += 1
+    return False
 
 
 def _picture_allowed() -> bool:
     """False when pictures are switched off (``GEOMLIB_NO_FEEDBACK_PICTURES`` set) or when this run has
-    drawn ``GEOMLIB_MAX_FEEDBACK_PICTURES`` already. The autograder sets a cap: a student needs a picture
-    of the first failures of each task, and every picture costs seconds of the run and ~0.2 MB of
-    results.json."""
+    drawn its cap already (:func:`pictures_for_run`; outside a run, ``GEOMLIB_MAX_FEEDBACK_PICTURES``).
+    The autograder sets a cap: a student needs a picture of the first failures of each task, and every
+    picture costs a second of the run and ~0.2 MB of results.json."""
     if os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
         return False
+    if _CAP[0] is not None:
+        return _DRAWN[0] < _CAP[0]
     cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
     return not cap.isdigit() or _DRAWN[0] < int(cap)
 
@@ -53,7 +151,7 @@ def _drawn_in_time(path, draw) -> str | None:
 
     from geomlib.grading import sandbox, tolerances
 
-    if not _picture_allowed():
+    if not picture_wanted():
         return None
     limit = tolerances.PICTURE_TIME_S
     left = sandbox.remaining_time()
@@ -61,6 +159,8 @@ def _drawn_in_time(path, draw) -> str | None:
         limit = min(limit, left - 1.0)
     if limit <= 0:
         return None
+    if _ASYNC[0]:
+        _finish_pending(keep=MAX_DRAWING - 1)  # one picture at a time beside the tests
     pid = os.fork()
     if pid == 0:  # pragma: no cover - child
         code = 1
@@ -70,6 +170,10 @@ def _drawn_in_time(path, draw) -> str | None:
         finally:
             os._exit(code)
     deadline = time.monotonic() + limit
+    if _ASYNC[0]:  # a grading run: the picture is drawn while the next tests run (pictures_for_run waits)
+        _PENDING.append((pid, path, deadline))
+        _DRAWN[0] += 1
+        return _relpath(path)
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
         if done:
@@ -131,15 +235,18 @@ def mesh_picture(ctx: Context, Ve, Fe, Vg, Fg) -> str | None:
         b = _draw(Vg, Fg, wireframe=len(Fg) < 5000, size=size)
         c = _draw(Vg, Fg, colors=colors, size=size)
         bar = plot.colorbar(0.0, vmax, cmap="inferno", label="distance", height=size[1])
-        captions = ["expected", "submitted", f"distance to the nearest expected vertex (max {d.max():.3g})"]
+        captions = ["expected", "yours", f"difference: distance to the nearest expected vertex (max {d.max():.3g})"]
         img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
 
 
-def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel: np.ndarray) -> str | None:
-    """Expected and submitted images in [0, 1] with a per-pixel difference heat map."""
+def image_picture(
+    ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel: np.ndarray, *, unit: str = ""
+) -> str | None:
+    """Expected and submitted images in [0, 1] with a per-pixel difference heat map (``per_pixel``, in
+    ``unit`` when given: the unit the message uses)."""
     path = ctx.feedback_path()
     if path is None:
         return None
@@ -160,66 +267,215 @@ def image_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, per_pixel
             )
         vmax = max(float(per_pixel.max()), 1e-12)
         heat = plot.heatmap_image(per_pixel, cmap="inferno", vmin=0.0, vmax=vmax)
-        bar = plot.colorbar(0.0, vmax, cmap="inferno", label="|difference|", height=max(128, heat.shape[0]))
-        captions = ["expected", "submitted", "|difference| per pixel"]
+        label = f"|difference| ({unit})" if unit else "|difference|"
+        bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=max(128, heat.shape[0]))
+        captions = ["expected", "yours", f"difference: {label} per pixel"]
         img = plot.panels([to_rgb(expected), to_rgb(got), _beside(heat, bar)], captions, title=ctx.label)
         plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
 
 
-def highlight_picture(ctx: Context, V, F, points, caption: str, *, suffix: str = "") -> str | None:
-    """The input mesh with ``points`` ((k, 3) positions: the wrong vertices, edge midpoints, ...)
-    marked in red, for failures that are about rows of a matrix rather than a drawn result."""
+def _mesh_edges(F, limit: int = 6000) -> np.ndarray:
+    """The unique edges of triangles, quads or polygons (a list of index sequences), at most ``limit``
+    of them (an even sample of a larger mesh: the see-through outline is for orientation only)."""
+    if isinstance(F, np.ndarray) and F.ndim == 2:
+        E = np.stack([F, np.roll(F, -1, axis=1)], axis=2).reshape(-1, 2)
+    else:
+        E = np.array([(f[i], f[(i + 1) % len(f)]) for f in F for i in range(len(f))], dtype=np.int64).reshape(-1, 2)
+    E = np.unique(np.sort(E.astype(np.int64), axis=1), axis=0)
+    if len(E) > limit:
+        E = E[np.linspace(0, len(E) - 1, limit).astype(np.int64)]
+    return E
+
+
+def _error_cmap():
+    """inferno without its palest yellow: the largest errors stay visible on a white page."""
+    from matplotlib.colors import ListedColormap
+    from matplotlib.pyplot import get_cmap
+
+    return ListedColormap(get_cmap("inferno")(np.linspace(0.0, 0.82, 256)), name="inferno_dark")
+
+
+def _three_panel_figure(title: str, captions, *, three_d: bool, flat: bool = False):
+    """A matplotlib figure of three panels (expected | yours | difference) sharing one view."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(14.4, 4.6), dpi=80)
+    axes = []
+    for k, caption in enumerate(captions):
+        if three_d:
+            ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
+            ax.view_init(elev=90, azim=-90) if flat else ax.view_init(elev=24, azim=-58)
+            ax.set_axis_off()
+        else:
+            ax = fig.add_subplot(1, 3, k + 1)
+        ax.set_title(textwrap.fill(caption, 48), fontsize=10)
+        axes.append(ax)
+    fig.suptitle(title, fontsize=11)
+    return fig, plt, axes
+
+
+def _save(fig, plt, path) -> None:
+    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.04, top=0.86, wspace=0.04)
+    fig.savefig(path, bbox_inches="tight", pad_inches=0.15)
+    plt.close(fig)
+
+
+def _errors(e: np.ndarray, g: np.ndarray) -> np.ndarray:
+    """Per-row error ``|g - e|``; a row with NaN or inf where the other has a number counts as the
+    largest finite error (or 1); NaN where NaN is expected is no error."""
+    e, g = np.asarray(e, float), np.asarray(g, float)
+    with np.errstate(invalid="ignore"):
+        d = np.where((np.isnan(e) & np.isnan(g)) | (e == g), 0.0, np.abs(g - e)).reshape(len(e), -1)
+    err = np.sqrt(np.sum(np.where(np.isfinite(d), d, 0.0) ** 2, axis=1))
+    bad = ~np.isfinite(d).all(axis=1)
+    if bad.any():
+        err[bad] = float(err[~bad].max()) if (~bad).any() and err[~bad].max() > 0 else 1.0
+    return err
+
+
+def rows_picture(
+    ctx: Context, V, F, expected, got, caption: str, *, err=None, values=None, yours: str = "", suffix: str = ""
+) -> str | None:
+    """Wrong rows on a mesh, in three panels seen the same way: **expected** (where the rows should
+    be, blue), **yours** (where the submission puts them, orange) and **difference** (each wrong row
+    joined to where it should be, coloured by its error). The mesh is a see-through wireframe, so
+    markers inside a solid (edge points of an octahedron) stay visible.
+
+    Parameters
+    ----------
+    expected, got : (k, 3) array_like
+        Positions of the wrong rows, expected and submitted (equal for values that are not
+        positions: the vertex of each wrong row).
+    err : (k,) array_like, optional
+        The rows' errors (default ``|got - expected|``).
+    values : ((k,), (k,)), optional
+        Expected and submitted values per row, to colour the first two panels (one scale), when the
+        rows are not positions (``got`` then equals ``expected``).
+    caption, yours : str
+        Captions of the first two panels.
+    """
     path = ctx.feedback_path(suffix)
     if path is None:
         return None
 
-    def draw(V=V):  # the body rebinds V
-        from geomlib import plot
+    def draw():
+        from matplotlib.collections import LineCollection  # noqa: F401 - matplotlib is imported in the child
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-        V = np.asarray(V, float)
-        P = np.asarray(points, float).reshape(-1, 3)
-        # Marked points are drawn by index: append them as extra (unreferenced) vertices.
-        W = np.vstack([V, P])
-        idx = np.arange(len(V), len(W))
-        size = (480, 400)
-        # A flat mesh is best seen from above; on a closed one, marks on the far side show from behind.
-        # Zoomed out a little: a mark on the outline is not cut in half by the frame.
-        extent = np.ptp(V, axis=0) if len(V) else np.zeros(3)
-        second = (
-            ("top", "seen from above")
-            if extent[2] <= 1e-6 * max(extent.max(), 1e-12)
-            else ("three_quarter_back", "seen from behind")
-        )
-        views = [
-            _draw(
-                W, F, wireframe=len(F) < 5000, highlight_points=idx, point_radius=5.0, size=size, camera=cam, zoom=0.92
-            )
-            for cam in ("three_quarter", second[0])
+        W = np.asarray(V, float)
+        P = np.asarray(expected, float).reshape(-1, 3)
+        G = np.asarray(got, float).reshape(-1, 3)
+        e = _errors(P, G) if err is None else np.asarray(err, float).ravel()
+        e = np.where(np.isfinite(e), e, float(np.nanmax(np.where(np.isfinite(e), e, 0.0))) or 1.0)
+        ok = np.isfinite(G).all(axis=1)
+        extent = np.ptp(W, axis=0) if len(W) else np.ones(3)
+        flat = bool(extent[2] <= 1e-6 * max(extent.max(), 1e-12))
+        E = _mesh_edges(F)
+        lo, hi = W.min(axis=0), W.max(axis=0)
+        span = max(float((hi - lo).max()), 1e-12)
+        # far-off submitted rows are clipped to a box a little larger than the mesh
+        box_lo, box_hi = lo - 0.25 * span, hi + 0.25 * span
+        Gc = np.clip(np.where(ok[:, None], G, P), box_lo, box_hi)
+        vmax = max(float(e.max()) if len(e) else 0.0, 1e-12)
+        n = len(P)
+        captions = [
+            caption,
+            yours or ("yours" if values is None else "yours (colour: your value)"),
+            f"difference: |error| per row (max {vmax:.3g})",
         ]
-        img = plot.panels(views, [caption, second[1]], title=ctx.label)
-        plot.save_png(path, img)
+        fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=True, flat=flat)
+        size = 60 if n <= 50 else 16 if n <= 500 else 6
+        if values is not None:
+            ve, vg = (np.asarray(x, float).ravel() for x in values)
+            both = np.concatenate([ve[np.isfinite(ve)], vg[np.isfinite(vg)]]) if n else np.zeros(1)
+            vlo, vhi = (float(both.min()), float(both.max())) if both.size else (0.0, 1.0)
+        for k, ax in enumerate(axes):
+            ax.add_collection3d(Line3DCollection(W[E], colors="0.35", linewidths=0.5, alpha=0.4, zorder=1))
+            if k == 0:
+                colour = {"c": "#1f77b4"} if values is None else {"c": ve, "cmap": "viridis", "vmin": vlo, "vmax": vhi}
+                ax.scatter(*P.T, s=size, depthshade=False, zorder=3, edgecolors="white", linewidths=0.4, **colour)
+            elif k == 1:
+                if values is None:
+                    ax.scatter(*Gc[ok].T, s=size * 1.3, c="#ff7f0e", marker="X", depthshade=False, zorder=3,
+                               edgecolors="black", linewidths=0.3)  # fmt: skip
+                else:
+                    sc = ax.scatter(*P.T, s=size, c=np.nan_to_num(vg, nan=vhi), cmap="viridis", vmin=vlo, vmax=vhi,
+                                    depthshade=False, zorder=3, edgecolors="white", linewidths=0.4)  # fmt: skip
+                    fig.colorbar(sc, ax=ax, shrink=0.6, pad=0.0, label="value (expected | yours)")
+            else:
+                if values is None:
+                    seg = Line3DCollection(np.stack([P, Gc], axis=1), cmap=_error_cmap(), linewidths=1.6, zorder=2)
+                    seg.set_array(e)
+                    seg.set_clim(0.0, vmax)
+                    ax.add_collection3d(seg)
+                hs = ax.scatter(*P.T, s=size, c=e, cmap=_error_cmap(), vmin=0.0, vmax=vmax, depthshade=False, zorder=3,
+                                edgecolors="0.5", linewidths=0.3)  # fmt: skip
+                fig.colorbar(hs, ax=ax, shrink=0.6, pad=0.0, label="|error|")
+            ax.set_xlim(box_lo[0], box_hi[0])
+            ax.set_ylim(box_lo[1], box_hi[1])
+            ax.set_zlim(box_lo[2], box_hi[2])
+            ax.set_box_aspect(np.maximum(box_hi - box_lo, 0.05 * span), zoom=1.35)
+        _save(fig, plt, path)
 
     return _drawn_in_time(path, draw)
 
 
-def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -> str | None:
-    """The mesh coloured by a per-vertex error, with its colour bar beside it (two views)."""
+def highlight_picture(ctx: Context, V, F, points, caption: str, *, got=None, suffix: str = "") -> str | None:
+    """The mesh with ``points`` ((k, 3): where wrong vertices, edge points... should be) marked:
+    expected | yours | difference (:func:`rows_picture`). ``got`` ((k, 3)): where the submission has
+    them; without it, each point's nearest vertex of ``V`` (the submitted mesh's closest offer)."""
+    P = np.asarray(points, float).reshape(-1, 3)
+    yours = "yours"
+    if got is None:
+        Vf = np.asarray(V, float)
+        yours = "the nearest vertex of the mesh to each"
+        if len(Vf) and len(P):
+            from scipy.spatial import cKDTree
+
+            got = Vf[cKDTree(Vf).query(P)[1]]
+        else:
+            got = P
+    return rows_picture(ctx, V, F, P, got, caption, yours=yours, suffix=suffix)
+
+
+def heat_on_mesh_picture(ctx: Context, V, F, expected, got, err, caption: str, label: str) -> str | None:
+    """Per-vertex values on the mesh, three renders from one camera: expected and submitted values
+    (one colour scale; rows of several numbers by their length) and the per-vertex error, each with
+    its colour bar."""
     path = ctx.feedback_path()
     if path is None:
         return None
 
-    def draw(values=values):  # the body rebinds values
+    def draw():
         from geomlib import plot
 
-        values = np.asarray(values, float)
-        vmax = max(float(np.nanmax(values)), 1e-12)
-        colors = plot.heat_colors(np.nan_to_num(values, nan=vmax), vmin=0.0, vmax=vmax)
-        size = (440, 380)
-        views = [_draw(V, F, colors=colors, size=size, camera=cam) for cam in ("three_quarter", "top")]
-        bar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
-        img = plot.panels([views[0], _beside(views[1], bar)], [caption, "seen from above"], title=ctx.label)
+        def size_of(x):
+            x = np.asarray(x, float).reshape(len(V), -1)
+            return np.linalg.norm(x, axis=1) if x.shape[1] > 1 else x[:, 0]
+
+        ve, vg = size_of(expected), size_of(got)
+        fin = np.concatenate([ve[np.isfinite(ve)], vg[np.isfinite(vg)]])
+        lo, hi = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+        hi = hi if hi > lo else lo + 1e-12
+        e = np.asarray(err, float)
+        vmax = max(float(np.nanmax(e)) if np.isfinite(e).any() else 1.0, 1e-12)
+        size = (400, 340)
+        flat = np.ptp(np.asarray(V, float), axis=0)
+        cam = "top" if flat[2] <= 1e-6 * max(flat.max(), 1e-12) else "three_quarter"
+        a = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(ve, nan=hi), vmin=lo, vmax=hi, cmap="viridis"),
+                  size=size, camera=cam)  # fmt: skip
+        b = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(vg, nan=hi), vmin=lo, vmax=hi, cmap="viridis"),
+                  size=size, camera=cam)  # fmt: skip
+        c = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(e, nan=vmax), vmin=0.0, vmax=vmax), size=size, camera=cam)
+        vbar = plot.colorbar(lo, hi, cmap="viridis", label="value", height=size[1])
+        ebar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
+        captions = ["expected", "yours", f"difference: {caption}"]
+        img = plot.panels([a, _beside(b, vbar), _beside(c, ebar)], captions, title=ctx.label)
         plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
@@ -227,45 +483,48 @@ def heat_on_mesh_picture(ctx: Context, V, F, values, caption: str, label: str) -
 
 def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: str) -> str | None:
     """Expected and submitted ``(n, 2)`` or ``(n, 3)`` points with no mesh to draw them on (e.g. light-space
-    ``(u, v, z)``), seen from above: the first two coordinates, each wrong row joined to where it should be,
-    coloured by its error."""
+    ``(u, v, z)``), seen from above (the first two coordinates) in three panels: expected | yours |
+    difference (each wrong row joined to where it should be, coloured by its error)."""
     path = ctx.feedback_path()
     if path is None:
         return None
 
     def draw():
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
         from matplotlib.collections import LineCollection
 
         e, g = np.asarray(expected, float), np.asarray(got, float)
-        err = np.linalg.norm(np.nan_to_num(g - e, nan=np.inf, posinf=np.inf, neginf=np.inf), axis=1)
+        err = _errors(e, g)
         bad = ~(err <= 1e-8)
-        fig, ax = plt.subplots(figsize=(6.4, 5.6), dpi=100)
-        ax.scatter(e[:, 0], e[:, 1], s=10, c="#1f77b4", label="expected", zorder=2)
         gf = np.isfinite(g[:, :2]).all(axis=1)
-        ax.scatter(g[gf, 0], g[gf, 1], s=14, c="#d62728", marker="x", label="submitted", zorder=3)
+        captions = [
+            f"expected {name}",
+            f"yours ({int(bad.sum())} of {len(e)} rows wrong)",
+            f"difference: |{name} error| (max {err.max():.3g})",
+        ]
+        fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=False)
+        pts = np.vstack([e[:, :2], g[gf, :2]])
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        lo, hi = (pts.min(axis=0), pts.max(axis=0)) if len(pts) else (np.zeros(2), np.ones(2))
+        pad = 0.05 * max(float((hi - lo).max()), 1e-12)
+        vmax = max(float(err.max()), 1e-12)
+        axes[0].scatter(e[:, 0], e[:, 1], s=10, c="#1f77b4", zorder=2)
+        axes[1].scatter(g[gf, 0], g[gf, 1], s=14, c="#ff7f0e", marker="x", zorder=3)
         both = bad & gf
+        axes[2].scatter(e[~bad, 0], e[~bad, 1], s=6, c="0.75", zorder=1)
         if both.any():
-            shown = np.where(np.isfinite(err[both]), err[both], np.nan)
-            vmax = max(float(np.nanmax(shown)) if np.isfinite(shown).any() else 1.0, 1e-12)
-            lines = LineCollection(
-                np.stack([e[both, :2], g[both, :2]], axis=1), cmap="inferno", linewidths=1.5, zorder=1
-            )
-            lines.set_array(np.nan_to_num(shown, nan=vmax))
+            lines = LineCollection(np.stack([e[both, :2], g[both, :2]], axis=1), cmap=_error_cmap(), linewidths=1.5)
+            lines.set_array(err[both])
             lines.set_clim(0.0, vmax)
-            ax.add_collection(lines)
-            fig.colorbar(lines, ax=ax, label=f"|{name} error|")
-        ax.set_xlabel(f"{name}[:, 0]")
-        ax.set_ylabel(f"{name}[:, 1]")
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.legend(loc="best", fontsize=8)
-        ax.set_title(f"{ctx.label}\n{int(bad.sum())} of {len(e)} rows of {name} wrong", fontsize=9)
-        fig.tight_layout()
-        fig.savefig(path)
-        plt.close(fig)
+            axes[2].add_collection(lines)
+        hs = axes[2].scatter(e[bad, 0], e[bad, 1], s=12, c=err[bad], cmap=_error_cmap(), vmin=0.0, vmax=vmax, zorder=3)
+        fig.colorbar(hs, ax=axes[2], shrink=0.8, label=f"|{name} error|")
+        for ax in axes:
+            ax.set_xlim(lo[0] - pad, hi[0] + pad)
+            ax.set_ylim(lo[1] - pad, hi[1] + pad)
+            ax.set_aspect("equal", adjustable="box")
+            ax.set_xlabel(f"{name}[:, 0]")
+            ax.set_ylabel(f"{name}[:, 1]")
+        _save(fig, plt, path)
 
     return _drawn_in_time(path, draw)
 
@@ -275,16 +534,21 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
 # hand-written graded tests (expect_close, a lab's own comparisons through failure_picture).
 
 
-def default_picture(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: float = 1e-8, rtol: float = 0.0):
+def default_picture(
+    ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: float = 1e-8, rtol: float = 0.0, unit: str = ""
+):
     """A picture for a wrong array: rows on the input mesh, or a grid output as an image, or free points.
 
     ``inputs`` holds the mesh, if any, as ``V`` and ``F`` (or ``faces``, ``Q``); ``expected`` and
     ``got`` map output names to arrays. A row is wrong where it differs by more than
-    ``atol + rtol * |expected|``. Returns the picture's path, or None when none fits.
+    ``atol + rtol * |expected|``; ``unit`` names the unit of the values (a grid's difference heat
+    map says it). Returns the picture's path, or None when none fits.
     """
+    if ctx.feedback_dir is None or not picture_wanted():
+        return None
     return (
         rows_on_mesh(ctx, inputs, expected, got, atol=atol, rtol=rtol)
-        or grid_image(ctx, expected, got)
+        or grid_image(ctx, expected, got, unit=unit)
         or free_points(ctx, inputs, expected, got, atol=atol, rtol=rtol)
     )
 
@@ -312,7 +576,7 @@ def free_points(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: 
     return None
 
 
-def grid_image(ctx: Context, expected: dict, got: dict):
+def grid_image(ctx: Context, expected: dict, got: dict, *, unit: str = ""):
     """Expected and submitted (h, w, c) grids (displacements, positions, maps) as images, with the
     per-texel error as a heat map; channels are scaled by the expected values' range."""
     for name, e in expected.items():
@@ -350,8 +614,18 @@ def grid_image(ctx: Context, expected: dict, got: dict):
         def up(x, k=k):
             return np.repeat(np.repeat(x, k, axis=0), k, axis=1)
 
-        return image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))))
+        return image_picture(ctx, up(show(e3)), up(show(g3)), up(np.nan_to_num(err, nan=float(span.max()))), unit=unit)
     return None
+
+
+def _positions_like(e: np.ndarray, V: np.ndarray) -> bool:
+    """Whether per-vertex ``(n, 3)`` rows look like positions near the mesh (moved vertices), not
+    directions (unit normals) or other vectors: within the mesh's box grown by its size."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    span = max(float((hi - lo).max()), 1e-12)
+    fin = e[np.isfinite(e).all(axis=1)]
+    unit = len(fin) and np.allclose(np.linalg.norm(fin, axis=1), 1.0, atol=1e-6)
+    return bool(len(fin)) and not unit and bool(((fin >= lo - span) & (fin <= hi + span)).all())
 
 
 def rows_on_mesh(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol: float = 1e-8, rtol: float = 0.0):
@@ -380,17 +654,24 @@ def rows_on_mesh(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol:
         bad = ~np.isclose(g, e, rtol=rtol, atol=atol).reshape(len(e), -1).all(axis=1)
         if not bad.any():
             continue
+        err = _errors(e, g)
         if per_vertex and bad.sum() > 20:
-            err = np.linalg.norm(np.nan_to_num(g - e, nan=np.inf).reshape(len(e), -1), axis=1)
-            err[~np.isfinite(err)] = np.nan
             return heat_on_mesh_picture(
-                ctx, V, F, err, f"{int(bad.sum())} of {len(e)} rows of {name} wrong", f"|{name} error|"
+                ctx, V, F, e, g, err, f"{int(bad.sum())} of {len(e)} rows of {name} wrong", f"|{name} error|"
             )
-        if per_vertex:
-            points, what = V[bad], f"{count(int(bad.sum()), 'vertex', 'vertices')} where {name} is wrong"
-        else:
-            points, what = e[bad], f"where the {count(int(bad.sum()), 'wrong row', 'wrong rows')} of {name} should be"
-        return highlight_picture(ctx, V, F, points, what)
+        if e.ndim == 2 and e.shape[1] == 3 and (not per_vertex or _positions_like(e, V)):
+            # points (odd vertices, edge points, moved vertices): where they should be and where they are
+            what = f"expected: where the {count(int(bad.sum()), 'wrong row', 'wrong rows')} of {name} should be"
+            return rows_picture(
+                ctx, V, F, e[bad], g[bad], what, err=err[bad], yours=f"yours: where your {name} puts them"
+            )
+        what = f"expected: {count(int(bad.sum()), 'vertex', 'vertices')} where {name} is wrong (colour: value)"
+        size = (
+            np.linalg.norm(e.reshape(len(e), -1), axis=1),
+            np.linalg.norm(np.nan_to_num(g).reshape(len(g), -1), axis=1),
+        )
+        values = (size[0][bad], size[1][bad])
+        return rows_picture(ctx, V, F, V[bad], V[bad], what, err=err[bad], values=values)
     return None
 
 
@@ -433,7 +714,9 @@ def picture_context(label: str, name: str = "output") -> Context | None:
     return Context(label=label, lab=_TEST["lab"], case_id=case_id, feedback_dir=_TEST["dir"])
 
 
-def failure_picture(label: str, got, expected, *, name: str = "output", mesh=None, atol: float = 1e-8, rtol=0.0):
+def failure_picture(
+    label: str, got, expected, *, name: str = "output", mesh=None, atol: float = 1e-8, rtol=0.0, unit: str = ""
+):
     """The feedback picture of a failed comparison in a hand-written graded test, or None.
 
     Parameters
@@ -449,6 +732,9 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
         grids and images are drawn as images, ``(n, 2)`` and ``(n, 3)`` arrays as points.
     atol, rtol : float
         The comparison's tolerance: rows within it are not marked.
+    unit : str
+        The unit of the values as the message gives them (``"texels"``): pass the values in it, and
+        the picture's difference is labelled with it, so text and picture agree.
     """
     ctx = picture_context(label, name)
     if ctx is None:
@@ -467,7 +753,7 @@ def failure_picture(label: str, got, expected, *, name: str = "output", mesh=Non
                 e, g = full_e, full_g
         if mesh is not None and e.shape == (3,) and len(mesh[0]) != 3 and g is not None and g.shape == (3,):
             e, g = e[None], g[None]  # one point (a vertex, an edge point): marked where it should be
-        return default_picture(ctx, inputs, {name: e}, {name: g}, atol=max(atol, 1e-12), rtol=rtol)
+        return default_picture(ctx, inputs, {name: e}, {name: g}, atol=max(atol, 1e-12), rtol=rtol, unit=unit)
     except Exception:  # noqa: BLE001 - a picture is a help: the message stands alone
         return None
 

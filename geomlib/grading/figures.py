@@ -1,7 +1,7 @@
 """The main job: regenerate every figure from the reference solutions, with an index page.
 
 ``geomlib figures`` renders the gallery of built-in datasets and, for every lab that has a
-``solutions/<lab>/figures.py``, calls its ``make_figures(out_dir, lab=None, quick=False)`` (one
+``solutions/<lab>/figures.py`` (in a student bundle, without solutions: ``labs/<lab>/figures.py``), calls its ``make_figures(out_dir, lab=None, quick=False)`` (one
 signature in every lab, checked by ``tests/test_lab_contracts.py``); then writes ``index.html``
 and ``index.md`` showing every figure with its caption, and each lab's interactive 3D view
 (``make_view``: ``<lab>_3d.html``, see :mod:`geomlib.viewer`) in a frame.
@@ -19,11 +19,16 @@ from geomlib.grading.impl import course_root
 __all__ = ["lab_figure_modules", "build_all"]
 
 
+def _figures_impl() -> str:
+    """Whose ``figures.py`` draws: the reference solutions', or in a student bundle (no solutions)
+    the student's ``labs/<lab>/figures.py``, which draws what is implemented and labels the rest."""
+    return "solutions" if (course_root() / "solutions").is_dir() else "labs"
+
+
 def lab_figure_modules() -> list[str]:
-    """Labs whose reference solution has a ``figures.py``, in course order."""
+    """Labs with a ``figures.py`` (the solutions', else the stubs'), in course order."""
     order = ["subdivision", "simplification", "remeshing", "maps", "denoise", "shadows", "vdm", "sdf", "relief"]
-    sol = course_root() / "solutions"
-    names = [p.parent.name for p in sol.glob("*/figures.py")] if sol.is_dir() else []
+    names = [p.parent.name for p in (course_root() / _figures_impl()).glob("*/figures.py")]
     return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
 
 
@@ -45,9 +50,10 @@ def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, 
         if name == "gallery":
             figs = gallery.build_gallery(out / "gallery", quick=quick)
         else:
-            if not (course_root() / "solutions" / name / "figures.py").is_file():
-                raise FileNotFoundError(f"no figures for lab {name!r} (expected solutions/{name}/figures.py)")
-            mod = importlib.import_module(f"solutions.{name}.figures")
+            impl = _figures_impl()
+            if not (course_root() / impl / name / "figures.py").is_file():
+                raise FileNotFoundError(f"no figures for lab {name!r} (expected {impl}/{name}/figures.py)")
+            mod = importlib.import_module(f"{impl}.{name}.figures")
             figs = mod.make_figures(out / name, quick=quick)
             if hasattr(mod, "make_view"):  # the lab's interactive 3D page, framed in the index
                 figs = [*figs, mod.make_view(out / name, quick=quick)]

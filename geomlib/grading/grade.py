@@ -95,6 +95,7 @@ def grade(
     extra_args: list[str] | None = None,
     task: int | None = None,
     part: str | None = None,
+    pictures: str | None = None,
 ) -> dict:
     """Grade ``impl`` (``solutions``, ``labs`` or a submission path) on ``labs`` (default: all).
 
@@ -106,6 +107,9 @@ def grade(
         Only the graded tests of this part (``"boundary rules"``), as in the score table.
     verbose : bool
         Show pytest's own output as well.
+    pictures : {"first", "all", "none"}, optional
+        Feedback pictures to draw: the first failure's (default; a picture costs about a second),
+        every failure's, or none (see :class:`geomlib.grading.feedback.pictures_for_run`).
 
     Returns
     -------
@@ -145,15 +149,23 @@ def grade(
     args += extra_args or []
     os.environ.setdefault("GEOMLIB_IMPL", str(impl))
     selection = _Selection(task=task, part=part)
+    _start_sandbox_early()
     t0 = time.time()
     captured = io.StringIO()
-    if verbose:
-        code = pytest.main(args, plugins=[selection])
-    else:
-        with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+    from geomlib.grading import feedback
+
+    with feedback.pictures_for_run(pictures) as drawn:
+        if verbose:
             code = pytest.main(args, plugins=[selection])
+        else:
+            with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
+                code = pytest.main(args, plugins=[selection])
     elapsed = time.time() - t0
     records = list(plugin.RECORDS)
+    for r in records if drawn.failed else ():  # pictures named in a message but not drawn after all
+        r.message = feedback.without_pictures(r.message, drawn.failed)
+        if r.picture and feedback._relpath(r.picture) in drawn.failed:
+            r.picture = None
     if task is None and part is None:
         _remove_stale_pictures(feedback_dir, {r.lab for r in records}, before=t0)
     note = ""
@@ -173,7 +185,36 @@ def grade(
     data["report"] = report_lines(
         records, feedback_dir=feedback_dir, note=note, tasks=selection.tasks, whole=task is None and part is None
     )
+    if drawn.held and feedback_dir:
+        data["report"] += [
+            "Pictures of the other failures (about a second each): add --pictures all "
+            '(in a notebook: check(..., pictures="all")).'
+        ]
     return data
+
+
+def _start_sandbox_early() -> None:
+    """Start the sandbox's zygote (an interpreter importing NumPy, SciPy, libigl: about a second) in
+    the background, so that it starts while pytest starts and collects, not after: a student's
+    ``--task N`` waits for the longer of the two, not their sum. Later runs in this process (a
+    notebook's ``check``) reuse it."""
+    import threading
+
+    from geomlib.grading import sandbox
+
+    if any(t.name == "geomlib-zygote-start" for t in threading.enumerate()):
+        return  # started by an earlier run in this process (and restarted by the sandbox if it died)
+
+    def start():
+        try:
+            sandbox._zygote()
+        except Exception:  # noqa: BLE001 - the first test starts it again and reports the problem
+            return
+        # The zygote asks for SIGTERM when its parent *thread* ends (PR_SET_PDEATHSIG follows the
+        # thread that started it), so this thread stays, parked, for the life of the process.
+        threading.Event().wait()
+
+    threading.Thread(target=start, name="geomlib-zygote-start", daemon=True).start()
 
 
 def _remove_stale_pictures(feedback_dir, labs, *, before: float) -> None:
@@ -376,6 +417,7 @@ def check(
     *,
     impl: str | None = None,
     feedback_dir: str | Path = "feedback",
+    pictures: str | None = None,
 ) -> Report:
     """Grade one lab (optionally one task or part) and return the report's lines.
 
@@ -384,11 +426,13 @@ def check(
         from geomlib.grading import check
         check("subdivision", task=2)
 
+    ``pictures="all"`` draws a feedback picture for every failure, not only the first.
+
     Returns
     -------
     Report
         A list of the report's lines (it prints as the report); ``.score`` and ``.results`` hold
         the numbers.
     """
-    data = grade(impl, [lab], feedback_dir=feedback_dir, task=task, part=part)
+    data = grade(impl, [lab], feedback_dir=feedback_dir, task=task, part=part, pictures=pictures)
     return Report(data.pop("report"), data)

@@ -143,8 +143,19 @@ def _forbidden() -> list[Path]:
     return [root / "tests", root / "solutions", root / ".git", *extra]
 
 
+#: :func:`_readable_paths` by what it depends on (it resolves dozens of paths: once, not per call).
+_READABLE: dict = {}
+
+
 def _readable_paths() -> list[str]:
     """What a Landlock-confined worker may read: Python, the libraries, geomlib, system folders."""
+    key = (tuple(sys.path), os.environ.get("GEOMLIB_SANDBOX_HIDE", ""), str(_course_root()))
+    if key not in _READABLE:
+        _READABLE[key] = _find_readable_paths()
+    return list(_READABLE[key])
+
+
+def _find_readable_paths() -> list[str]:
     cands = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix}
     cands |= {p for k, p in sysconfig.get_paths().items() if k in ("stdlib", "platstdlib", "purelib", "platlib")}
     cands |= {p for p in sys.path if p and os.path.isdir(p)}

@@ -20,6 +20,7 @@ place to mark (valences, Euler characteristic, "about half the faces").
 
 from __future__ import annotations
 
+import importlib
 import os
 import re
 import shutil
@@ -272,3 +273,198 @@ def test_expect_close_outside_a_graded_test_still_fails_with_its_message():
     with pytest.raises(Mismatch) as e:
         expect_close("moved vertices", V + [0, 0, 0.5], V, name="V", mesh=(V, [[0, 1, 2]]))
     assert e.value.feedback is None and "V[0] expected (0, 0, 0), got (0, 0, 0.5)" in str(e.value)
+
+
+# ------------------------------------------------------------------------------ every kind: expected | yours | difference
+
+
+def _capture_panels(monkeypatch):
+    """Record the panels each picture kind draws, in the drawing process (pictures are drawn inline)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.figure
+    import matplotlib.pyplot as plt
+
+    from geomlib import plot
+
+    drawn = []
+    monkeypatch.setattr(feedback, "_drawn_in_time", lambda path, draw: (draw(), str(path))[1])
+    real_panels, real_save = plot.panels, matplotlib.figure.Figure.savefig
+
+    def panels(images, captions=None, *a, **k):
+        drawn.append(("images", [plot.to_rgb8(i) for i in images], list(captions or [])))
+        return real_panels(images, captions, *a, **k)
+
+    def savefig(fig, *a, **k):
+        fig.canvas.draw()
+        axes = [ax for ax in fig.axes if ax.get_title()]  # the three panels (colour bars have no title)
+        crops = []
+        for ax in axes:
+            box = ax.get_window_extent()
+            rgb = np.array(fig.canvas.buffer_rgba())[..., :3]  # a copy: saving draws again
+            h = rgb.shape[0]
+            crops.append(rgb[int(h - box.y1) : int(h - box.y0), int(box.x0) : int(box.x1)])
+        drawn.append(("axes", crops, [ax.get_title() for ax in axes]))
+        return real_save(fig, *a, **k)
+
+    monkeypatch.setattr(plot, "panels", panels)
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", savefig)
+    return drawn, plt
+
+
+OCTA_V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+OCTA_F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+
+
+def _kinds():
+    """One wrong output of each picture kind: (name, inputs, expected, got)."""
+    rng = np.random.default_rng(1)
+    E = np.array(sorted({tuple(sorted((f[i], f[(i + 1) % 3]))) for f in OCTA_F.tolist() for i in range(3)}))
+    odd = (OCTA_V[E[:, 0]] + OCTA_V[E[:, 1]]) * 0.375  # points inside the octahedron (its odd vertices, 3/8)
+    sphere_V = rng.normal(size=(60, 3))
+    sphere_V /= np.linalg.norm(sphere_V, axis=1, keepdims=True)
+    from scipy.spatial import ConvexHull
+
+    sphere_F = ConvexHull(sphere_V).simplices
+    values = np.linalg.norm(sphere_V - [1, 0, 0], axis=1)
+    grid = rng.random((16, 16, 3))
+    points = rng.random((40, 3))
+    return [
+        ("rows inside a solid", {"V": OCTA_V, "F": OCTA_F}, {"odd": odd}, {"odd": odd * 0.8}),
+        ("few per-vertex values", {"V": OCTA_V, "F": OCTA_F}, {"w": np.arange(6.0)}, {"w": np.arange(6.0) + [0, 0, 2, 0, 0, 0]}),
+        ("many per-vertex values", {"V": sphere_V, "F": sphere_F}, {"w": values}, {"w": values * 1.5}),
+        ("a grid", {}, {"map": grid}, {"map": np.where(grid > 0.5, grid, 0.0)}),
+        ("free points", {}, {"uvz": points}, {"uvz": points + [0.1, 0, 0]}),
+    ]  # fmt: skip
+
+
+@pytest.mark.render
+@pytest.mark.parametrize("kind", [k[0] for k in _kinds()])
+def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, monkeypatch):
+    """docs/students.md promises "expected / yours / difference": every kind of picture has those three
+    panels, and the expected and yours panels differ where the data differ (markers inside a solid
+    are drawn, not hidden by it)."""
+    from geomlib.grading.checks import Context
+
+    name, inputs, expected, got = next(k for k in _kinds() if k[0] == kind)
+    drawn, _ = _capture_panels(monkeypatch)
+    ctx = Context(label=kind, lab="kinds", case_id=_file(kind), feedback_dir=tmp_path)
+    path = feedback.default_picture(ctx, inputs, expected, got)
+    assert path and Path(path).is_file(), f"{kind}: no picture"
+    (what, panels, captions), *_ = drawn
+    assert len(panels) == 3, f"{kind}: {len(panels)} panels ({captions})"
+    assert captions[0].startswith("expected") and captions[1].startswith("yours"), captions
+    assert "difference" in captions[2] or "distance" in captions[2], captions
+    a, b = panels[0], panels[1]
+    h, w = min(a.shape[0], b.shape[0]), min(a.shape[1], b.shape[1])
+    differ = np.abs(a[:h, :w].astype(int) - b[:h, :w].astype(int)).max(axis=2) > 40
+    assert differ.sum() > 30, f"{kind}: the expected and yours panels look the same ({int(differ.sum())} pixels differ)"
+    not_white = (a[:h, :w] < 200).any(axis=2)
+    assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
+
+
+def _file(text: str) -> str:
+    return re.sub(r"\W+", "_", text)
+
+
+@pytest.mark.render
+def test_a_wrong_shader_picture_is_in_the_unit_of_its_message(tmp_path, monkeypatch):
+    """relief's GLSL comparison says "differs by 6.4 texels": the picture's difference heat map is in
+    texels too (it was in uv units, 1/s of the text's numbers)."""
+    relief = importlib.import_module("graded.relief.test_relief")
+    seen = {}
+    real = feedback.image_picture
+
+    def image_picture(ctx, expected, got, per_pixel, **k):
+        seen.update(max=float(per_pixel.max()), **k)
+        return real(ctx, expected, got, per_pixel, **k)
+
+    monkeypatch.setattr(feedback, "image_picture", image_picture)
+    monkeypatch.setattr(feedback, "_drawn_in_time", lambda path, draw: (draw(), str(path))[1])
+    s = 64
+    t = (np.arange(s) + 0.5) / s
+    uv = np.stack(np.meshgrid(t, t), axis=-1)
+    wrong = uv - 2 * (uv - 0.5) * 0.2  # a wrong-sign offset: 0.2 * 2 * |uv - 0.5| off, up to ~0.2 uv
+    feedback.begin_test(tmp_path, "relief", "test_glsl_parallax")
+    try:
+        with pytest.raises(Mismatch) as e:
+            relief.expect_glsl_matches("parallax", wrong, uv, atol=0.05, unit=" texels", scale_to=s)
+    finally:
+        feedback.end_test()
+    said = float(re.search(r"differs from the NumPy reference by ([\d.]+) texels", str(e.value)).group(1))
+    assert e.value.feedback and seen, "no picture"
+    assert seen.get("unit") == "texels", seen
+    worst = np.abs(wrong - uv).max() * s
+    assert abs(seen["max"] - worst) < 1e-6 * s and said <= worst + 1e-3, (seen, said, worst)
+
+
+# ------------------------------------------------------------------------------ which pictures a run draws, and when
+
+
+def _image_ctx(tmp_path, case_id):
+    from geomlib.grading.checks import Context
+
+    return Context(label=case_id, lab="run", case_id=case_id, feedback_dir=tmp_path)
+
+
+def test_a_run_draws_the_first_failures_picture_unless_asked_for_all(tmp_path, monkeypatch):
+    """A student fixing one task gets one picture (a picture costs about a second): the first
+    failure's; ``pictures="all"`` draws every one. Each run counts from zero (a notebook's kernel
+    grades many times)."""
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES", raising=False)
+    a, b = np.zeros((8, 8)), np.eye(8)
+    for mode, drawn in (("first", 1), ("first", 1), ("all", 3), ("none", 0)):
+        out = tmp_path / mode
+        with feedback.pictures_for_run(mode) as run:
+            paths = [feedback.image_picture(_image_ctx(out, f"case{i}"), a, b, np.abs(a - b)) for i in range(3)]
+        assert sum(p is not None for p in paths) == drawn, (mode, paths)
+        assert all(Path(p).is_file() for p in paths if p), "a run ends when its pictures are drawn"
+        assert run.held == 3 - drawn and not run.failed, (mode, run.held, run.failed)
+    with pytest.raises(ValueError, match="pictures='some'"):
+        feedback.pictures_for_run("some")
+
+
+def test_a_picture_that_fails_while_the_tests_go_on_leaves_no_dangling_path(tmp_path, monkeypatch):
+    """Pictures are drawn in a child while the next tests run; one that fails (or runs out of time) is
+    taken out of the messages that named it."""
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    path = _image_ctx(tmp_path, "broken").feedback_path()
+
+    def draw():
+        raise RuntimeError("no OpenGL here")
+
+    with feedback.pictures_for_run("all") as run:
+        named = feedback._drawn_in_time(path, draw)
+        assert named  # named at once: the child is still drawing
+    assert run.failed == {named} and not path.exists()
+    msg = f"S_odd row 0 differs (see {named})"
+    assert feedback.without_pictures(msg, run.failed) == "S_odd row 0 differs"
+
+
+@pytest.mark.render
+def test_grade_task_draws_one_picture_and_says_how_to_get_the_others(tmp_path):
+    """``geomlib grade --task 1`` with a wrong Task 1 (odd weight 3/8 -> 0.3): five failures, one
+    picture (the first failure's, named in its message), and the report says ``--pictures all``."""
+    from .course import planted_solution, run_geomlib
+
+    def edit(dest):
+        p = dest / "loop.py"
+        text = p.read_text()
+        p.write_text(text.replace("np.tile([3 / 8, 3 / 8, 1 / 8, 1 / 8]", "np.tile([0.3, 0.3, 1 / 8, 1 / 8]"))
+
+    lab = planted_solution("subdivision", edit)
+    try:
+        env = {"GEOMLIB_NO_FEEDBACK_PICTURES": "", "GEOMLIB_MAX_FEEDBACK_PICTURES": ""}
+        p = run_geomlib(course_root(), "grade", "--impl", str(lab.parent), "--lab", "subdivision", "--task", "1",
+                        "--feedback", str(tmp_path), cwd=tmp_path, env=env)  # fmt: skip
+    finally:
+        shutil.rmtree(lab.parent, ignore_errors=True)
+    out = p.stdout
+    assert re.search(r"What to fix \([2-9] failing tests\)", out), out
+    named = [ln.strip() for ln in out.splitlines() if ln.strip().endswith(".png")]
+    assert "Feedback pictures (1)" in out and len(named) == 1 and (tmp_path / named[0]).is_file(), out
+    assert sorted(x.name for x in (tmp_path / "subdivision").glob("*.png")) == [Path(named[0]).name]
+    assert f"(see {named[0]})" in " ".join(out.split()), "the picture is named in its failure's message"
+    assert "--pictures all" in out and 'pictures="all"' in out, out

@@ -40,7 +40,8 @@ def expect_glsl_matches(label: str, got, expected, *, atol: float, unit: str = "
             f"{label}: pixel [{r}, {c}] differs from the NumPy reference by {per[r, c]:.3g}{unit}; "
             f"{int(bad.sum())} of {bad.size} pixels differ by more than {atol:g}{unit} "
             f"(at most {100 * (1 - GLSL_FRACTION):.2g}% may)",
-            failure_picture(label, g, e, name="shader output", atol=atol / scale_to),
+            # the picture in the message's unit: values scaled like the text's (uv * s = texels)
+            failure_picture(label, g * scale_to, e * scale_to, name="shader output", atol=atol, unit=unit.strip()),
         )
 
 

@@ -159,27 +159,37 @@ def wrong_rows(expected, got, name: str = "S", atol: float = tol.EXACT) -> np.nd
 
 
 def matrix_picture(ctx, V, F, expected, got, name: str) -> str | None:
-    """The mesh with the places whose rows of a subdivision matrix are wrong marked in red: edge
-    midpoints for ``S_odd`` (one row per edge, in :func:`geomlib.topology.unique_edges` order),
-    vertices for ``S_even`` and the other matrices (one row per vertex)."""
-    from geomlib import topology
+    """The new vertices of the wrong rows of a subdivision matrix, expected | yours | difference:
+    row ``i`` of ``S`` places a new vertex at ``S[i] @ V`` (an edge's odd vertex for ``S_odd``, one
+    row per edge; a vertex's new position for ``S_even`` and the other matrices), so the panels show
+    where the expected rows put it, where the submitted rows put it, and how far apart they are."""
     from geomlib.grading import feedback
 
-    if ctx is None:
+    if ctx is None or ctx.feedback_dir is None or not feedback.picture_wanted():
         return None
     rows = wrong_rows(expected, got, name)
     if rows is None or not len(rows):
         return None
     V = np.asarray(V, float)
-    if name == "S_odd":
-        E = topology.unique_edges(np.asarray(F))
-        rows = rows[rows < len(E)]
-        points = (V[E[rows, 0]] + V[E[rows, 1]]) / 2
-        what = f"{feedback.count(len(rows), 'edge', 'edges')} whose {name} row is wrong"
-    else:
-        rows = rows[rows < len(V)]
-        points, what = V[rows], f"{feedback.count(len(rows), 'vertex', 'vertices')} whose {name} row is wrong"
-    return feedback.highlight_picture(ctx, V, F, points, what)
+    E, G = as_dense(expected, name)[rows], as_dense(got, name)[rows]
+    if E.shape[1] != len(V):
+        return None
+    what = (
+        feedback.count(len(rows), "edge", "edges")
+        if name == "S_odd"
+        else feedback.count(len(rows), "vertex", "vertices")
+    )
+    err = np.abs(np.nan_to_num(G - E, nan=1.0)).sum(axis=1)  # how much weight is misplaced in the row
+    return feedback.rows_picture(
+        ctx,
+        V,
+        F,
+        E @ V,
+        np.nan_to_num(G) @ V,
+        f"expected: the new vertex of each of the {what} whose {name} row is wrong",
+        err=err,
+        yours=f"yours: where your {name} rows put them",
+    )
 
 
 def matrix_check(name: str, *, atol: float = tol.EXACT, what_row: str = "row"):
