@@ -114,11 +114,11 @@ def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "")
     what : str
         What the figure will show once the task is done (goes into the caption).
     """
-    import re
+    from geomlib.taskref import find_task
 
     msg = str(error).strip() or type(error).__name__
-    m = re.search(r"Task\s+(\d+[a-z]?)", msg)
-    head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
+    m = find_task(msg)
+    head = f"Task {m.label} not implemented yet" if m else "not implemented yet"
     blank = np.full((160, 560, 3), 244, dtype=np.uint8)
     img = panels([blank], [msg if len(msg) <= 300 else msg[:297] + "..."], title=Path(path).stem, font_size=14)
     # Write the head into the grey box too, so a thumbnail still says it.

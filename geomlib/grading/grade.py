@@ -22,6 +22,7 @@ from pathlib import Path
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.results import build_results, write_results
+from geomlib.taskref import find_task, task_at_start
 
 __all__ = ["grade", "check", "Report", "report_lines"]
 
@@ -199,7 +200,7 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
 
 _SEE = re.compile(r"\(see ([^()]+?\.png)\)")
 #: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
-_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to Task (\d+) \(([^()]*)\)")
+_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to ")
 
 
 def report_lines(
@@ -254,8 +255,9 @@ def report_lines(
         where = f"{r.lab} · " if several else ""
         part = r.part
         rows = _ROWS.search(msg)  # the differing rows are another task's (geomlib.grading.diagnose)
-        if rows:
-            t, part = (int(rows.group(1)),), rows.group(2)
+        owner = task_at_start(msg[rows.end() :]) if rows else None
+        if owner and owner.title is not None:
+            t, part = (owner.number,), owner.title
         line = f"✗ {where}{_tasks_text(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
         if line in seen:
             continue
@@ -266,8 +268,8 @@ def report_lines(
         lines += ["", f"What to fix ({n_tests} failing test{'s' if n_tests != 1 else ''}):"]
 
         def task_no(msg):
-            m = re.search(r"Task (\d+)", msg)
-            return int(m.group(1)) if m else 1_000
+            m = find_task(msg)
+            return m.number if m else 1_000
 
         for lab in labs:  # per lab: wrong results of started tasks, then tasks not started, in task order
             for _, line in sorted(fix[lab], key=lambda tl: tl[0]):
@@ -311,9 +313,9 @@ def _nothing_implemented(records) -> str:
         return ""
     best = None
     for r in pointed:
-        m = re.search(r"Task (\d+)[a-z]? \(([^()]*)\)", r.message)
-        if m and (best is None or int(m.group(1)) < best[0]):
-            best = (int(m.group(1)), m.group(0), r.message.split(":", 1)[0].strip())
+        m = find_task(r.message, titled=True)
+        if m and (best is None or m.number < best[0]):
+            best = (m.number, m.text, r.message.split(":", 1)[0].strip())
     total = sum(r.points for r in pointed)
     start = f"; start with {best[1]}: {best[2]}" if best else ""
     return f"0 / {total:g} — nothing implemented yet{start}"

@@ -11,7 +11,6 @@ dense grid displaced by the height field, rasterized the same way.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +19,7 @@ from geomlib import camera, datasets
 from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers, partial_figure
 from geomlib.plot import Figure, colorbar, heatmap_image, line_plot, panels, save_png
 from geomlib.raster import rasterize
+from geomlib.taskref import find_task
 
 from .bump import bump_normal
 from .heights import bricks, bumps
@@ -81,8 +81,8 @@ def _try(fn, size):
     try:
         return fn(), None
     except NotImplementedError as e:
-        task = re.search(r"Task (\d+[a-z]?)", str(e))
-        _MISSING.append(task.group(1) if task else "?")
+        task = find_task(str(e))
+        _MISSING.append(task.label if task else "?")
         return None, f" (not implemented yet: {str(e).split(':')[0]})"
 
 
@@ -226,8 +226,8 @@ def _fig_error_vs_angle(out: Path, quick: bool) -> Drawn:
                         else relief_uv(H, uv, V, scale=SCALE, refine=m)[0]
                     )
                 except NotImplementedError as e:
-                    task = re.search(r"Task (\d+[a-z]?)", str(e))
-                    _MISSING.append(task.group(1) if task else "?")
+                    task = find_task(str(e))
+                    _MISSING.append(task.label if task else "?")
                     continue
                 e = np.percentile(uv_error_texels(got, truth, 256), 99)
                 curves.setdefault(f"{m} ({kind})", []).append(max(e, 1e-6))
@@ -261,8 +261,8 @@ def _fig_steps(out: Path, quick: bool) -> Drawn:
     try:
         _, _, steps = relief_uv(H, uv, view, scale=SCALE, refine="none")
     except NotImplementedError as e:
-        task = re.search(r"Task (\d+[a-z]?)", str(e))
-        _MISSING.append(task.group(1) if task else "?")
+        task = find_task(str(e))
+        _MISSING.append(task.label if task else "?")
         img = panels([_missing(size)], ["relief_uv: not implemented yet"])
     else:
         from .relief import layer_count

@@ -13,7 +13,6 @@ boundary loop (:func:`bunny_head`).
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +22,7 @@ from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, trian
 from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers
 from geomlib.plot import colorbar, heat_colors, line_plot, panels
 from geomlib.render import render
+from geomlib.taskref import find_task
 
 __all__ = [
     "make_figures",
@@ -194,8 +194,8 @@ def _todo(missing: list) -> str:
     """Caption prefix of a figure drawn in part: which task is missing (empty when none is)."""
     if not missing:
         return ""
-    first = re.search(r"Task \d+[a-z]?", str(missing[0]))
-    return f"{first.group(0) if first else 'A task'} not implemented yet; the other panels show: "
+    first = find_task(str(missing[0]))
+    return f"{'Task ' + first.label if first else 'A task'} not implemented yet; the other panels show: "
 
 
 def _mesh(result):

@@ -10,7 +10,6 @@ geomlib's rasterizer.
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +17,7 @@ import numpy as np
 from geomlib import camera, datasets, raster
 from geomlib.labfigures import Drawn, MeshView, figure_name, lab_figure_makers, partial_figure
 from geomlib.plot import colorbar, heatmap_image, panels
+from geomlib.taskref import find_task
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
 from .bricks import EMPTY_INSIDE, compress_bricks
@@ -42,8 +42,8 @@ def _missing(size, what: str) -> np.ndarray:
 
     from PIL import Image, ImageDraw
 
-    task = re.search(r"\(Task (\d+[a-z]?)", what)
-    _MISSING.append(task.group(1) if task else "?")
+    task = find_task(what)
+    _MISSING.append(task.label if task else "?")
     h, w = max(size[0], 160), max(size[1], 260)
     im = Image.new("RGB", (w, h), (235, 235, 235))
     text = "not implemented yet:\n" + "\n".join(textwrap.wrap(what, max(20, w // 7)))
