@@ -16,7 +16,7 @@ import re
 
 import numpy as np
 
-from geomlib.grading.checks import Context
+from geomlib.grading.context import Context
 
 
 def count(n: int, one: str, many: str) -> str:

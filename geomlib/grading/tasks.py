@@ -18,13 +18,13 @@ hand-written test).
 from __future__ import annotations
 
 import ast
-import importlib
 import inspect
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
+from geomlib.grading.registry import graded_module
 from geomlib.taskref import find_task
 
 __all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
@@ -172,12 +172,7 @@ def _lab_module_aliases(tree) -> set[str]:
 
 
 def _declared(lab: str):
-    tests = str(_impl.tests_dir())
-    if tests not in sys.path:
-        sys.path.insert(0, tests)
-    if not (_impl.tests_dir() / "graded" / lab / "diagnose.py").is_file():
-        return None
-    return importlib.import_module(f"graded.{lab}.diagnose")
+    return graded_module(lab, "diagnose")
 
 
 def table(lab: str) -> TaskTable:
