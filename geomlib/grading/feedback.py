@@ -40,10 +40,12 @@ def _picture_allowed() -> bool:
     drawn ``GEOMLIB_MAX_FEEDBACK_PICTURES`` already. The autograder sets a cap: a student needs a picture
     of the first failures of each task, and every picture costs seconds of the run and ~0.2 MB of
     results.json."""
-    if os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    from geomlib.grading.settings import GradingSettings
+
+    run = GradingSettings.build()
+    if not run.pictures:
         return False
-    cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
-    return not cap.isdigit() or _DRAWN[0] < int(cap)
+    return run.max_pictures is None or _DRAWN[0] < run.max_pictures
 
 
 def _drawn_in_time(path, draw) -> str | None:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import re
 import time
 from dataclasses import dataclass, field
@@ -22,6 +21,7 @@ from pathlib import Path
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.results import build_results, write_results
+from geomlib.grading.settings import GradingSettings
 from geomlib.taskref import find_task, task_at_start
 
 __all__ = ["grade", "check", "Report", "report_lines"]
@@ -144,17 +144,17 @@ def grade(
         "console_output_style=classic",
     ]
     args += extra_args or []
-    os.environ.setdefault("GEOMLIB_IMPL", str(impl))
+    run = plugin.GradingRun(GradingSettings.build(impl=impl, feedback_dir=feedback_dir))
     selection = _Selection(task=task, part=part)
     t0 = time.time()
     captured = io.StringIO()
     if verbose:
-        code = pytest.main(args, plugins=[selection])
+        code = pytest.main(args, plugins=[selection, run])
     else:
         with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
-            code = pytest.main(args, plugins=[selection])
+            code = pytest.main(args, plugins=[selection, run])
     elapsed = time.time() - t0
-    records = list(plugin.RECORDS)
+    records = list(run.records)
     if task is None and part is None:
         _remove_stale_pictures(feedback_dir, {r.lab for r in records}, before=t0)
     note = ""

@@ -20,7 +20,9 @@ __all__ = ["course_root", "resolve_impl", "default_impl", "lab_names", "load_lab
 
 def course_root() -> Path:
     """The folder holding ``geomlib/``, ``labs/``, ``tests/`` (override with ``GEOMLIB_ROOT``)."""
-    env = os.environ.get("GEOMLIB_ROOT")
+    from geomlib.grading.settings import env as _env
+
+    env = _env("GEOMLIB_ROOT")
     if env:
         return Path(env).resolve()
     return Path(__file__).resolve().parents[2]
