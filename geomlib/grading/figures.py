@@ -14,17 +14,14 @@ import sys
 import time
 from pathlib import Path
 
-from geomlib.grading.impl import course_root
+from geomlib.grading.course import course, course_root
 
 __all__ = ["lab_figure_modules", "build_all"]
 
 
 def lab_figure_modules() -> list[str]:
-    """Labs whose reference solution has a ``figures.py``, in course order."""
-    order = ["subdivision", "simplification", "remeshing", "maps", "denoise", "shadows", "vdm", "sdf", "relief"]
-    sol = course_root() / "solutions"
-    names = [p.parent.name for p in sol.glob("*/figures.py")] if sol.is_dir() else []
-    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
+    """Labs whose reference solution has a ``figures.py``, in course order (:mod:`geomlib.grading.course`)."""
+    return course().figure_labs
 
 
 def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, progress: bool = True) -> list:

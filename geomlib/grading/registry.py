@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from geomlib.grading import impl as _impl
+from geomlib.grading.course import course
 from geomlib.grading.errors import Mismatch
 
 if TYPE_CHECKING:
@@ -39,10 +39,11 @@ def graded_module(lab: str, name: str):
     imported in this process), and a ``graded`` package imported from another course (a fixture
     course in the same process) is forgotten first.
     """
-    folder = _impl.tests_dir() / "graded" / lab
+    c = course()
+    folder = c.lab(lab).graded
     if not (folder / f"{name}.py").is_file():
         return None
-    tests = str(_impl.tests_dir())
+    tests = str(c.tests_dir)
     if sys.path[:1] != [tests]:
         if tests in sys.path:
             sys.path.remove(tests)
@@ -69,8 +70,8 @@ def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Ca
 
 
 def reference_path(lab: str, case: Case) -> Path:
-    sub = "hidden" if case.hidden else ""
-    return _impl.reference_dir() / lab / sub / f"{case.id}.npz"
+    paths = course().lab(lab)
+    return (paths.hidden_references if case.hidden else paths.references) / f"{case.id}.npz"
 
 
 def load_reference(lab: str, case: Case) -> dict:
@@ -78,7 +79,7 @@ def load_reference(lab: str, case: Case) -> dict:
     path = reference_path(lab, case)
     if not path.is_file():
         raise Mismatch(
-            f"reference output {path.relative_to(_impl.course_root())} is missing: run `geomlib refs build --lab {lab}`"
+            f"reference output {path.relative_to(course().root)} is missing: run `geomlib refs build --lab {lab}`"
         )
     with np.load(path, allow_pickle=False) as z:
         return {name: z[name] for name in z.files}
@@ -87,14 +88,15 @@ def load_reference(lab: str, case: Case) -> dict:
 # ------------------------------------------------------------------------------ stored inputs
 def stored_path(lab: str, case: Case) -> Path:
     """Where ``geomlib refs build`` stores the outputs of a ``STORED`` entry."""
-    sub = ("hidden", "inputs") if case.hidden else ("inputs",)
-    return _impl.reference_dir().joinpath(lab, *sub, f"{case.id}.npz")
+    paths = course().lab(lab)
+    return (paths.hidden_stored_inputs if case.hidden else paths.stored_inputs) / f"{case.id}.npz"
 
 
 def stored_input(lab: str, id: str) -> dict:
     """The stored outputs (``{name: array}``) of the ``STORED`` entry ``id`` of ``lab`` (public or hidden)."""
-    for sub in (("inputs",), ("hidden", "inputs")):
-        path = _impl.reference_dir().joinpath(lab, *sub, f"{id}.npz")
+    paths = course().lab(lab)
+    for folder in (paths.stored_inputs, paths.hidden_stored_inputs):
+        path = folder / f"{id}.npz"
         if path.is_file():
             with np.load(path, allow_pickle=False) as z:
                 return {name: z[name] for name in z.files}
