@@ -42,7 +42,7 @@ def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, 
         if name == "gallery":
             figs = gallery.build_gallery(out / "gallery", quick=quick)
         else:
-            if not (course_root() / "solutions" / name / "figures.py").is_file():
+            if not course().lab(name).figures.is_file():
                 raise FileNotFoundError(f"no figures for lab {name!r} (expected solutions/{name}/figures.py)")
             mod = importlib.import_module(f"solutions.{name}.figures")
             figs = mod.make_figures(out / name, quick=quick)

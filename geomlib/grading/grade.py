@@ -20,6 +20,7 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
+from geomlib.grading.course import course
 from geomlib.grading.results import build_results, write_results
 from geomlib.grading.settings import GradingSettings
 from geomlib.taskref import find_task, task_at_start
@@ -119,12 +120,12 @@ def grade(
 
     impl = impl or _impl.default_impl()
     _impl.resolve_impl(impl)  # fail early, with the path, if it does not exist
-    graded_dir = _impl.tests_dir() / "graded"
-    names = labs or _impl.lab_names()
-    unknown = [n for n in names if not (graded_dir / n).is_dir()]
+    c = course()
+    names = labs or c.labs
+    unknown = [n for n in names if not c.lab(n).graded.is_dir()]
     if unknown:
-        raise SystemExit(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(_impl.lab_names())}")
-    targets = [str(graded_dir / n) for n in names]
+        raise SystemExit(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(c.labs)}")
+    targets = [str(c.lab(n).graded) for n in names]
     args = [
         *targets,
         f"--impl={impl}",
@@ -329,7 +330,7 @@ def _hidden_totals(records) -> list[str]:
     out = []
     for lab in dict.fromkeys(r.lab for r in records):
         try:
-            text = (_impl.course_root() / "labs" / lab / "README.md").read_text()
+            text = course().lab(lab).handout.read_text()
         except OSError:
             continue
         m = re.search(r"^\| \*\*total\*\* \| ([0-9.]+) \+ ([0-9.]+) = ([0-9.]+) \|", text, re.M)
