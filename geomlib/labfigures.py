@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from geomlib.plot import Figure, _font, panels, save_png
+from geomlib.taskref import TASK_RUN, find_task
 from geomlib.validate import MeshError
 
 __all__ = [
@@ -76,7 +77,7 @@ class Claims:
     #: the constants of a formula (``1 - h``, ``v > 1``, ``2r/255``). A measured value (a count, an
     #: error, a threshold the builder uses) is a field.
     ALLOWED = (
-        re.compile(r"Tasks? \d+[a-z]?((, | and |-)\d+[a-z]?)*"),
+        TASK_RUN,
         re.compile(r"\[0, 1\]"),
         re.compile(
             r"\((19|20)\d\d\)|\b[a-z]+\d+\b|\b[23]D\b|\b\d+-(tap|bit|point|ring)s?\b|\bp\d+\b|\b\d+[a-z]\b|\b\d+\^\d+"
@@ -184,8 +185,8 @@ def lab_package(lab, package: str):
 
 def task_label(error: BaseException) -> str:
     """The task a stub's ``NotImplementedError`` names (``"2"``, ``"1a"``), or ``"?"``."""
-    m = re.search(r"Task\s+(\d+[a-z]?)", str(error))
-    return m.group(1) if m else "?"
+    m = find_task(str(error))
+    return m.label if m else "?"
 
 
 class MissingTasks(list):
@@ -236,8 +237,8 @@ def missing_task_figure(path, error: BaseException, lab: str, *, what: str = "")
         What the figure will show once the task is done (goes into the caption).
     """
     msg = str(error).strip() or type(error).__name__
-    m = re.search(r"Task\s+(\d+[a-z]?)", msg)
-    head = f"Task {m.group(1)} not implemented yet" if m else "not implemented yet"
+    m = find_task(msg)
+    head = f"Task {m.label} not implemented yet" if m else "not implemented yet"
     blank = np.full((160, 560, 3), 244, dtype=np.uint8)
     img = panels([blank], [msg if len(msg) <= 300 else msg[:297] + "..."], title=Path(path).stem, font_size=14)
     # Write the head into the grey box too, so a thumbnail still says it.

@@ -62,10 +62,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
+from geomlib.taskref import find_task
 
 __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
 
-_MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
 _HELPER = "_geomlib_audit_nothing"
 NOTHING_MODES = ("zeros", "input", "constant")
 #: How many mutants per lab ``--quick`` grades (a fixed, seeded sample).
@@ -118,10 +118,10 @@ def _blocks(lab_dir: Path) -> tuple[list[_Block], list[str]]:
             shaders.append(f"{rel} ({len(blocks)} block{'s' if len(blocks) != 1 else ''})")
             continue
         for b in blocks:
-            m = _MARK.search(b.task)
+            m = find_task(b.task, titled=True)
             if not m:
                 raise AuditError(f"{rel}, line {b.start}: a solution block without 'Task N (title)' in its marker")
-            out.append(_Block(rel, b.start, b.end, int(m.group(1)), m.group(2).strip()))
+            out.append(_Block(rel, b.start, b.end, m.number, m.title.strip()))
     return out, shaders
 
 

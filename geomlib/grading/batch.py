@@ -34,6 +34,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from geomlib.grading.settings import env as setting
 from geomlib.grading.submission import SubmissionError, copy_lab, find_lab
 
 __all__ = ["grade_all", "discover", "Submission", "BatchError"]
@@ -130,7 +131,7 @@ def _failure(message: str) -> dict:
 def sandbox_user() -> str:
     """The user student code runs as: ``GEOMLIB_SANDBOX_USER``, else ``nobody`` when root, else none."""
     default = "nobody" if os.geteuid() == 0 else ""
-    return os.environ.get("GEOMLIB_SANDBOX_USER", default)
+    return setting("GEOMLIB_SANDBOX_USER", default)
 
 
 #: Where the private uids of ``grade-all`` come from (``GEOMLIB_SANDBOX_UIDS=FIRST-LAST`` overrides;
@@ -167,7 +168,7 @@ def _ids_in_use() -> set[int]:
 
 
 def _uid_ranges() -> list[tuple[int, int]]:
-    spec = os.environ.get("GEOMLIB_SANDBOX_UIDS", "")
+    spec = setting("GEOMLIB_SANDBOX_UIDS", "")
     if spec:
         m = re.fullmatch(r"\s*(\d+)\s*-\s*(\d+)\s*", spec)
         if not m or int(m.group(1)) < 1000 or int(m.group(1)) > int(m.group(2)):
@@ -216,7 +217,7 @@ class UidPool:
                     self.given.add(n)
                     return n, fd
         raise BatchError(
-            f"no free uid left in {os.environ.get('GEOMLIB_SANDBOX_UIDS') or UID_RANGES}; "
+            f"no free uid left in {setting('GEOMLIB_SANDBOX_UIDS') or UID_RANGES}; "
             f"set GEOMLIB_SANDBOX_UIDS=FIRST-LAST to a free range"
         )
 
@@ -344,9 +345,7 @@ def sandbox_interpreter(user: str, log=print) -> str:
     log(f"the sandbox user cannot run {sys.executable}; making {venv} as the autograder's setup.sh does")
     env = {**os.environ, "UV_PROJECT_ENVIRONMENT": str(venv)}
     env.pop("VIRTUAL_ENV", None)
-    base = os.environ.get("GEOMLIB_AUTOGRADER_PYTHON") or next(
-        (c for c in PYTHON_CANDIDATES if os.access(c, os.X_OK)), ""
-    )
+    base = setting("GEOMLIB_AUTOGRADER_PYTHON") or next((c for c in PYTHON_CANDIDATES if os.access(c, os.X_OK)), "")
     try:
         if not base:
             env["UV_PYTHON_INSTALL_DIR"] = str(root / ".python-sandbox")
@@ -454,7 +453,7 @@ def grade_all(
     python = sandbox_interpreter(user, log)
     check_sandbox_user(user, python)
     out = Path(out)
-    private = bool(user) and os.geteuid() == 0 and os.environ.get("GEOMLIB_SANDBOX_UIDS", "").lower() != "none"
+    private = bool(user) and os.geteuid() == 0 and setting("GEOMLIB_SANDBOX_UIDS", "").lower() != "none"
     pool = None
     if private:
         # Every submission's workers run as a uid of their own (and the gid of the same number), so

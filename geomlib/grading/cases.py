@@ -6,20 +6,25 @@ See ``docs/adding-a-lab.md`` for how a lab uses them.
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 import re
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from geomlib.grading import impl as _impl
 from geomlib.grading import tolerances as tol
 from geomlib.grading.checks import Context, compare_arrays, nonfinite_problem
 from geomlib.grading.errors import BadReturn, Mismatch, StudentError
+from geomlib.grading.registry import (  # re-exported: graded tests and the tooling import them from here
+    load_cases,
+    load_reference,
+    load_stored,
+    reference_path,
+    stored_input,
+    stored_path,
+)
 
 __all__ = [
     "Case",
@@ -139,22 +144,6 @@ def graded(
     import pytest  # graded tests run under pytest; importing this module does not need it
 
     return pytest.mark.graded(points=points, part=part, visibility=visibility, timeout=timeout, memory_mb=memory_mb)
-
-
-def reference_path(lab: str, case: Case) -> Path:
-    sub = "hidden" if case.hidden else ""
-    return _impl.reference_dir() / lab / sub / f"{case.id}.npz"
-
-
-def load_reference(lab: str, case: Case) -> dict:
-    """The stored expected outputs of ``case`` (written by ``geomlib refs build``)."""
-    path = reference_path(lab, case)
-    if not path.is_file():
-        raise Mismatch(
-            f"reference output {path.relative_to(_impl.course_root())} is missing: run `geomlib refs build --lab {lab}`"
-        )
-    with np.load(path, allow_pickle=False) as z:
-        return {name: z[name] for name in z.files}
 
 
 def inputs_digest(inputs: dict, params: dict) -> str:
@@ -320,32 +309,6 @@ def expect_raises(
     raise Mismatch(f"{label} should raise {exception} for this input, but it returned normally")
 
 
-def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Case]:
-    """All cases a lab declares (``tests/graded/<lab>/cases.py`` and, if present and wanted,
-    ``cases_hidden.py`` and the probe-only cases of ``diagnose.py``, which need references but are
-    never graded)."""
-    tests = str(_impl.tests_dir())
-    if sys.path[:1] != [tests]:  # first, ahead of another course's tests folder imported in this process
-        if tests in sys.path:
-            sys.path.remove(tests)
-        sys.path.insert(0, tests)
-    cases: list[Case] = []
-    folder = _impl.tests_dir() / "graded" / lab
-    loaded = sys.modules.get("graded")
-    if loaded is not None and str(folder.parent) not in [str(Path(p)) for p in getattr(loaded, "__path__", [])]:
-        # `graded` was imported from another course (a fixture course in the same process): forget it.
-        for name in [m for m in sys.modules if m == "graded" or m.startswith("graded.")]:
-            del sys.modules[name]
-    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True), ("diagnose", False)):
-        if (is_hidden and not hidden) or (mod_name == "diagnose" and not probes):
-            continue
-        if not (folder / f"{mod_name}.py").is_file():
-            continue
-        mod = importlib.import_module(f"graded.{lab}.{mod_name}")
-        cases.extend(getattr(mod, "CASES", []))
-    return cases
-
-
 # ------------------------------------------------------------------------------ stored inputs
 # A test often needs, as its input, what an earlier task produces (a depth map for the shadow
 # test, a mesh's sharp edges for the alignment). Test helpers never compute those with solution
@@ -353,39 +316,3 @@ def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Ca
 # functions), ``geomlib refs build`` runs the solution once and stores their outputs under
 # ``tests/reference/<lab>/inputs/`` (``hidden/inputs/`` for those of ``cases_hidden.py``), and
 # the helpers read them with :func:`stored_input`.
-
-
-def stored_path(lab: str, case: Case) -> Path:
-    """Where ``geomlib refs build`` stores the outputs of a ``STORED`` entry."""
-    sub = ("hidden", "inputs") if case.hidden else ("inputs",)
-    return _impl.reference_dir().joinpath(lab, *sub, f"{case.id}.npz")
-
-
-def stored_input(lab: str, id: str) -> dict:
-    """The stored outputs (``{name: array}``) of the ``STORED`` entry ``id`` of ``lab`` (public or hidden)."""
-    for sub in (("inputs",), ("hidden", "inputs")):
-        path = _impl.reference_dir().joinpath(lab, *sub, f"{id}.npz")
-        if path.is_file():
-            with np.load(path, allow_pickle=False) as z:
-                return {name: z[name] for name in z.files}
-    raise FileNotFoundError(
-        f"stored input {lab}/inputs/{id}.npz is missing: run `geomlib refs build --lab {lab}` (instructors)"
-    )
-
-
-def load_stored(lab: str, *, hidden: bool = True) -> list[Case]:
-    """The ``STORED`` entries of a lab's case modules (public first), in the order they are built."""
-    tests = str(_impl.tests_dir())
-    if tests not in sys.path:
-        sys.path.insert(0, tests)
-    out: list[Case] = []
-    folder = _impl.tests_dir() / "graded" / lab
-    for mod_name, is_hidden in (("cases", False), ("cases_hidden", True)):
-        if (is_hidden and not hidden) or not (folder / f"{mod_name}.py").is_file():
-            continue
-        mod = importlib.import_module(f"graded.{lab}.{mod_name}")
-        for c in getattr(mod, "STORED", []):
-            if c.hidden != is_hidden:
-                raise ValueError(f"{lab}: STORED entry {c.id} in {mod_name}.py has visibility {c.visibility!r}")
-            out.append(c)
-    return out

@@ -59,7 +59,7 @@ def _module(lab: str):
 
 def probes_for(lab: str, case) -> list:
     """Probe cases for a composite case, in the order they are tried (task, same input first)."""
-    from geomlib.grading.cases import load_cases
+    from geomlib.grading.registry import load_cases
 
     tab = _tasks.table(lab)
     blocks = tab.composites.get(case.function, ())
@@ -84,8 +84,8 @@ def probes_for(lab: str, case) -> list:
 
 def _run_probe(lab, probe, mod, feedback_dir):
     """None when the student's block matches the probe's reference, else (what, message)."""
-    from geomlib.grading.cases import load_reference
-    from geomlib.grading.checks import Context
+    from geomlib.grading.context import Context
+    from geomlib.grading.registry import load_reference
 
     key = (str(lab.lab_dir), _stamp(lab.lab_dir), probe.id)
     if key in _CACHE:
@@ -191,7 +191,7 @@ def rows_task_note(lab: str, case, inputs: dict, expected: dict, got: dict) -> s
         own = tab.of_part(case.part) or (tab.of_function(case.function) or (None,))[0]
         if n is None or n == own:
             return None
-        from geomlib.grading.cases import load_cases
+        from geomlib.grading.registry import load_cases
 
         hint = next(
             (

@@ -17,7 +17,7 @@ import textwrap
 
 import numpy as np
 
-from geomlib.grading.checks import Context
+from geomlib.grading.context import Context
 
 
 def count(n: int, one: str, many: str) -> str:
@@ -52,9 +52,11 @@ class pictures_for_run:  # noqa: N801 - used as a function: ``with pictures_for_
     def __init__(self, pictures: str | None = None):
         if pictures is not None and pictures not in PICTURE_CHOICES:
             raise ValueError(f"pictures={pictures!r}: expected one of {', '.join(map(repr, PICTURE_CHOICES))}")
-        cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
-        if pictures is None and cap.isdigit():
-            self.cap = int(cap)
+        from geomlib.grading.settings import GradingSettings
+
+        cap = GradingSettings.build().max_pictures
+        if pictures is None and cap is not None:
+            self.cap = cap
         else:
             self.cap = {"first": 1, "all": None, "none": 0}[pictures or "first"]
 
@@ -126,7 +128,9 @@ def picture_wanted() -> bool:
     as held back). Call it before preparing a costly picture (dense matrices, distances)."""
     if _picture_allowed():
         return True
-    if not os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    from geomlib.grading.settings import GradingSettings
+
+    if GradingSettings.build().pictures:
         _HELD[0] += 1
     return False
 
@@ -136,12 +140,14 @@ def _picture_allowed() -> bool:
     drawn its cap already (:func:`pictures_for_run`; outside a run, ``GEOMLIB_MAX_FEEDBACK_PICTURES``).
     The autograder sets a cap: a student needs a picture of the first failures of each task, and every
     picture costs a second of the run and ~0.2 MB of results.json."""
-    if os.environ.get("GEOMLIB_NO_FEEDBACK_PICTURES"):
+    from geomlib.grading.settings import GradingSettings
+
+    run = GradingSettings.build()
+    if not run.pictures:
         return False
     if _CAP[0] is not None:
         return _DRAWN[0] < _CAP[0]
-    cap = os.environ.get("GEOMLIB_MAX_FEEDBACK_PICTURES", "").strip()
-    return not cap.isdigit() or _DRAWN[0] < int(cap)
+    return run.max_pictures is None or _DRAWN[0] < run.max_pictures
 
 
 def _drawn_in_time(path, draw) -> str | None:

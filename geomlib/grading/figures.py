@@ -14,22 +14,14 @@ import sys
 import time
 from pathlib import Path
 
-from geomlib.grading.impl import course_root
+from geomlib.grading.course import course, course_root
 
 __all__ = ["lab_figure_modules", "build_all"]
 
 
-def _figures_impl() -> str:
-    """Whose ``figures.py`` draws: the reference solutions', or in a student bundle (no solutions)
-    the student's ``labs/<lab>/figures.py``, which draws what is implemented and labels the rest."""
-    return "solutions" if (course_root() / "solutions").is_dir() else "labs"
-
-
 def lab_figure_modules() -> list[str]:
-    """Labs with a ``figures.py`` (the solutions', else the stubs'), in course order."""
-    order = ["subdivision", "simplification", "remeshing", "maps", "denoise", "shadows", "vdm", "sdf", "relief"]
-    names = [p.parent.name for p in (course_root() / _figures_impl()).glob("*/figures.py")]
-    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
+    """Labs with a ``figures.py`` (the solutions', else in a student bundle the stubs'), in course order."""
+    return course().figure_labs
 
 
 def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, progress: bool = True) -> list:
@@ -50,10 +42,12 @@ def build_all(out: Path, labs: list[str] | None = None, *, quick: bool = False, 
         if name == "gallery":
             figs = gallery.build_gallery(out / "gallery", quick=quick)
         else:
-            impl = _figures_impl()
-            if not (course_root() / impl / name / "figures.py").is_file():
-                raise FileNotFoundError(f"no figures for lab {name!r} (expected {impl}/{name}/figures.py)")
-            mod = importlib.import_module(f"{impl}.{name}.figures")
+            paths = course().lab(name)
+            if not paths.figures.is_file():
+                raise FileNotFoundError(
+                    f"no figures for lab {name!r} (expected {paths.figures.relative_to(course().root)})"
+                )
+            mod = importlib.import_module(f"{course().figures_package}.{name}.figures")
             figs = mod.make_figures(out / name, quick=quick)
             if hasattr(mod, "make_view"):  # the lab's interactive 3D page, framed in the index
                 figs = [*figs, mod.make_view(out / name, quick=quick)]

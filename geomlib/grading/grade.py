@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-import os
 import re
 import time
 from dataclasses import dataclass, field
@@ -21,7 +20,10 @@ from pathlib import Path
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
+from geomlib.grading.course import course
 from geomlib.grading.results import build_results, write_results
+from geomlib.grading.settings import GradingSettings
+from geomlib.taskref import find_task, task_at_start
 
 __all__ = ["grade", "check", "Report", "report_lines"]
 
@@ -122,12 +124,12 @@ def grade(
 
     impl = impl or _impl.default_impl()
     _impl.resolve_impl(impl)  # fail early, with the path, if it does not exist
-    graded_dir = _impl.tests_dir() / "graded"
-    names = labs or _impl.lab_names()
-    unknown = [n for n in names if not (graded_dir / n).is_dir()]
+    c = course()
+    names = labs or c.labs
+    unknown = [n for n in names if not c.lab(n).graded.is_dir()]
     if unknown:
-        raise SystemExit(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(_impl.lab_names())}")
-    targets = [str(graded_dir / n) for n in names]
+        raise SystemExit(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(c.labs)}")
+    targets = [str(c.lab(n).graded) for n in names]
     args = [
         *targets,
         f"--impl={impl}",
@@ -147,7 +149,7 @@ def grade(
         "console_output_style=classic",
     ]
     args += extra_args or []
-    os.environ.setdefault("GEOMLIB_IMPL", str(impl))
+    run = plugin.GradingRun(GradingSettings.build(impl=impl, feedback_dir=feedback_dir))
     selection = _Selection(task=task, part=part)
     _start_sandbox_early()
     t0 = time.time()
@@ -156,12 +158,12 @@ def grade(
 
     with feedback.pictures_for_run(pictures) as drawn:
         if verbose:
-            code = pytest.main(args, plugins=[selection])
+            code = pytest.main(args, plugins=[selection, run])
         else:
             with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
-                code = pytest.main(args, plugins=[selection])
+                code = pytest.main(args, plugins=[selection, run])
     elapsed = time.time() - t0
-    records = list(plugin.RECORDS)
+    records = list(run.records)
     for r in records if drawn.failed else ():  # pictures named in a message but not drawn after all
         r.message = feedback.without_pictures(r.message, drawn.failed)
         if r.picture and feedback._relpath(r.picture) in drawn.failed:
@@ -240,7 +242,7 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
 
 _SEE = re.compile(r"\(see ([^()]+?\.png)\)")
 #: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
-_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to Task (\d+) \(([^()]*)\)")
+_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to ")
 
 
 def report_lines(
@@ -295,8 +297,9 @@ def report_lines(
         where = f"{r.lab} · " if several else ""
         part = r.part
         rows = _ROWS.search(msg)  # the differing rows are another task's (geomlib.grading.diagnose)
-        if rows:
-            t, part = (int(rows.group(1)),), rows.group(2)
+        owner = task_at_start(msg[rows.end() :]) if rows else None
+        if owner and owner.title is not None:
+            t, part = (owner.number,), owner.title
         line = f"✗ {where}{_tasks_text(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
         if line in seen:
             continue
@@ -307,8 +310,8 @@ def report_lines(
         lines += ["", f"What to fix ({n_tests} failing test{'s' if n_tests != 1 else ''}):"]
 
         def task_no(msg):
-            m = re.search(r"Task (\d+)", msg)
-            return int(m.group(1)) if m else 1_000
+            m = find_task(msg)
+            return m.number if m else 1_000
 
         for lab in labs:  # per lab: wrong results of started tasks, then tasks not started, in task order
             for _, line in sorted(fix[lab], key=lambda tl: tl[0]):
@@ -352,9 +355,9 @@ def _nothing_implemented(records) -> str:
         return ""
     best = None
     for r in pointed:
-        m = re.search(r"Task (\d+)[a-z]? \(([^()]*)\)", r.message)
-        if m and (best is None or int(m.group(1)) < best[0]):
-            best = (int(m.group(1)), m.group(0), r.message.split(":", 1)[0].strip())
+        m = find_task(r.message, titled=True)
+        if m and (best is None or m.number < best[0]):
+            best = (m.number, m.text, r.message.split(":", 1)[0].strip())
     total = sum(r.points for r in pointed)
     start = f"; start with {best[1]}: {best[2]}" if best else ""
     return f"0 / {total:g} — nothing implemented yet{start}"
@@ -368,7 +371,7 @@ def _hidden_totals(records) -> list[str]:
     out = []
     for lab in dict.fromkeys(r.lab for r in records):
         try:
-            text = (_impl.course_root() / "labs" / lab / "README.md").read_text()
+            text = course().lab(lab).handout.read_text()
         except OSError:
             continue
         m = re.search(r"^\| \*\*total\*\* \| ([0-9.]+) \+ ([0-9.]+) = ([0-9.]+) \|", text, re.M)

@@ -15,23 +15,17 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+from geomlib.grading.course import course, course_root
+
 __all__ = ["course_root", "resolve_impl", "default_impl", "lab_names", "load_lab", "tests_dir", "reference_dir"]
 
 
-def course_root() -> Path:
-    """The folder holding ``geomlib/``, ``labs/``, ``tests/`` (override with ``GEOMLIB_ROOT``)."""
-    env = os.environ.get("GEOMLIB_ROOT")
-    if env:
-        return Path(env).resolve()
-    return Path(__file__).resolve().parents[2]
-
-
 def tests_dir() -> Path:
-    return course_root() / "tests"
+    return course().tests_dir
 
 
 def reference_dir() -> Path:
-    return tests_dir() / "reference"
+    return course().reference_dir
 
 
 def default_impl() -> str:
@@ -61,22 +55,8 @@ def resolve_impl(impl: str | os.PathLike | None) -> Path:
 
 
 def lab_names(impl: str | os.PathLike | None = "solutions") -> list[str]:
-    """Labs that have graded tests, in course order if known (folders under ``tests/graded``)."""
-    graded = tests_dir() / "graded"
-    names = sorted(p.name for p in graded.iterdir() if p.is_dir() and not p.name.startswith(("_", ".")))
-    order = [
-        "sample",
-        "subdivision",
-        "simplification",
-        "remeshing",
-        "maps",
-        "denoise",
-        "shadows",
-        "vdm",
-        "sdf",
-        "relief",
-    ]
-    return sorted(names, key=lambda n: (order.index(n) if n in order else len(order), n))
+    """Labs that have graded tests, in course order (``[tool.geomlib] labs``; see :mod:`geomlib.grading.course`)."""
+    return course().labs
 
 
 def load_lab(lab: str, impl: str | os.PathLike | None = None) -> ModuleType:

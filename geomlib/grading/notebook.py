@@ -9,9 +9,9 @@ yet (even vertices): the rest of this cell is skipped"); the notebook goes on.
 from __future__ import annotations
 
 import contextlib
-import os
-import re
 from types import ModuleType
+
+from geomlib.taskref import find_task
 
 __all__ = ["open_lab", "TasksDone"]
 
@@ -30,10 +30,10 @@ class TasksDone:
         try:
             yield
         except NotImplementedError as e:
-            m = re.search(r"(Task \d+[a-z]?)(?: \(([^)]*)\))?", str(e))
-            task = m.group(1) if m else "a task"
+            m = find_task(str(e))
+            task = f"Task {m.label}" if m else "a task"
             self.missing.append(task)
-            title = f" ({m.group(2)})" if m and m.group(2) else ""
+            title = f" ({m.title})" if m and m.title else ""
             print(f"{task} not implemented yet{title}: the rest of this cell is skipped")
         except NameError as e:
             tb = e.__traceback__
@@ -58,8 +58,9 @@ def open_lab(lab: str, impl: str | None = None) -> tuple[ModuleType, TasksDone]:
         present, else ``labs``.
     """
     from geomlib.grading.impl import default_impl, load_lab
+    from geomlib.grading.settings import env
 
-    impl = impl or os.environ.get("GEOMLIB_IMPL") or default_impl()
+    impl = impl or env("GEOMLIB_IMPL") or default_impl()
     module = load_lab(lab, impl)
     print(f"using the {impl} implementation: {module.__name__}")
     return module, TasksDone()

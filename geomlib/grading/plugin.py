@@ -7,14 +7,14 @@ Loaded by ``tests/conftest.py``. A graded test lives in ``tests/graded/<lab>/`` 
 - tells :mod:`~geomlib.grading.feedback` where the running graded test's failure pictures go;
 - replaces the traceback of an expected failure (:class:`~geomlib.grading.errors.GradingFailure`)
   by its one- or two-sentence message;
-- records every graded outcome, prints a per-lab, per-part score table, and leaves the records in
-  :data:`RECORDS` for ``geomlib grade`` to turn into ``results.json``.
+- records every graded outcome in the run's :class:`GradingRun` (``geomlib grade`` hands pytest its
+  own instance and turns its records into ``results.json``; a plain ``pytest`` run gets one) and
+  prints a per-lab, per-part score table. No records are kept in module globals.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import os
 from pathlib import Path
 
 import pytest
@@ -24,9 +24,8 @@ from geomlib.grading import sandbox, tolerances
 from geomlib.grading.errors import GraderError, GradingFailure, NotImplementedYet
 from geomlib.grading.results import Record
 from geomlib.grading.sandbox import LabProxy
+from geomlib.grading.settings import GradingSettings, env_float
 
-#: Records of the most recent run in this process (read by ``geomlib grade``).
-RECORDS: list[Record] = []
 _RECORD_KEY = "geomlib_graded_record"
 
 
@@ -43,21 +42,53 @@ def pytest_addoption(parser):
     g.addoption(
         "--time-budget",
         type=float,
-        default=float(os.environ["GEOMLIB_TIME_BUDGET"]) if os.environ.get("GEOMLIB_TIME_BUDGET") else None,
+        default=env_float("GEOMLIB_TIME_BUDGET"),
         help="seconds for the whole run; later tests fail at once with a message saying so "
         f"(default {tolerances.TIME_BUDGET_S:g} when --impl is given, else none; 0 = none; env GEOMLIB_TIME_BUDGET)",
     )
     g.addoption(
         "--time-limit",
         type=float,
-        default=float(os.environ["GEOMLIB_TIME_LIMIT"]) if os.environ.get("GEOMLIB_TIME_LIMIT") else None,
+        default=env_float("GEOMLIB_TIME_LIMIT"),
         help="seconds allowed per call into the implementation (default: each test's own, else 30; env GEOMLIB_TIME_LIMIT)",
     )
 
 
+class GradingRun:
+    """One grading run, as a pytest plugin instance: its settings and the records of its graded tests.
+
+    ``geomlib grade`` builds one per run (``pytest.main(args, plugins=[GradingRun(settings)])``) and
+    reads :attr:`records` afterwards; a run without one (``pytest tests``) gets its own.
+    """
+
+    def __init__(self, settings: GradingSettings | None = None):
+        self.settings = settings or GradingSettings.build()
+        self.records: list[Record] = []
+
+    def pytest_runtest_logreport(self, report):
+        """Keep the graded record a report carries (see :func:`pytest_runtest_makereport`)."""
+        for key, value in report.user_properties:
+            if key == _RECORD_KEY:
+                self.records.append(Record(**value))
+
+    def pytest_terminal_summary(self, terminalreporter, exitstatus, config):
+        if self.records:
+            terminalreporter.write_sep("=", "graded score")
+            terminalreporter.write_line(score_table(self.records))
+
+
+def grading_run(config) -> GradingRun:
+    """The :class:`GradingRun` registered with this pytest session."""
+    for _, p in config.pluginmanager.list_name_plugin():
+        if isinstance(p, GradingRun):
+            return p
+    raise RuntimeError("no GradingRun plugin in this pytest session")
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_configure(config):
-    RECORDS.clear()
+    if not any(isinstance(p, GradingRun) for _, p in config.pluginmanager.list_name_plugin()):
+        config.pluginmanager.register(GradingRun(), "geomlib-grading-run")
     # The whole-run budget protects grading runs (`geomlib grade`, the autograder: both name --impl);
     # a plain `pytest tests` (CI, students) has none unless asked for.
     budget = config.getoption("--time-budget", None)
@@ -106,7 +137,7 @@ def lab(request) -> LabProxy:
     name = _lab_of(request.path)
     if name is None:
         raise RuntimeError("the `lab` fixture is for tests under tests/graded/<lab>/")
-    root = _impl.resolve_impl(request.config.getoption("--impl"))
+    root = _impl.resolve_impl(request.config.getoption("--impl") or grading_run(request.config).settings.impl)
     marker = request.node.get_closest_marker("graded")
     timeout = request.config.getoption("--time-limit") or (marker.kwargs.get("timeout") if marker else None)
     memory = marker.kwargs.get("memory_mb") if marker else None
@@ -177,13 +208,6 @@ def pytest_runtest_makereport(item, call):
     )
 
 
-def pytest_runtest_logreport(report):
-    """Keep the graded record a report carries (see :func:`pytest_runtest_makereport`)."""
-    for key, value in report.user_properties:
-        if key == _RECORD_KEY:
-            RECORDS.append(Record(**value))
-
-
 def score_table(records: list[Record]) -> str:
     """A per-lab, per-part score table."""
     from collections import OrderedDict
@@ -203,9 +227,3 @@ def score_table(records: list[Record]) -> str:
     lines.append("-" * len(lines[0]))
     lines.append(f"{'total':<59}{f'{total:g} / {maxtotal:g}':>14}")
     return "\n".join(lines)
-
-
-def pytest_terminal_summary(terminalreporter, exitstatus, config):
-    if RECORDS:
-        terminalreporter.write_sep("=", "graded score")
-        terminalreporter.write_line(score_table(RECORDS))

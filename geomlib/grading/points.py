@@ -13,6 +13,7 @@ import sys
 from collections import OrderedDict
 
 from geomlib.grading import impl as _impl
+from geomlib.grading.course import course
 
 __all__ = ["points_by_part", "graded_items"]
 
@@ -44,9 +45,8 @@ def graded_items(labs: list[str] | None = None) -> list[tuple[str, str, str, flo
     import pytest
 
     names = labs or _impl.lab_names()
-    graded = _impl.tests_dir() / "graded"
     c = _Collector()
-    args = [str(graded / n) for n in names]
+    args = [str(course().lab(n).graded) for n in names]
     args += ["--collect-only", "-qq", "-p", "no:cacheprovider", f"--rootdir={_impl.course_root()}"]
     # Another course's `graded` package (a test session may hold one) would shadow this one's.
     saved = {k: sys.modules.pop(k) for k in list(sys.modules) if k == "graded" or k.startswith("graded.")}

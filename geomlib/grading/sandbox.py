@@ -62,6 +62,7 @@ from geomlib.grading.errors import (
     StudentError,
     StudentTimeout,
 )
+from geomlib.grading.settings import env as setting
 
 __all__ = ["call", "LabProxy", "status", "set_deadline", "remaining_time", "clean_text", "shutdown"]
 
@@ -139,7 +140,7 @@ def _hidden_paths() -> list[Path]:
 
 def _forbidden() -> list[Path]:
     root = _course_root()
-    extra = [Path(p) for p in os.environ.get("GEOMLIB_SANDBOX_HIDE", "").split(os.pathsep) if p]
+    extra = [Path(p) for p in setting("GEOMLIB_SANDBOX_HIDE", "").split(os.pathsep) if p]
     return [root / "tests", root / "solutions", root / ".git", *extra]
 
 
@@ -149,7 +150,7 @@ _READABLE: dict = {}
 
 def _readable_paths() -> list[str]:
     """What a Landlock-confined worker may read: Python, the libraries, geomlib, system folders."""
-    key = (tuple(sys.path), os.environ.get("GEOMLIB_SANDBOX_HIDE", ""), str(_course_root()))
+    key = (tuple(sys.path), setting("GEOMLIB_SANDBOX_HIDE") or "", str(_course_root()))
     if key not in _READABLE:
         _READABLE[key] = _find_readable_paths()
     return list(_READABLE[key])
@@ -216,14 +217,14 @@ class _Zygote:
         except (OSError, EOFError, ValueError) as e:
             raise GraderError(f"the sandbox could not start ({e}): {self.log_tail()}") from None
         # GEOMLIB_LANDLOCK=0 turns Landlock off (to test the protection of a kernel without it).
-        self.landlock = 0 if os.environ.get("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
+        self.landlock = 0 if setting("GEOMLIB_LANDLOCK") == "0" else int(ready.get("landlock", 0))
         # What a non-Linux system lacks (no prctl, no /proc, RLIMIT_AS ignored), one line each.
         self.notes = [n for n in ready.get("notes", []) if "Landlock" not in n]
         for note in self.notes:  # once per run, on stderr: the sandbox works, with less
             print(f"geomlib sandbox: {note}", file=sys.stderr)
         # GEOMLIB_SECCOMP=0 turns the network filter off (to test what it blocks).
-        self.seccomp = bool(ready.get("seccomp")) and os.environ.get("GEOMLIB_SECCOMP") != "0"
-        self.user = os.environ.get("GEOMLIB_SANDBOX_USER") or None
+        self.seccomp = bool(ready.get("seccomp")) and setting("GEOMLIB_SECCOMP") != "0"
+        self.user = setting("GEOMLIB_SANDBOX_USER") or None
         self.is_root = os.geteuid() == 0
         if self.user and not self.is_root:
             self.user = None  # only root can switch users; say so in status()
@@ -489,7 +490,7 @@ def _format_student_exception(function: str, info: dict) -> str:
 
 
 def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
-    base = os.environ.get("GEOMLIB_STUBS")
+    base = setting("GEOMLIB_STUBS")
     stubs = Path(base) / lab if base else _course_root() / "labs" / lab
     if not stubs.is_dir() or stubs.resolve() == lab_dir.resolve():
         return None

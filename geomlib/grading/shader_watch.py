@@ -17,13 +17,14 @@ import re
 import stat
 from pathlib import Path
 
+from geomlib.taskref import find_task
+
 __all__ = ["NOTE", "install", "read", "timeout_message"]
 
 #: File name of the note in the call's scratch folder.
 NOTE = ".geomlib-running-shader"
 
 _NAME = re.compile(r"[A-Za-z0-9_./ -]{1,200}\.(?:frag|vert|glsl)")
-_TASK = re.compile(r"Task (\d+[a-z]?)\b(?:\s*\(([^)\n]{1,80})\))?")
 
 
 def install(scratch: str | None) -> None:
@@ -73,11 +74,9 @@ def _task_of(name: str, folders: list[Path]) -> str | None:
             text = (folder / name).read_text(encoding="utf-8", errors="replace")[:200_000]
         except (OSError, ValueError):
             continue
-        marks = _TASK.findall(text)
-        if marks:
-            titled = [m for m in marks if m[1]]
-            n, title = (titled or marks)[0]
-            return f"Task {n}" + (f" ({title.strip()})" if title else "")
+        m = find_task(text, titled=True) or find_task(text)
+        if m:
+            return f"Task {m.label}" + (f" ({m.title.strip()})" if m.title else "")
     return None
 
 

@@ -18,18 +18,16 @@ hand-written test).
 from __future__ import annotations
 
 import ast
-import importlib
 import inspect
-import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
+from geomlib.grading.registry import graded_module
+from geomlib.taskref import find_task
 
 __all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
-
-_MARK = re.compile(r"Task (\d+)[a-z]?\s*\(([^)]*)\)")
 
 
 @dataclass
@@ -158,9 +156,9 @@ def _marks(lines) -> list[tuple[int, str]]:
     """``(task, title)`` of the task markers among ``lines`` (Python or GLSL, solution or stub)."""
     out = []
     for line in lines:
-        m = _MARK.search(line)
+        m = find_task(line, titled=True)
         if m and ("BEGIN SOLUTION" in line or "NotImplementedError" in line or "#error" in line):
-            out.append((int(m.group(1)), m.group(2).strip()))
+            out.append((m.number, m.title.strip()))
     return out
 
 
@@ -174,12 +172,7 @@ def _lab_module_aliases(tree) -> set[str]:
 
 
 def _declared(lab: str):
-    tests = str(_impl.tests_dir())
-    if tests not in sys.path:
-        sys.path.insert(0, tests)
-    if not (_impl.tests_dir() / "graded" / lab / "diagnose.py").is_file():
-        return None
-    return importlib.import_module(f"graded.{lab}.diagnose")
+    return graded_module(lab, "diagnose")
 
 
 def table(lab: str) -> TaskTable:

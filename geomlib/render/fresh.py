@@ -46,7 +46,7 @@ def _server():
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
     err = tempfile.TemporaryFile()  # a file, not a pipe: a chatty stderr cannot block the server
     proc = subprocess.Popen(
-        [sys.executable, "-c", "from geomlib.render.fresh import _serve; _serve()"],
+        [sys.executable, "-c", "from geomlib.render.fresh_server import serve; serve()"],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=err,
@@ -108,24 +108,3 @@ def render_in_fresh_process(entry: str, V, F, options, overrides: dict) -> np.nd
     if status == "error":
         raise value
     return value
-
-
-def _serve() -> None:  # pragma: no cover - runs in the fresh process (tested through render)
-    """Answer pickled calls from stdin with ``("ok", image)`` or ``("error", exc)`` until stdin closes."""
-    from geomlib.render import draw
-
-    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
-    while True:
-        try:
-            entry, V, F, options, overrides = _receive(stdin)
-        except EOFError:
-            return
-        try:
-            out = ("ok", getattr(draw, entry)(V, F, options, **overrides))
-        except Exception as e:
-            out = ("error", e)
-        try:
-            data = _pickled(out)
-        except Exception:  # an exception that does not pickle: keep its type's name and message
-            data = _pickled(("error", RuntimeError(f"{type(out[1]).__name__}: {out[1]}")))
-        _send(stdout, data)

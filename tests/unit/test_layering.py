@@ -78,48 +78,45 @@ def test_the_grading_tooling_imports_without_pytest():
     assert p.stdout.strip() == "ok True"
 
 
-def _module_level_imports(path: Path, name: str, known: set[str]) -> set[str]:
-    """The modules of ``known`` that module ``name`` (file ``path``) imports when it is imported:
-    its top-level imports, in ``try``/``if`` blocks too, but not under ``if TYPE_CHECKING`` and not
-    inside functions (a lazy import runs later and cannot close a cycle at import time)."""
+def _imports(path: Path, name: str, known: set[str]) -> set[str]:
+    """The modules of ``known`` that module ``name`` (file ``path``) imports, anywhere: at the top,
+    in ``try``/``if`` blocks and inside functions too (a function-level import that closes a cycle
+    only hides it: the two modules still need each other), but not under ``if TYPE_CHECKING``."""
     import ast
 
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     out = set()
 
-    def visit(stmts):
-        for s in stmts:
-            if isinstance(s, ast.If) and "TYPE_CHECKING" in ast.unparse(s.test):
-                visit(s.orelse)
-            elif isinstance(s, (ast.If, ast.Try)):
-                visit(s.body)
-                visit(getattr(s, "orelse", []))
-                for h in getattr(s, "handlers", []):
-                    visit(h.body)
-                visit(getattr(s, "finalbody", []))
-            elif isinstance(s, ast.Import):
-                out.update(a.name for a in s.names)
-            elif isinstance(s, ast.ImportFrom):
-                base = s.module or ""
-                if s.level:
-                    parts = package.split(".")
-                    base = ".".join(parts[: len(parts) - s.level + 1] + ([s.module] if s.module else []))
-                for a in s.names:
-                    out.add(f"{base}.{a.name}" if f"{base}.{a.name}" in known else base)
+    def visit(node):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            for s in node.orelse:
+                visit(s)
+            return
+        if isinstance(node, ast.Import):
+            out.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[: len(parts) - node.level + 1] + ([node.module] if node.module else []))
+            for a in node.names:
+                out.add(f"{base}.{a.name}" if f"{base}.{a.name}" in known else base)
+        for child in ast.iter_child_nodes(node):
+            visit(child)
 
-    visit(ast.parse(path.read_text(encoding="utf-8")).body)
+    visit(ast.parse(path.read_text(encoding="utf-8")))
     return {m for m in out if m in known and m != name}
 
 
 def import_cycles(root: Path, top: str) -> list[list[str]]:
     """The import cycles among the modules of package ``top`` under ``root`` (strongly connected
-    components of the module-level import graph with more than one module)."""
+    components of the import graph, function-level imports included, with more than one module)."""
     files = {}
     for p in sorted((root / top).rglob("*.py")):
         rel = p.relative_to(root).with_suffix("")
         parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
         files[".".join(parts)] = p
-    graph = {n: _module_level_imports(p, n, set(files)) for n, p in files.items()}
+    graph = {n: _imports(p, n, set(files)) for n, p in files.items()}
     index, low, stack, on, cycles = {}, {}, [], set(), []
 
     def strong(v):  # Tarjan's algorithm
@@ -161,8 +158,10 @@ def test_a_planted_import_cycle_is_found(tmp_path):
     (pkg / "a.py").write_text("from pkg import b\n")
     (pkg / "b.py").write_text("from .c import x\n")
     (pkg / "c.py").write_text("import pkg.a\nx = 1\n")
-    (pkg / "d.py").write_text("def f():\n    from pkg import a  # lazy: no cycle\n")
-    assert import_cycles(tmp_path, "pkg") == [["pkg.a", "pkg.b", "pkg.c"]]
+    (pkg / "d.py").write_text("def f():\n    from pkg import a  # a lazy import of a: no cycle by itself\n")
+    (pkg / "e.py").write_text("def f():\n    from pkg import f  # lazy, but f imports e: a cycle all the same\n")
+    (pkg / "f.py").write_text("from pkg import e\n")
+    assert import_cycles(tmp_path, "pkg") == [["pkg.a", "pkg.b", "pkg.c"], ["pkg.e", "pkg.f"]]
 
 
 #: A module may be longer than this when its docstring says why (issue: "no module over ~600 lines
