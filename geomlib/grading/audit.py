@@ -374,7 +374,12 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
     lines = text.split("\n")
     stmts = [s for s in _walk_no_defs(fn) if isinstance(s, ast.stmt) and _in_block(s, b)]
     params = [a.arg for a in (*fn.args.posonlyargs, *fn.args.args) if a.arg not in ("self", "cls")]
-    inputs = "(" + "".join(f"{p}, " for p in params) + ")"
+    # The inputs as the block sees them at its start (the block may rebind V or F): held in a name
+    # set on the block's first line, inside the block.
+    inputs = f"{_HELPER}_in"
+    indent = re.match(r"\s*", lines[b.start - 1]).group(0)
+    at_start = _offset(lines, b.start + 1, 0)
+    capture = (at_start, at_start, f"{indent}{inputs} = (" + "".join(f"{p}, " for p in params) + ")\n")
     edits = []
     # Returns inside the block give trivial values.
     for s in stmts:
@@ -406,7 +411,6 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
     }
     # Closures read names too (relief's f(k, d)): count loads in nested functions as well.
     read_outside |= {n.id for n in ast.walk(fn) if isinstance(n, ast.Name) and not (b.start < n.lineno < b.end)}
-    indent = re.match(r"\s*", lines[b.start - 1]).group(0)
     resets = []
     for name in bound:
         if name in read_outside and name not in changed:
@@ -421,7 +425,7 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
         edits.append((at, at, "\n".join(resets) + "\n"))
     if not edits:
         return [], "the block has no result the function uses"
-    return edits, ""
+    return [capture, *edits], ""
 
 
 def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
