@@ -789,6 +789,29 @@ def audit(
                     return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
 
                 reqs.append({"prepare": prepare, "mutant": m})
+        # Which tests run each block: a probe copy raises at the block's first line; the tests it
+        # fails are the ones that reach the block (measured through the same grading path).
+        probes, covered = [], {}  # covered: (lab, file, line) -> names of the tests that run the block
+        for key in dict.fromkeys((r["mutant"].lab, r["mutant"].file, r["mutant"].line, r["mutant"].task)
+                                 for r in reqs if r["mutant"].kind == "nothing"):  # fmt: skip
+            d = work / f"probe-{len(probes)}"
+
+            def prepare_probe(key=key, d=d):
+                lab, file, line, task = key
+                _copy_lab(root / "solutions" / lab, d / lab)
+                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line))
+                return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
+
+            probes.append({"prepare": prepare_probe, "key": key})
+
+        def probe_done(i, r, res):
+            shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
+            if res.get("ok"):
+                covered[probes[i]["key"][:3]] = {t["name"] for t in res["tests"] if not t["passed"]}
+
+        if progress and probes:
+            sys.stderr.write(f"finding the tests that run each block ({len(probes)} probe runs)...\n")
+        pool.run(probes, probe_done)
         prog = _Progress(len(reqs)) if progress else None
         rows: dict[int, dict] = {}
 
@@ -807,7 +830,7 @@ def audit(
             elif m.kind == "nothing":
                 status = "killed" if got == 0 else ("partly killed" if got < full else "survived")
                 task_status = status
-                own = _own_tests(res, m.function, runs_of[m.lab])
+                own = _own_tests(res, m.function, runs_of[m.lab], covered.get((m.lab, m.file, m.line)))
                 if own:  # the rule: the tests that run the block's function score 0
                     own_got, own_top = sum(t["score"] for t in own), sum(t["max"] for t in own)
                     status = "killed" if own_got == 0 else ("partly killed" if own_got < own_top else "survived")
@@ -865,8 +888,20 @@ def audit(
     return report
 
 
-def _own_tests(res: dict, function: str, runs: dict) -> list[dict]:
-    """The graded tests of a mutant's run that run ``function`` (directly or through a composite)."""
+def _probe_source(text: str, line: int) -> str:
+    """``text`` with a ``raise`` as the first statement of the block whose BEGIN marker is on ``line``."""
+    lines = text.split("\n")
+    indent = re.match(r"\s*", lines[line - 1]).group(0)
+    lines.insert(line, f'{indent}raise RuntimeError("geomlib audit: probe (this block runs)")')
+    return "\n".join(lines)
+
+
+def _own_tests(res: dict, function: str, runs: dict, covered: set | None = None) -> list[dict]:
+    """The point-carrying tests of a mutant's run that run its block: the ones its block's probe
+    failed (``covered``), else (no probe result) the ones that call ``function``, directly or
+    through a composite."""
+    if covered is not None:
+        return [t for t in res.get("tests", []) if t["max"] > 0 and t["name"] in covered]
     if not function:
         return []
     return [
