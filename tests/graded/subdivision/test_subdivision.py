@@ -280,6 +280,11 @@ def test_planar_mesh_stays_planar(lab):
         )
         # Positive weights on a flat grid keep every triangle proper and facing the input's way.
         V3, F3 = np.asarray(V3, float), np.asarray(F3)
+        if F3.shape != (64 * len(F), 3):
+            raise Mismatch(
+                f"loop_subdivide(flat grid, 3, {weights!r}): F has shape {F3.shape}, expected ({64 * len(F)}, 3): "
+                "each level splits every triangle in 4"
+            )
         z = np.cross(V3[F3[:, 1]] - V3[F3[:, 0]], V3[F3[:, 2]] - V3[F3[:, 0]])[:, 2] * up[0]
         if not (z > 1e-12).all():
             raise Mismatch(
