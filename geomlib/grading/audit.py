@@ -5,8 +5,11 @@ Each mutant is graded through the real grading path (``geomlib grade --impl COPY
 sandboxed workers, the course's stubs merged in, public and hidden tests) on the graded tests of the
 block's task, and it is
 
-- *killed* when it loses points there (a *does-nothing* mutant is only counted killed when it
-  scores 0 on that task; one that keeps some points is reported as *partly killed*);
+- *killed* when it loses points there (a *does-nothing* mutant is only counted killed when the
+  tests that run its block score 0; one that keeps some of their points is reported as *partly
+  killed*). The tests that run a block are measured: a *probe* copy raises at the block's first
+  line, and the tests it fails are the block's (without a probe result: the tests that call the
+  block's function or a composite of it). The row keeps the per-task verdict as ``task_status``;
 - *survived* otherwise: the tests cannot tell it from the reference solution;
 - *equivalent* when ``tests/graded/<lab>/equivalent_mutants.toml`` declares it so, with a reason
   (an equivalent mutant that a test kills is an error of the declaration).
