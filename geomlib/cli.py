@@ -175,7 +175,7 @@ def _cmd_audit(a) -> int:
     from geomlib.grading import audit
 
     try:
-        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs)
+        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs, kind=a.kind, sample=a.sample)
     except audit.AuditError as e:
         print(f"geomlib audit: error: {e}", file=sys.stderr)
         return 1
@@ -314,6 +314,8 @@ def build_parser() -> argparse.ArgumentParser:
     au.add_argument("--lab", action="append", help="only this lab (repeatable; default: every lab)")
     au.add_argument("--quick", action="store_true", help="a fixed sample of a few mutants per lab (for CI)")
     au.add_argument("--jobs", type=int, default=1, help="mutants graded at once (default 1)")
+    au.add_argument("--kind", choices=("nothing", "operator"), help="only does-nothing or only operator mutants")
+    au.add_argument("--sample", type=int, help="a fixed, seeded sample of N mutants per lab (of --kind)")
     au.add_argument("--out", help="also write audit.md and audit.json into this folder")
     au.set_defaults(func=_cmd_audit)
     return p

@@ -5,8 +5,11 @@ Each mutant is graded through the real grading path (``geomlib grade --impl COPY
 sandboxed workers, the course's stubs merged in, public and hidden tests) on the graded tests of the
 block's task, and it is
 
-- *killed* when it loses points there (a *does-nothing* mutant is only counted killed when it
-  scores 0 on that task; one that keeps some points is reported as *partly killed*);
+- *killed* when it loses points there (a *does-nothing* mutant is only counted killed when the
+  tests that run its block score 0; one that keeps some of their points is reported as *partly
+  killed*). The tests that run a block are measured: a *probe* copy raises at the block's first
+  line, and the tests it fails are the block's (without a probe result: the tests that call the
+  block's function or a composite of it). The row keeps the per-task verdict as ``task_status``;
 - *survived* otherwise: the tests cannot tell it from the reference solution;
 - *equivalent* when ``tests/graded/<lab>/equivalent_mutants.toml`` declares it so, with a reason
   (an equivalent mutant that a test kills is an error of the declaration).
@@ -87,6 +90,7 @@ class Mutant:
     kind: str  # "nothing" or "operator"
     op: str  # "zeros", "+ → -", "3 → 6", ...
     diff: str  # "- old line" / "+ new line", one line each
+    function: str = ""  # the module-level function that holds the block
     source: str = field(repr=False, default="")
 
 
@@ -373,7 +377,12 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
     lines = text.split("\n")
     stmts = [s for s in _walk_no_defs(fn) if isinstance(s, ast.stmt) and _in_block(s, b)]
     params = [a.arg for a in (*fn.args.posonlyargs, *fn.args.args) if a.arg not in ("self", "cls")]
-    inputs = "(" + "".join(f"{p}, " for p in params) + ")"
+    # The inputs as the block sees them at its start (the block may rebind V or F): held in a name
+    # set on the block's first line, inside the block.
+    inputs = f"{_HELPER}_in"
+    indent = re.match(r"\s*", lines[b.start - 1]).group(0)
+    at_start = _offset(lines, b.start + 1, 0)
+    capture = (at_start, at_start, f"{indent}{inputs} = (" + "".join(f"{p}, " for p in params) + ")\n")
     edits = []
     # Returns inside the block give trivial values.
     for s in stmts:
@@ -405,7 +414,6 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
     }
     # Closures read names too (relief's f(k, d)): count loads in nested functions as well.
     read_outside |= {n.id for n in ast.walk(fn) if isinstance(n, ast.Name) and not (b.start < n.lineno < b.end)}
-    indent = re.match(r"\s*", lines[b.start - 1]).group(0)
     resets = []
     for name in bound:
         if name in read_outside and name not in changed:
@@ -420,7 +428,7 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
         edits.append((at, at, "\n".join(resets) + "\n"))
     if not edits:
         return [], "the block has no result the function uses"
-    return edits, ""
+    return [capture, *edits], ""
 
 
 def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
@@ -448,6 +456,8 @@ def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[
             texts[b.file] = (text, ast.parse(text))
         text, tree = texts[b.file]
         edits, why = _nothing_edits(text, tree, b)
+        chain = _enclosing(tree, b)
+        fname = chain[0].name if chain else ""
         if not edits:
             notes.append(f"{b.file}:{b.start} (Task {b.task}): {why}")
         for mode in NOTHING_MODES if edits else ():
@@ -457,7 +467,7 @@ def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[
             if mode == "input":
                 diff = f"- (block at line {b.start + 1}: its results)\n+ the function's input of the same kind (else zeros)"
             mid = f"{b.file}:{b.start}:nothing-{mode}"
-            out.append(Mutant(mid, lab, b.file, b.start, b.task, b.title, "nothing", mode, diff, src))
+            out.append(Mutant(mid, lab, b.file, b.start, b.task, b.title, "nothing", mode, diff, fname, src))
         for a, z, new, label, line, col in _operator_edits(text, tree, b):
             src = _apply(text, [(a, z, new)])
             if src in seen or src == text:
@@ -471,7 +481,7 @@ def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[
             k = 2
             while any(m.id == mid for m in out):
                 mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
-            out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), src))
+            out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), fname, src))
     return out, notes
 
 
@@ -484,6 +494,15 @@ def quick_sample(mutants: list[Mutant], lab: str, n: int = QUICK_PER_LAB) -> lis
     pick += rng.sample(ops, min(len(ops), n - len(pick)))
     order = {m.id: i for i, m in enumerate(mutants)}
     return sorted(pick, key=lambda m: order[m.id])
+
+
+def sample_mutants(mutants: list[Mutant], lab: str, n: int) -> list[Mutant]:
+    """A fixed sample of ``n`` of ``mutants`` (seeded by the lab's name: the same ones every run), in order."""
+    if n >= len(mutants):
+        return list(mutants)
+    rng = random.Random(zlib.crc32(f"sample:{lab}".encode()))
+    pick = {m.id for m in rng.sample(mutants, n)}
+    return [m for m in mutants if m.id in pick]
 
 
 # ---------------------------------------------------------------------------------- equivalent mutants
@@ -516,10 +535,38 @@ def equivalents(lab: str) -> dict[str, str]:
 # ---------------------------------------------------------------------------------- grading
 
 
+#: ``{pytest node id: lab functions the test calls}``, filled by the hook below while the worker grades.
+_CALLS: dict[str, list[str]] = {}
+
+
+def pytest_collection_modifyitems(session, config, items):
+    """Pytest hook (the worker passes ``-p geomlib.grading.audit``): which lab functions each graded
+    test calls, as the grader reads them (``Case.function``, ``lab.name(...)`` in a hand-written test)."""
+    from geomlib.grading import plugin, tasks
+
+    tables: dict = {}
+    for item in items:
+        lab = plugin._lab_of(item.path)
+        if lab is None:
+            continue
+        callspec = getattr(item, "callspec", None)
+        case = callspec.params.get("case") if callspec is not None else None
+        if case is not None and hasattr(case, "function"):
+            names = [case.function]
+        else:
+            if lab not in tables:
+                tables[lab] = tasks.table(lab)
+            names = tasks._lab_calls(item.function)
+            names += [n for n in tasks._named_functions(item.function, tables[lab]) if n not in names]
+        _CALLS[item.nodeid] = names
+
+
 def _worker_main() -> int:
     """``python -m geomlib.grading.audit --worker``: grade requests (JSON lines on stdin), one per line out."""
     reply = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # anything else written to stdout goes to the log, not into the replies
+    from geomlib.grading import audit as registered  # the module pytest loads with -p (this one is __main__)
+    from geomlib.grading import plugin
     from geomlib.grading.grade import grade
 
     for line in sys.stdin:
@@ -527,11 +574,16 @@ def _worker_main() -> int:
         t = time.time()
         os.environ["GEOMLIB_TIME_BUDGET"] = str(req.get("budget") or "")
         try:
-            data = grade(req["impl"], [req["lab"]], task=req["task"], feedback_dir="")
+            registered._CALLS.clear()
+            data = grade(
+                req["impl"], [req["lab"]], task=req["task"], feedback_dir="", extra_args=["-p", "geomlib.grading.audit"]
+            )
+            ids = [r.nodeid for r in plugin.RECORDS]
+            ids = ids if len(ids) == len(data["tests"]) else [""] * len(data["tests"])
             tests = [
                 {"name": x["name"], "score": x["score"], "max": x["max_score"], "passed": x["status"] == "passed",
-                 "output": x.get("output", "")[:300]}
-                for x in data["tests"]
+                 "output": x.get("output", "")[:300], "calls": registered._CALLS.get(nid, [])}
+                for x, nid in zip(data["tests"], ids, strict=True)
             ]  # fmt: skip
             out = {"ok": True, "tests": tests}
         except BaseException as e:  # noqa: BLE001  (the audit keeps going; the mutant's row says what happened)
@@ -648,8 +700,15 @@ def audit(
     jobs: int = 1,
     progress: bool = True,
     log=print,
+    kind: str | None = None,
+    sample: int | None = None,
 ) -> dict:
-    """Grade the mutants of each lab; returns the report as a dict (see :func:`markdown`)."""
+    """Grade the mutants of each lab; returns the report as a dict (see :func:`markdown`).
+
+    ``kind`` (``"nothing"`` or ``"operator"``) keeps one kind of mutant; ``sample`` grades a fixed,
+    seeded sample of that many mutants per lab (after ``kind``)."""
+    from geomlib.grading import tasks as _tasks
+
     names = labs or _impl.lab_names()
     known = _impl.lab_names()
     unknown = [n for n in names if n not in known]
@@ -659,7 +718,10 @@ def audit(
     work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
     os.chmod(work, 0o755)
     t_start = time.time()
-    report: dict = {"labs": {}, "quick": quick, "jobs": jobs}
+    report: dict = {"labs": {}, "quick": quick, "jobs": jobs, "kind": kind, "sample": sample}
+    if kind not in (None, "nothing", "operator"):
+        raise AuditError(f"unknown mutant kind {kind!r}: 'nothing' or 'operator'")
+    runs_of: dict[str, dict] = {}  # lab -> {function: every lab function a call of it runs}
     pool = _Pool(max(1, jobs), work)
     try:
         plan = []  # (lab, mutant)
@@ -668,8 +730,15 @@ def audit(
             eq = equivalents(lab)
             ids = {m.id for m in muts}
             stale = [i for i in eq if i not in ids]
+            total = len(muts)
+            if kind:
+                muts = [m for m in muts if m.kind == kind]
             if quick:
                 muts = quick_sample(muts, lab)
+            elif sample:
+                muts = sample_mutants(muts, lab, sample)
+            tab = _tasks.derive(root / "solutions" / lab)
+            runs_of[lab] = {f: {f, *tab.composites.get(f, ())} for f in {*tab.tasks, *tab.composites}}
             tasks = sorted({m.task for m in muts})
             report["labs"][lab] = {
                 "notes": notes,
@@ -679,6 +748,7 @@ def audit(
                 "mutants": [],
                 "baseline": {},
                 "errors": [],
+                "generated": total,
             }
             plan.append((lab, muts, tasks))
         # Baseline: the unchanged solution, graded task by task the same way. --quick skips it (the
@@ -722,6 +792,29 @@ def audit(
                     return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
 
                 reqs.append({"prepare": prepare, "mutant": m})
+        # Which tests run each block: a probe copy raises at the block's first line; the tests it
+        # fails are the ones that reach the block (measured through the same grading path).
+        probes, covered = [], {}  # covered: (lab, file, line) -> names of the tests that run the block
+        for key in dict.fromkeys((r["mutant"].lab, r["mutant"].file, r["mutant"].line, r["mutant"].task)
+                                 for r in reqs if r["mutant"].kind == "nothing"):  # fmt: skip
+            d = work / f"probe-{len(probes)}"
+
+            def prepare_probe(key=key, d=d):
+                lab, file, line, task = key
+                _copy_lab(root / "solutions" / lab, d / lab)
+                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line))
+                return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
+
+            probes.append({"prepare": prepare_probe, "key": key})
+
+        def probe_done(i, r, res):
+            shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
+            if res.get("ok"):
+                covered[probes[i]["key"][:3]] = {t["name"] for t in res["tests"] if not t["passed"]}
+
+        if progress and probes:
+            sys.stderr.write(f"finding the tests that run each block ({len(probes)} probe runs)...\n")
+        pool.run(probes, probe_done)
         prog = _Progress(len(reqs)) if progress else None
         rows: dict[int, dict] = {}
 
@@ -730,6 +823,8 @@ def audit(
             shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
             lr = report["labs"][m.lab]
             got, top = _score(res)
+            own: list[dict] = []  # a does-nothing mutant's tests that run the block's function
+            task_status = None  # the old rule for does-nothing mutants: killed when the whole task scores 0
             full = lr["baseline"][m.task]["score"] if m.task in lr["baseline"] else top
             if not res.get("ok"):
                 status = "error"
@@ -737,8 +832,14 @@ def audit(
                 status = "survived"  # no graded test of the task at all
             elif m.kind == "nothing":
                 status = "killed" if got == 0 else ("partly killed" if got < full else "survived")
+                task_status = status
+                own = _own_tests(res, m.function, runs_of[m.lab], covered.get((m.lab, m.file, m.line)))
+                if own:  # the rule: the tests that run the block's function score 0
+                    own_got, own_top = sum(t["score"] for t in own), sum(t["max"] for t in own)
+                    status = "killed" if own_got == 0 else ("partly killed" if own_got < own_top else "survived")
             else:
                 status = "killed" if got < full else "survived"
+            task_status = task_status or status
             eq = lr["equivalent_declared"].get(m.id)
             if eq is not None:
                 status = "equivalent" if status == "survived" else f"ERROR: declared equivalent but {status}"
@@ -753,6 +854,16 @@ def audit(
                 "why": failure,
                 "by_time": timeout,
             }
+            if m.kind == "nothing":
+                row["task_status"] = task_status
+                row["own_tests"] = len(own) if own else 0
+                row["own_score"] = sum(t["score"] for t in own) if own else None
+                row["own_max"] = sum(t["max"] for t in own) if own else None
+                row["kept_points"] = [
+                    f"{t['name']} ({t['score']:g}/{t['max']:g})"
+                    for t in (own or res.get("tests", []))
+                    if t["score"] > 0
+                ]
             if eq is not None:
                 row["reason"] = eq
             rows[i] = row
@@ -780,15 +891,39 @@ def audit(
     return report
 
 
+def _probe_source(text: str, line: int) -> str:
+    """``text`` with a ``raise`` as the first statement of the block whose BEGIN marker is on ``line``."""
+    lines = text.split("\n")
+    indent = re.match(r"\s*", lines[line - 1]).group(0)
+    lines.insert(line, f'{indent}raise RuntimeError("geomlib audit: probe (this block runs)")')
+    return "\n".join(lines)
+
+
+def _own_tests(res: dict, function: str, runs: dict, covered: set | None = None) -> list[dict]:
+    """The point-carrying tests of a mutant's run that run its block: the ones its block's probe
+    failed (``covered``), else (no probe result) the ones that call ``function``, directly or
+    through a composite."""
+    if covered is not None:
+        return [t for t in res.get("tests", []) if t["max"] > 0 and t["name"] in covered]
+    if not function:
+        return []
+    return [
+        t
+        for t in res.get("tests", [])
+        if t["max"] > 0 and any(function in runs.get(c, {c}) for c in t.get("calls", []))
+    ]
+
+
 def _task_summary(lr: dict) -> dict:
     out: dict = {}
     for r in lr["mutants"]:
         t = out.setdefault(
             str(r["task"]),
             {"title": r["title"], "mutants": 0, "killed": 0, "survived": 0, "equivalent": 0, "nothing": 0,
-             "nothing_killed": 0, "operators": 0, "operators_killed": 0, "by_time": 0},
+             "nothing_killed": 0, "nothing_task_zero": 0, "operators": 0, "operators_killed": 0, "by_time": 0},
         )  # fmt: skip
         t["mutants"] += 1
+        t["nothing_task_zero"] += r.get("task_status") == "killed"
         kind = "nothing" if r["kind"] == "nothing" else "operators"
         t[kind] += 1
         if r["status"] == "killed":
@@ -808,13 +943,24 @@ def _pct(k: int, n: int) -> str:
 
 def markdown(report: dict) -> str:
     """The report as Markdown: one table per lab (a row per task), then every survivor with its diff."""
-    out = [f"# Mutation audit{' (quick sample)' if report.get('quick') else ''}", ""]
+    what = " (quick sample)" if report.get("quick") else ""
+    if report.get("sample") and not report.get("quick"):
+        what = f" (a seeded sample of {report['sample']} mutants per lab)"
+    if report.get("kind"):
+        what += f", {report['kind']} mutants only"
+    out = [f"# Mutation audit{what}", ""]
     out.append(f"{report.get('seconds', 0):.0f} s with {report.get('jobs', 1)} job(s).")
     out.append("")
     out.append(
-        "| lab | task | mutants | killed | survived | equivalent | does-nothing killed | operators killed | operator score |"
+        "A does-nothing mutant is killed when the tests that run its block's function score 0; "
+        "*whole task 0* counts the ones whose whole task scores 0."
     )
-    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|")
+    out.append("")
+    out.append(
+        "| lab | task | mutants | killed | survived | equivalent | does-nothing killed | whole task 0 "
+        "| operators killed | operator score |"
+    )
+    out.append("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for lab, lr in report["labs"].items():
         for t, s in lr["tasks"].items():
             ops_n = s["operators"] - sum(
@@ -824,15 +970,18 @@ def markdown(report: dict) -> str:
             )
             out.append(
                 f"| {lab} | {t} ({s['title']}) | {s['mutants']} | {s['killed']} | {s['survived']} | {s['equivalent']} "
-                f"| {s['nothing_killed']}/{s['nothing']} | {s['operators_killed']}/{s['operators']} "
+                f"| {s['nothing_killed']}/{s['nothing']} | {s['nothing_task_zero']}/{s['nothing']} "
+                f"| {s['operators_killed']}/{s['operators']} "
                 f"| {_pct(s['operators_killed'], ops_n)} |"
             )
         ops = [r for r in lr["mutants"] if r["kind"] == "operator" and r["status"] != "equivalent"]
         k = sum(r["status"] == "killed" for r in ops)
         nothing = [r for r in lr["mutants"] if r["kind"] == "nothing"]
         kn = sum(r["status"] == "killed" for r in nothing)
+        kt = sum(r.get("task_status") == "killed" for r in nothing)
         out.append(
-            f"| **{lab}** | **all** | **{len(lr['mutants'])}** | | | | **{kn}/{len(nothing)}** | **{k}/{len(ops)}** "
+            f"| **{lab}** | **all** | **{len(lr['mutants'])}** | | | | **{kn}/{len(nothing)}** | {kt}/{len(nothing)} "
+            f"| **{k}/{len(ops)}** "
             f"| **{_pct(k, len(ops))}** |"
         )
     for lab, lr in report["labs"].items():
@@ -845,7 +994,11 @@ def markdown(report: dict) -> str:
             for r in surv:
                 d = r["diff"].replace("\n", " ⟶ ")
                 what = f" ({r['score']:g}/{r['max']:g} points kept)" if r["status"] == "partly killed" else ""
+                if r["kind"] == "nothing" and r.get("own_max"):
+                    what = f" ({r['own_score']:g}/{r['own_max']:g} points kept by the tests of `{r['function']}`)"
                 out.append(f"- Task {r['task']} `{r['id']}`{what}: `{d}`")
+                if r.get("kept_points"):
+                    out.append(f"  kept by: {'; '.join(r['kept_points'][:4])}")
         if lr["notes"]:
             out += ["", f"## {lab}: not mutated", ""]
             out += [f"- {n}" for n in lr["notes"]]

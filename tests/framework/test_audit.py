@@ -126,9 +126,13 @@ def test_audit_quick_reports_a_planted_weak_test(two_lab_course, tmp_path):
     # The planted weak test: the midpoints can be anything, so doing nothing survives...
     weak = by_id["weak"]["ops.py:41:nothing-zeros"]
     assert weak["status"] == "survived" and weak["score"] == weak["max"] > 0, weak
+    # ...judged by the tests that run the block (found by its probe run), whose points it keeps.
+    assert weak["own_tests"] >= 1 and weak["own_score"] == weak["own_max"] > 0, weak
+    assert weak["kept_points"] and weak["task_status"] == "survived", weak
     assert "| weak | 2 (midpoints) |" in md and "ops.py:41:nothing-zeros" in md.split("## weak")[1]
     # ...while the intact tests kill the same mutant.
-    assert by_id["sample"]["ops.py:41:nothing-zeros"]["status"] == "killed"
+    intact = by_id["sample"]["ops.py:41:nothing-zeros"]
+    assert intact["status"] == "killed" and intact["own_tests"] >= 1 and intact["own_score"] == 0, intact
     # A declared-equivalent mutant that a test kills, and a declaration naming no mutant, are errors.
     errors = "\n".join(data["labs"]["sample"]["errors"])
     assert "ops.py:22:nothing-zeros: ERROR: declared equivalent but killed" in errors, errors
@@ -137,3 +141,22 @@ def test_audit_quick_reports_a_planted_weak_test(two_lab_course, tmp_path):
     # Deterministic sample: the same mutants every run.
     again = [m.id for m in audit.quick_sample(audit.generate("weak", two_lab_course / "solutions" / "weak")[0], "weak")]
     assert again == [r["id"] for r in data["labs"]["weak"]["mutants"]]
+
+
+def test_does_nothing_is_judged_by_the_tests_that_run_the_block():
+    """A does-nothing mutant's own tests are the ones its block's probe failed (not the whole
+    task's); without a probe result, the tests that call the block's function or a composite of it."""
+    src = "def f(x):\n    y = 1\n    # BEGIN SOLUTION: Task 1 (t): x\n    return x\n    # END SOLUTION\n"
+    probe = audit._probe_source(src, 3)
+    assert probe.split("\n")[3] == '    raise RuntimeError("geomlib audit: probe (this block runs)")'
+    compile(probe, "f.py", "exec")
+    res = {"tests": [
+        {"name": "a", "score": 0, "max": 2, "calls": ["f"]},
+        {"name": "b", "score": 1, "max": 1, "calls": ["g"]},  # another function of the task: not f's test
+        {"name": "c", "score": 1, "max": 1, "calls": ["whole"]},  # a composite that runs f
+        {"name": "d", "score": 0, "max": 0, "calls": ["f"]},  # no points: cannot tell
+    ]}  # fmt: skip
+    runs = {"whole": {"whole", "f"}}
+    assert [t["name"] for t in audit._own_tests(res, "f", runs)] == ["a", "c"]
+    assert [t["name"] for t in audit._own_tests(res, "f", runs, covered={"a", "d"})] == ["a"]
+    assert audit._own_tests(res, "f", runs, covered=set()) == []

@@ -225,9 +225,16 @@ def test_lambert_by_hand(lab):
 
 @graded(points=1, part="shading")
 def test_flat_normal_map_changes_nothing(lab):
-    """a normal map full of (0, 0, 1) gives the same image as no normal map"""
+    """a normal map full of (0, 0, 1) gives the same image as no normal map (a lit quad with a highlight)"""
     g, eye = quad_gbuffer(16)
     plain = lab.shade(g, LIGHT, eye, (0.7, 0.7, 0.7))
+    img = np.asarray(plain, float)
+    if not (img.size and np.isfinite(img).all() and img.max() > 0.1 and np.ptp(img) > 0.01):
+        raise Mismatch(
+            "shade without a normal map: the quad faces the light, so it is lit, and the specular highlight "
+            f"varies across it; got values from {np.nanmin(img) if img.size else 'nothing'} to "
+            f"{np.nanmax(img) if img.size else 'nothing'}"
+        )
     flat = lab.shade(g, LIGHT, eye, (0.7, 0.7, 0.7), np.tile([0.0, 0.0, 1.0], (4, 4, 1)))
     expect_map_close(
         "shade with a flat normal map vs without", flat, plain, atol=1e-5, hint="tangent space (0, 0, 1) is N'"
@@ -272,10 +279,18 @@ def test_constant_map_by_hand(lab):
 
 @graded(points=1, part="displacement")
 def test_seam_copies_move_together(lab):
-    """UV sphere with a random map: vertices that share a position still share it after displacement"""
+    """UV sphere with a random map: vertices that share a position still share it after displacement, each moved by at most lam"""
     V, F, UV = datasets.uv_sphere(8, 16)
     H = np.random.default_rng(1).random((16, 16))
     Vd = np.asarray(lab.displace(V, F, UV, None, H, lam=0.2), float)
+    if Vd.shape != V.shape:
+        raise Mismatch(f"displace: got shape {Vd.shape}, expected {V.shape} (one position per vertex)")
+    step = np.linalg.norm(Vd - V, axis=1)
+    if not (step.max() <= 0.2 + 1e-9 and step.max() > 0.02):
+        raise Mismatch(
+            f"displace(lam=0.2) with heights in [0, 1]: vertices moved between {step.min():.3g} and {step.max():.3g}; "
+            "each moves lam h <= 0.2 along its normal, and the random map moves some of them"
+        )
     key = np.round(V, 9)
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
     gaps = np.linalg.norm(Vd - Vd[first][inv.ravel()], axis=1)

@@ -199,7 +199,7 @@ def test_no_acne_with_default_bias(lab):
 
 @graded(points=1, part="culling")
 def test_cull_one_triangle(lab):
-    """a triangle facing the light is dropped by cull='front' and kept by cull='back'"""
+    """a triangle facing the light is dropped by cull='front' and kept, unchanged, by cull='back'"""
     V = square(0.5)
     M = ortho_light((0, 0, -1), UNIT)
     front = np.asarray(lab.cull_faces(V, SQUARE_F[:1], M, "front")).reshape(-1, 3)
@@ -207,6 +207,9 @@ def test_cull_one_triangle(lab):
     if len(front) != 0 or len(back) != 1:
         fail(f"the square faces the light (counter-clockwise seen from it): cull='front' kept {len(front)} faces "
              f"(expected 0), cull='back' kept {len(back)} (expected 1). Front-facing <=> det([x, y, w] of the corners) > 0")  # fmt: skip
+    if back.tolist() != np.asarray(SQUARE_F[:1]).tolist():
+        fail(f"cull='back' kept the face {back.tolist()}, expected the input's own face {np.asarray(SQUARE_F[:1]).tolist()} "
+             "(culling returns the rows of F it keeps, unchanged)")  # fmt: skip
 
 
 @graded(points=1, part="culling")

@@ -163,7 +163,7 @@ def test_placement_linear_neighbourhood_searches_the_segment(lab):
 
 @graded(points=1, part="placement")
 def test_placement_batched_equals_one_by_one(lab):
-    """k pairs at once give the same answers as k single calls (regular, flat and linear mixed)"""
+    """k pairs at once give the same answers as k single calls (regular, flat and linear mixed); cost = quadric error at p"""
     Q = np.concatenate(
         [random_quadrics(4, seed=3) + 0.1 * np.eye(4), [planes([0, 0, 1, 0])], [planes([1, 0, 0, 0], [0, 1, 0, 0])]]
     )
@@ -179,6 +179,15 @@ def test_placement_batched_equals_one_by_one(lab):
         p1, c1 = lab.optimal_contraction(Q[k], v1[k], v2[k])
         expect_close(f"optimal_contraction: pair {k} alone vs in the batch", pos[k], p1, atol=1e-9, name="position")
         expect_close(f"optimal_contraction: pair {k} alone vs in the batch", cost[k], c1, atol=1e-9, name="cost")
+    # The cost is the quadric error at the position returned: cost = [p, 1]ᵀ Q [p, 1].
+    ph = np.c_[np.asarray(pos, float), np.ones(6)]
+    expect_close(
+        "optimal_contraction: cost vs [p, 1]ᵀ Q [p, 1] at the returned p",
+        np.asarray(cost, float),
+        np.einsum("ki,kij,kj->k", ph, Q, ph),
+        atol=1e-9,
+        name="cost",
+    )
 
 
 # --------------------------------------------------------------------------------------------

@@ -9,6 +9,8 @@ implementation that numbers new vertices differently still passes.
 
 from __future__ import annotations
 
+import numpy as np
+
 from geomlib import datasets
 from geomlib.grading import Case, checks
 from geomlib.grading.cases import stored_input
@@ -86,11 +88,25 @@ def no_vertices(make):
     return inputs
 
 
+def with_unused_vertex(make):
+    """The mesh plus one vertex no face uses (its row of S_even keeps it where it is: weight 1 on itself)."""
+
+    def inputs():
+        d = make()
+        d["V"] = np.vstack([d["V"], [[0.3, 0.2, 0.1]]])
+        return d
+
+    return inputs
+
+
 ODD_HINT = (
     "row i is the new vertex on edge topo.E[i] = (a, b): 3/8 on a and b, 1/8 on the two opposite "
     "vertices (opposite_vertices gives them)"
 )
-EVEN_HINT = "row v: (1 - k u) on v itself and u on each of its k neighbours; u comes from loop_weight(k, weights)"
+EVEN_HINT = (
+    "row v: (1 - k u) on v itself and u on each of its k neighbours; u comes from loop_weight(k, weights); "
+    "a vertex no face uses (k = 0): 1 on itself"
+)
 FACES_HINT = (
     "face f = (v0, v1, v2) with edge vertices m01, m12, m20 becomes (v0, m01, m20), (v1, m12, m01), "
     "(v2, m20, m12), (m01, m12, m20); m01 = n + topo.he_edge[3f]"
@@ -167,7 +183,7 @@ CASES = [
     Case(
         id="even-icosphere-1-loop",
         function="loop_even_matrix",
-        inputs=ico(1),
+        inputs=with_unused_vertex(ico(1)),
         params={"weights": "loop"},
         outputs=("S_even",),
         check=matrix_check("S_even", what_row="row (vertex)"),

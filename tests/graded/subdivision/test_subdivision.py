@@ -53,6 +53,20 @@ def expect_matrix(label: str, got, expected, name: str = "S", mesh=None) -> None
         raise Mismatch(f"{label}: {msg}", picture)
 
 
+def expect_distinct(label: str, V, faces) -> None:
+    """Subdivision makes a new point for every vertex, edge and face: no two vertices of the result coincide."""
+    from scipy.spatial import cKDTree
+
+    V = np.asarray(V, float)
+    d, _ = cKDTree(V).query(V, k=2)
+    same = d[:, 1] <= 1e-9
+    if same.any():
+        raise Mismatch(
+            f"{label}: {int(same.sum())} of {len(V)} vertices sit on another vertex; every new vertex has a place of its own",
+            marked_picture(label, V, faces, V[same], "vertices on top of another"),
+        )
+
+
 def expect_faces(label: str, got, expected, name: str = "F") -> None:
     msg = faces_mismatch(name, np.asarray(expected), got)
     if msg:
@@ -245,12 +259,15 @@ def test_subdivision_matrix_identity(lab):
         raise Mismatch(f"loop_subdivide(..., return_matrix=True): S has shape {S.shape}, expected ({n2}, {len(V)})")
     expect_close("S @ V (return_matrix=True)", S @ V, V2, atol=1e-10, name="S @ V", mesh=(V2, F2))
     expect_close("row sums of S", S.sum(axis=1), np.ones(n2), atol=1e-10, name="row sums", mesh=(V2, F2))
+    expect_distinct("loop_subdivide(icosphere(1), 2)", V2, F2)
 
 
 @graded(points=1, part="several levels")
 def test_planar_mesh_stays_planar(lab):
-    """a flat open grid stays in its plane through three levels (both weight rules)"""
+    """a flat open grid stays in its plane through three levels (both weight rules), every triangle facing up"""
     V, F = datasets.grid_patch(4)
+    up = np.sign(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])[:, 2])
+    assert (up == up[0]).all() and up[0] != 0, "the grid's triangles all face one way"
     for weights in ("warren", "loop"):
         V3, F3 = lab.loop_subdivide(V, F, 3, weights)
         expect_close(
@@ -261,6 +278,20 @@ def test_planar_mesh_stays_planar(lab):
             name="z",
             mesh=(V3, F3),
         )
+        # Positive weights on a flat grid keep every triangle proper and facing the input's way.
+        V3, F3 = np.asarray(V3, float), np.asarray(F3)
+        if F3.shape != (64 * len(F), 3):
+            raise Mismatch(
+                f"loop_subdivide(flat grid, 3, {weights!r}): F has shape {F3.shape}, expected ({64 * len(F)}, 3): "
+                "each level splits every triangle in 4"
+            )
+        z = np.cross(V3[F3[:, 1]] - V3[F3[:, 0]], V3[F3[:, 2]] - V3[F3[:, 0]])[:, 2] * up[0]
+        if not (z > 1e-12).all():
+            raise Mismatch(
+                f"loop_subdivide(flat grid, 3, {weights!r}): {int((z <= 1e-12).sum())} of {len(z)} triangles are "
+                "flat or flipped; refining a flat grid keeps every triangle proper and facing the same way",
+                marked_picture("loop_subdivide(flat grid)", V3, F3, V3[np.unique(F3[z <= 1e-12])], "bad triangles"),
+            )
 
 
 @graded(points=1, part="several levels")
@@ -333,6 +364,19 @@ def test_regular_torus_is_bicubic_bspline(lab):
             f"vertex (worst off by {d.max():.3g}) — check the edge and vertex point rules on regular quads",
             marked_picture("catmull_clark(quad torus)", V1, Q1, missing, "B-spline points with no matching vertex"),
         )
+    # The quads are the cells of the refined (2 nv) x (2 nu) periodic grid of those points.
+    _, j = cKDTree(expected).query(V1)  # vertex of V1 -> index i + 2 nu * r in the refined grid
+    Q1 = np.asarray(Q1)
+    gu, gv = 2 * nu, 2 * nv
+    i, r = np.meshgrid(np.arange(gu), np.arange(gv))
+    cells = np.stack([i + gu * r, (i + 1) % gu + gu * r, (i + 1) % gu + gu * ((r + 1) % gv), i + gu * ((r + 1) % gv)])
+    want = {frozenset(c) for c in cells.reshape(4, -1).T.tolist()}
+    got = {frozenset(q) for q in j[Q1].tolist()} if Q1.ndim == 2 and Q1.shape[1] == 4 and Q1.size else set()
+    if got != want or len(Q1) != len(want):
+        raise Mismatch(
+            f"catmull_clark(quad torus): {len(want - got)} of the {len(want)} cells of the refined grid are not "
+            "among the quads — check cc_quads (corner, edge point, face point, edge point)"
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -367,11 +411,23 @@ def test_regular_tetrahedron_by_hand(lab):
     Q1 = np.asarray(Q1)
     if Q1.shape != (12, 4):
         raise Mismatch(f"catmull_clark(tetrahedron): quads have shape {Q1.shape}, expected (12, 4): one per corner")
+    # Each quad is (vertex point, edge point, face point, edge point) around one corner: rows of
+    # `expected` 0-3 are vertex points, 4-9 edge points, 10-13 face points.
+    _, at = cKDTree(expected).query(V1)  # row of `expected` each vertex of V1 is
+    kind = np.repeat([0, 1, 2], [4, 6, 4])[at]
+    Q1 = np.clip(Q1.astype(np.int64), 0, len(V1) - 1)
+    cycles = {tuple(np.roll(kind[q], -int(np.argmin(kind[q])))) for q in Q1}
+    corners = {(int(at[q[np.argmin(kind[q])]]), int(at[q[np.argmax(kind[q])]])) for q in Q1}
+    if cycles != {(0, 1, 2, 1)} or len(corners) != 12:
+        raise Mismatch(
+            "catmull_clark(tetrahedron): each quad must go vertex point, edge point, face point, edge point "
+            "around one corner (v, f) of the input, one quad per corner"
+        )
 
 
 @graded(points=1, part="non-quad input")
 def test_cage_counts_and_extraordinary_vertices(lab):
-    """mixed cage: V' = V + E + F, one quad per corner, old valences kept, extraordinary count constant"""
+    """mixed cage: V' = V + E + F, one quad per corner, old valences kept, extraordinary count constant, points distinct and moved"""
     V, faces = datasets.polygon_cage()
     n, e, m = len(V), len(topology.unique_edges(faces)), len(faces)
     corners = sum(len(f) for f in faces)
@@ -393,6 +449,13 @@ def test_cage_counts_and_extraordinary_vertices(lab):
         )
     if not topology.is_closed(Q1):
         raise Mismatch("catmull_clark(cage): the refined mesh should still be closed")
+    expect_distinct("catmull_clark(cage)", V1, Q1)
+    moved = np.linalg.norm(V1[:n] - V, axis=1) > 1e-9
+    if not moved.all():
+        raise Mismatch(
+            f"catmull_clark(cage): {int((~moved).sum())} old vertices did not move; on this cage every vertex point "
+            "(Q + 2R + (k - 3) P) / k differs from P"
+        )
 
 
 # --------------------------------------------------------------------------------------------

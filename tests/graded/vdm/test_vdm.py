@@ -173,10 +173,13 @@ def test_sampling_a_tilted_plane(lab):
 
 @graded(points=1, part="sampling")
 def test_sampling_keeps_the_query_shape_and_checks_input(lab):
-    """(res, res, 2) queries give (res, res, 3); a UV with the wrong row count is rejected"""
+    """(res, res, 2) queries give (res, res, 3), (u, v, 0) on the flat square with uv = xy; a UV with the wrong row count is rejected"""
     V, F = datasets.grid_patch(3)
     P = np.asarray(lab.sample_surface(V, F, V[:, :2], uniform(4)))
     expect(P.shape == (4, 4, 3), f"sample_surface with a (4, 4, 2) query returned shape {P.shape}, expected (4, 4, 3)")
+    # The grid is the flat unit square z = 0 with uv = xy, so the point at uv (u, v) is (u, v, 0).
+    q = uniform(4)
+    expect_close("sample_surface on the flat square with uv = xy", P, np.dstack([q, np.zeros((4, 4))]), atol=1e-12)
     expect_rejected(
         lab, "sample_surface", V, F, V[:3, :2], uniform(4), match="UV", label="UV with 3 rows for 16 vertices"
     )
