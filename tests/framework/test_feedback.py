@@ -129,11 +129,11 @@ def test_a_missing_or_huge_picture_is_not_embedded(tmp_path):
 def test_the_picture_cap_stops_drawing_after_n_pictures(tmp_path, monkeypatch):
     """The autograder caps pictures per run (GEOMLIB_MAX_FEEDBACK_PICTURES): the first failures get one, the
     rest keep their message without one; GEOMLIB_NO_FEEDBACK_PICTURES switches every kind off."""
-    from geomlib.grading import feedback
+    from geomlib.grading import feedback, picture_run
 
     monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
     monkeypatch.setenv("GEOMLIB_MAX_FEEDBACK_PICTURES", "2")
-    monkeypatch.setattr(feedback, "_DRAWN", [0])
+    monkeypatch.setattr(picture_run, "_DRAWN", [0])
     expected = np.zeros((16, 16, 3))
     got = expected + 0.5
 
