@@ -98,6 +98,7 @@ def grade(
     task: int | None = None,
     part: str | None = None,
     pictures: str | None = None,
+    records_out: list | None = None,
 ) -> dict:
     """Grade ``impl`` (``solutions``, ``labs`` or a submission path) on ``labs`` (default: all).
 
@@ -112,6 +113,9 @@ def grade(
     pictures : {"first", "all", "none"}, optional
         Feedback pictures to draw: the first failure's (default; a picture costs about a second),
         every failure's, or none (see :class:`geomlib.grading.feedback.pictures_for_run`).
+    records_out : list, optional
+        Receives this run's :class:`~geomlib.grading.plugin.Record` objects, in the order of
+        ``results["tests"]`` (the audit matches them to test node ids).
 
     Returns
     -------
@@ -164,6 +168,8 @@ def grade(
                 code = pytest.main(args, plugins=[selection, run])
     elapsed = time.time() - t0
     records = list(run.records)
+    if records_out is not None:
+        records_out.extend(records)
     for r in records if drawn.failed else ():  # pictures named in a message but not drawn after all
         r.message = feedback.without_pictures(r.message, drawn.failed)
         if r.picture and feedback._relpath(r.picture) in drawn.failed:
