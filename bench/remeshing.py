@@ -216,9 +216,7 @@ def table(cases: list[dict]) -> str:
             f"{o['time']:>7.2f} /{g['time']:<5.2f}{o['time'] / g['time']:>7.2f}"
         )
     lines.append("-" * len(head))
-    lines.append(
-        "targets: " + "; ".join(f"{t}: {'met' if ok else 'NOT met'} ({m})" for t, ok, m in summary(cases))
-    )
+    lines.append("targets: " + "; ".join(f"{t}: {'met' if ok else 'NOT met'} ({m})" for t, ok, m in summary(cases)))
     return "\n".join(lines)
 
 

@@ -651,7 +651,7 @@ def clean_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, min_angle):
             L = length(V, F, h)
             if L < ls:
                 hs, ls = h, L
-        best_hh, best_p, best = -1, 0, worst
+        best_hh, best = -1, worst
         for side in range(2):
             hh = hs if side == 0 else T[hs]
             if hh < 0:
