@@ -17,7 +17,7 @@ from geomlib.validate import check_float, check_int, check_mesh
 
 from . import kernels as K
 from .adaptive import adaptive_target_length
-from .stages import SurfaceProjector, _closest_on_segments, _relax, _split_all, sharp_edges
+from .stages import SurfaceProjector, _closest_on_segments, _relax, _split_all, clean_slivers, sharp_edges
 from .state import make_state, state_mesh
 
 __all__ = ["isotropic_remesh"]
