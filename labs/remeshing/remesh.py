@@ -13,11 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.errors import MeshError
-from geomlib.validate import check_float, check_int, check_mesh
+from geomlib.validate import check_float, check_int
 
 from . import kernels as K
 from .adaptive import adaptive_target_length
-from .stages import SurfaceProjector, _closest_on_segments, _relax, _split_all, clean_slivers, sharp_edges
+from .stages import (
+    SurfaceProjector,
+    _closest_on_segments,
+    _relax,
+    _split_all,
+    clean_slivers,
+    manifold_input,
+    sharp_edges,
+)
 from .state import make_state, state_mesh
 
 __all__ = ["isotropic_remesh"]
@@ -91,7 +99,7 @@ def isotropic_remesh(
     V, F : the remeshed surface (compact: every vertex used).
     """
     where = "isotropic_remesh"
-    V0, F0 = check_mesh(V, F, where=where, manifold=True)
+    V0, F0, H0 = manifold_input(V, F, where)  # H0: the half-edge structure of the input, given
     its = check_int(iterations, "iterations", where=where, minimum=0)
     lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)

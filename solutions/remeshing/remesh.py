@@ -13,11 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.errors import MeshError
-from geomlib.validate import check_float, check_int, check_mesh
+from geomlib.validate import check_float, check_int
 
 from . import kernels as K
 from .adaptive import adaptive_target_length
-from .stages import SurfaceProjector, _closest_on_segments, _relax, _split_all, clean_slivers, sharp_edges
+from .stages import (
+    SurfaceProjector,
+    _closest_on_segments,
+    _relax,
+    _split_all,
+    clean_slivers,
+    manifold_input,
+    sharp_edges,
+)
 from .state import make_state, state_mesh
 
 __all__ = ["isotropic_remesh"]
@@ -91,14 +99,14 @@ def isotropic_remesh(
     V, F : the remeshed surface (compact: every vertex used).
     """
     where = "isotropic_remesh"
-    V0, F0 = check_mesh(V, F, where=where, manifold=True)
+    V0, F0, H0 = manifold_input(V, F, where)  # H0: the half-edge structure of the input, given
     its = check_int(iterations, "iterations", where=where, minimum=0)
     lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     L, field = _target_field(target_length, len(V0), bool(adaptive), V0, F0, where)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
     # BEGIN SOLUTION: Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat
-    S = make_state(V0, F0, fe, preserve_boundary=preserve_boundary, where=where)
+    S = make_state(V0, F0, fe, preserve_boundary=preserve_boundary, where=where, H=H0)
     E0 = S.feature_edges()
     A0, B0 = V0[E0[:, 0]], V0[E0[:, 1]]
     project = SurfaceProjector(V0, F0)
