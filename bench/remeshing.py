@@ -9,18 +9,19 @@ run there in a subprocess on the same input, timed inside that process. A tool t
 installed is skipped with a message. CGAL's Python bindings cannot protect feature edges, so CGAL
 runs only on meshes remeshed without features.
 
-On bunny_hr it also runs the adaptive target length (task 11, ``adaptive=True`` with L = 0.03);
-the other tools take a single ``h``, so that row has no comparison.
-
-Per mesh it prints, for ours and each tool: time (best of 2), faces, minimum angle, share of
-angles below 30°, edge-length std / mean, valence-6 share of interior vertices, Hausdorff distance
-to the input relative to the bbox diagonal (``geomlib.geometry.mesh_distance``), and the time
-ratio. It also reports the kernels' first-call cost: compile (fresh numba cache, in a subprocess)
-and cache load.
-
-Meshes: ``../shared/data/meshes`` when present (bunny_hr to h = 0.03 as in issue 18, an
-irregular 8k-face igl.qslim output of it to h = 0.015, fandisk with features, camelhead with its
-boundary), else the built-in bumpy sphere and height field.
+Per mesh of ``--meshes`` (default ``../shared/data/meshes``; every ``.obj/.off/.ply/.stl`` there,
+read by ``igl.read_triangle_mesh`` and given as the same arrays to every contender; a mesh that is
+not a manifold, oriented triangle mesh is skipped with the reason) and per target h = 1.5x and
+0.75x its mean edge, it runs ``isotropic_remesh(V, F, h)`` with its defaults and gpytoolbox's
+``remesh_botsch`` (``--iterations``, boundary kept, same h), then prints one table over the whole
+set: faces, minimum angle, edge-length std / mean, Hausdorff distance to the input relative to
+its bbox diagonal (``geomlib.geometry.mesh_distance``) and time (best of 2), ours / gpytoolbox
+with the ratios, and a summary line of the targets (met / not met): minimum angle no worse on
+every case, Hausdorff <= 1.15x on every case and <= 1x in geometric mean, time <= 1x. Other
+tools (``--tools trueform CGAL``) are listed below it. It also reports the kernels' first-call
+cost (compile with a fresh numba cache, in a subprocess, and cache load; ``--no-first-call``
+skips it). ``--quick`` uses the built-in bumpy sphere and height field; ``--only NAME ...``
+restricts the set; ``--json`` writes the cases.
 """
 
 from __future__ import annotations
@@ -114,33 +115,37 @@ def quality(V0, F0, V, F) -> dict:
     return {**mesh_quality(V, F), "hausdorff": mesh_distance(V0, F0, V, F, n_samples=50_000)["hausdorff"]}
 
 
-def meshes(quick: bool) -> list:
-    out = []
-    if SHARED.exists() and not quick:
-        V, F = igl.read_triangle_mesh(str(SHARED / "bunny_hr.obj"))
-        F = F.astype(np.int64)
-        out.append(("bunny_hr", V, F, None, None))
-        U, G, *_ = igl.qslim(V, F.astype(np.int32), 8000)
-        out.append(("bunny qslim 8k", U, G.astype(np.int64), None, None))
-        for name, fa in (("fandisk.obj", 45.0), ("camelhead.off", None)):
-            if (SHARED / name).exists():
-                V2, F2 = igl.read_triangle_mesh(str(SHARED / name))
-                out.append((name.split(".")[0], V2, F2.astype(np.int64), None, fa))
+#: The two targets of the comparison, as multiples of the input's mean edge length.
+FACTORS = (1.5, 0.75)
+
+
+def meshes(quick: bool, folder: Path, only: list[str] | None = None) -> tuple[list, list]:
+    """``([(name, V, F)], [(name, why skipped)])``: every mesh file of ``folder`` (as
+    ``igl.read_triangle_mesh`` reads it, the same arrays for every contender), or with ``quick``
+    (or no folder) the built-in bumpy sphere and height field."""
+    from geomlib.errors import MeshError
+    from geomlib.validate import check_mesh
+
+    out, skipped = [], []
+    if folder.is_dir() and not quick:
+        for path in sorted(folder.iterdir()):
+            if path.suffix.lower() not in (".obj", ".off", ".ply", ".stl"):
+                continue
+            name = path.stem
+            if only and name not in only:
+                continue
+            V, F = igl.read_triangle_mesh(str(path))
+            try:
+                V, F = check_mesh(V, F.astype(np.int64), where=name, manifold=True)
+            except MeshError as e:
+                skipped.append((name, str(e)))
+                continue
+            out.append((name, V, F))
     else:
         V, F = datasets.icosphere(4)
-        out.append(("bumpy sphere", datasets.add_noise(V, 0.01, seed=0, direction="normal", F=F), F, None, None))
-        out.append(("height field", *datasets.height_field(48), None, None))
-    return out
-
-
-def target(name, V, F):
-    from geomlib.geometry import mean_edge_length
-
-    if name == "bunny_hr":
-        return 0.03  # issue 18: about 2x its mean edge (0.0149)
-    if name == "bunny qslim 8k":
-        return 0.015
-    return 1.0 * mean_edge_length(V, F)
+        out.append(("bumpy sphere", datasets.add_noise(V, 0.01, seed=0, direction="normal", F=F), F))
+        out.append(("height field", *datasets.height_field(48)))
+    return out, skipped
 
 
 def run_tool(tool, py, V, F, h, its, feature_angle):
@@ -176,52 +181,113 @@ def first_call_costs() -> dict:
     return out
 
 
+def _gmean(x) -> float:
+    return float(np.exp(np.mean(np.log(x))))
+
+
+def summary(cases: list[dict]) -> list[tuple[str, bool, str]]:
+    """The targets of the comparison with gpytoolbox: ``(target, met, what was measured)``."""
+    worse = [c for c in cases if c["ours"]["min_angle"] < c["gpy"]["min_angle"]]
+    hd = np.array([c["ours"]["hausdorff"] / c["gpy"]["hausdorff"] for c in cases])
+    tr = np.array([c["ours"]["time"] / c["gpy"]["time"] for c in cases])
+    return [
+        ("minimum angle no worse on every case", not worse, f"worse in {len(worse)} of {len(cases)}"),
+        ("Hausdorff <= 1.15x on every case", bool(hd.max() <= 1.15), f"max {hd.max():.2f}x"),
+        ("Hausdorff <= 1x in geometric mean", _gmean(hd) <= 1.0, f"{_gmean(hd):.2f}x"),
+        ("time <= 1x on every case", bool(tr.max() <= 1.0), f"{tr.min():.2f}-{tr.max():.2f}x"),
+    ]
+
+
+def table(cases: list[dict]) -> str:
+    """One table over the whole set: ours / gpytoolbox per case, with the ratios, and the summary."""
+    head = (
+        f"{'mesh':<20}{'h':>6}{'faces':>15}{'min angle (deg)':>18}{'edge std/mean':>15}"
+        f"{'Hausdorff (x1e-3 diag)':>24}{'ratio':>7}{'time (s)':>14}{'ratio':>7}"
+    )
+    lines = [head, "-" * len(head)]
+    for c in cases:
+        o, g = c["ours"], c["gpy"]
+        lines.append(
+            f"{c['mesh']:<20}{c['factor']:>5.2f}x"
+            f"{o['faces']:>8}/{g['faces']:<6}"
+            f"{o['min_angle']:>9.1f} /{g['min_angle']:>5.1f}  "
+            f"{o['edge_cv']:>7.3f} /{g['edge_cv']:.3f}"
+            f"{1e3 * o['hausdorff']:>13.3f} /{1e3 * g['hausdorff']:<8.3f}"
+            f"{o['hausdorff'] / g['hausdorff']:>7.2f}"
+            f"{o['time']:>7.2f} /{g['time']:<5.2f}{o['time'] / g['time']:>7.2f}"
+        )
+    lines.append("-" * len(head))
+    lines.append("targets: " + "; ".join(f"{t}: {'met' if ok else 'NOT met'} ({m})" for t, ok, m in summary(cases)))
+    return "\n".join(lines)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--quick", action="store_true", help="the built-in meshes instead of the shared set")
+    ap.add_argument("--meshes", type=Path, default=SHARED, help=f"folder of test meshes (default {SHARED})")
+    ap.add_argument("--only", nargs="*", help="mesh names (file stems) to run, default all")
     ap.add_argument("--iterations", type=int, default=10)
     ap.add_argument("--gpy-python", default="/tmp/gpyvenv/bin/python")
+    ap.add_argument("--tools", nargs="*", default=["gpytoolbox"], help=f"contenders among {list(TOOL_SCRIPTS)}")
+    ap.add_argument("--json", type=Path, help="also write the cases here")
+    ap.add_argument("--no-first-call", action="store_true", help="skip measuring the compile and cache-load cost")
     args = ap.parse_args()
     tools = [
         t
-        for t, mod in TOOL_MODULES.items()
+        for t in args.tools
         if Path(args.gpy_python).exists()
-        and subprocess.run([args.gpy_python, "-c", f"import {mod}"], capture_output=True).returncode == 0
+        and subprocess.run([args.gpy_python, "-c", f"import {TOOL_MODULES[t]}"], capture_output=True).returncode == 0
     ]
-    for t in TOOL_MODULES:
+    for t in args.tools:
         if t not in tools:
             print(f"{t} not found at {args.gpy_python}: its comparison is skipped (see the module docstring)")
-    costs = first_call_costs()
+    costs = {} if args.no_first_call else first_call_costs()
     print(
         "first call of isotropic_remesh (tiny mesh, fresh process): "
         + ", ".join(f"{k} {v:.2f} s" for k, v in costs.items())
     )
     isotropic_remesh(*datasets.icosphere(1), 0.5, iterations=1)  # warm up in this process
-    rows = []
-    for name, V, F, _, fa in meshes(args.quick):
-        h = target(name, V, F)
-        best, res = np.inf, None
-        for _ in range(2):
-            t = time.perf_counter()
-            res = isotropic_remesh(V, F, h, iterations=args.iterations, feature_angle=fa)
-            best = min(best, time.perf_counter() - t)
-        q = {"time": best, **quality(V, F, *res)}
-        rows.append((name, "ours", q))
-        for tool in tools:
-            g, err = run_tool(tool, args.gpy_python, V, F, h, args.iterations, fa)
-            if g is None:
-                print(f"{name}: {tool}: {err}")
-                continue
-            rows.append((name, tool, {"time": g[2], **quality(V, F, g[0], g[1])}))
-            print(f"{name}: h = {h:.4g}, time ratio ours / {tool} = {best / g[2]:.2f}")
-        if name == "bunny_hr":  # task 11 (gpytoolbox's remesh_botsch takes one h only: ours alone)
-            t = time.perf_counter()
-            res = isotropic_remesh(V, F, h, iterations=args.iterations, adaptive=True)
-            rows.append(("bunny adaptive", "ours", {"time": time.perf_counter() - t, **quality(V, F, *res)}))
+    from geomlib.geometry import mean_edge_length
+
+    found, skipped = meshes(args.quick, args.meshes, args.only)
+    for name, why in skipped:
+        print(f"skipped {name}: {why}")
+    cases, others = [], []
+    for name, V, F in found:
+        for factor in FACTORS:
+            h = factor * mean_edge_length(V, F)
+            best, res = np.inf, None
+            for _ in range(2):
+                t = time.perf_counter()
+                res = isotropic_remesh(V, F, h, iterations=args.iterations)
+                best = min(best, time.perf_counter() - t)
+            ours = {"time": best, **quality(V, F, *res)}
+            for tool in tools:
+                g, err = run_tool(tool, args.gpy_python, V, F, h, args.iterations, None)
+                if g is None:
+                    print(f"{name} at {factor}x: {tool}: {err}")
+                    continue
+                q = {"time": g[2], **quality(V, F, g[0], g[1])}
+                if tool == "gpytoolbox":
+                    cases.append({"mesh": name, "factor": factor, "h": h, "ours": ours, "gpy": q})
+                else:
+                    others.append((name, factor, tool, q))
+            print(f"{name} at {factor}x (h = {h:.4g}) done", flush=True)
     cols = ("time", "faces", "min_angle", "below_30", "edge_cv", "valence6", "hausdorff")
-    print(f"{'mesh':<16}{'method':<12}" + "".join(f"{c:>11}" for c in cols))
-    for name, who, q in rows:
-        print(f"{name:<16}{who:<12}" + "".join(f"{q[c]:>11.4g}" for c in cols))
+    if others:
+        print(f"{'mesh':<20}{'h':>6} {'method':<12}" + "".join(f"{c:>11}" for c in cols))
+        for name, factor, who, q in others:
+            print(f"{name:<20}{factor:>5.2f}x {who:<12}" + "".join(f"{q[c]:>11.4g}" for c in cols))
+    if cases:
+        print()
+        print(
+            f"isotropic_remesh(V, F, h) (defaults) / gpytoolbox remesh_botsch ({args.iterations} iterations, "
+            "boundary kept, same h); h in multiples of the input's mean edge; Hausdorff distance to the "
+            "input relative to its bounding-box diagonal; time best of 2"
+        )
+        print(table(cases))
+    if args.json:
+        args.json.write_text(json.dumps({"first_call": costs, "cases": cases, "skipped": skipped}, default=float))
     print(json.dumps({"first_call": costs}))
 
 

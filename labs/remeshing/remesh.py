@@ -13,11 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.errors import MeshError
-from geomlib.validate import check_float, check_int, check_mesh
+from geomlib.validate import check_float, check_int
 
 from . import kernels as K
 from .adaptive import adaptive_target_length
-from .stages import SurfaceProjector, _closest_on_segments, _relax, _split_all, sharp_edges
+from .stages import (
+    SurfaceProjector,
+    _closest_on_segments,
+    _relax,
+    _split_all,
+    clean_slivers,
+    manifold_input,
+    sharp_edges,
+)
 from .state import make_state, state_mesh
 
 __all__ = ["isotropic_remesh"]
@@ -59,7 +67,9 @@ def isotropic_remesh(
     Each iteration: split edges longer than ``4/3 L``; collapse edges shorter than ``4/5 L``;
     flip edges to bring valences toward 6 (4 on the boundary); ``relax_steps`` steps of tangential
     relaxation; projection of the vertices back onto the input (feature-line and boundary vertices
-    onto the input's lines, the others onto its surface).
+    onto the input's lines, the others onto its surface). After the last iteration,
+    :func:`~.stages.clean_slivers` flips or collapses away the faces with an angle below 30° where
+    that raises the smallest angle around them.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear
@@ -91,10 +101,10 @@ def isotropic_remesh(
     V, F : the remeshed surface (compact: every vertex used).
     """
     where = "isotropic_remesh"
-    V0, F0 = check_mesh(V, F, where=where, manifold=True)
+    V0, F0, H0 = manifold_input(V, F, where)  # H0: the half-edge structure of the input, given
     its = check_int(iterations, "iterations", where=where, minimum=0)
     lam = check_float(damping, "damping", where=where, minimum=0.0, maximum=1.0)
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     L, field = _target_field(target_length, len(V0), bool(adaptive), V0, F0, where)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
-    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat')
+    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat; then the given clean_slivers(S)')

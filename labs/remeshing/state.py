@@ -19,7 +19,7 @@ __all__ = ["RemeshState", "make_state", "state_mesh"]
 class RemeshState:
     """The arrays the kernels edit (see :mod:`.kernels`); ``args`` passes them in kernel order."""
 
-    def __init__(self, V, F, T, cls, feat):
+    def __init__(self, V, F, T, cls, feat, val=None):
         n, m = len(V), len(F)
         self.V = np.zeros((max(2 * n, 16), 3))
         self.V[:n] = V
@@ -34,7 +34,7 @@ class RemeshState:
         self.VH = np.full(len(self.V), -1, np.int64)
         self.VH[F.ravel()[::-1]] = np.arange(3 * m - 1, -1, -1)
         self.val = np.zeros(len(self.V), np.int64)
-        self.val[:n] = np.bincount(topology.unique_edges(F).ravel(), minlength=n)
+        self.val[:n] = np.bincount(topology.unique_edges(F).ravel(), minlength=n) if val is None else val
         self.cls = np.zeros(len(self.V), np.int64)
         self.cls[:n] = cls
         self.cnt = np.array([n, m], np.int64)
@@ -91,15 +91,21 @@ def _edge_lookup(F: np.ndarray, n: int, pairs: np.ndarray) -> np.ndarray:
     return np.isin(keys, pk)
 
 
-def make_state(V, F, feature_edges=None, *, preserve_boundary: bool = True, where: str = "make_state") -> RemeshState:
+def make_state(
+    V, F, feature_edges=None, *, preserve_boundary: bool = True, where: str = "make_state", H=None
+) -> RemeshState:
     """Build the kernels' state of a checked manifold triangle mesh.
+
+    ``H`` is the mesh's :class:`~geomlib.topology.HalfEdgeMesh` when the caller has built it already
+    (a public entry validates its mesh by building it: it is not built again here).
 
     ``feature_edges`` (k, 2) vertex pairs are kept as feature lines; with ``preserve_boundary``
     the boundary edges are too. A vertex on two feature edges slides along them (class 1) unless
     the line turns there by more than 45°; there, and on one or more than two feature edges, it is
     a corner (class 2) and stays put.
     """
-    H = topology.halfedge_mesh(F, len(V), manifold=True, checked=True, where=where)
+    if H is None:
+        H = topology.halfedge_mesh(F, len(V), manifold=True, checked=True, where=where)
     T = H.twin
     fe = np.zeros((0, 2), np.int64) if feature_edges is None else np.asarray(feature_edges, np.int64).reshape(-1, 2)
     feat = _edge_lookup(F, len(V), fe)
@@ -118,7 +124,7 @@ def make_state(V, F, feature_edges=None, *, preserve_boundary: bool = True, wher
     np.add.at(s, ea, d)
     np.add.at(s, eb, -d)
     cls[(cls == 1) & ((s**2).sum(axis=1) > 2 - np.sqrt(2))] = 2
-    return RemeshState(V, F, T, cls, feat)
+    return RemeshState(V, F, T, cls, feat, H.valence)
 
 
 def state_mesh(S: RemeshState) -> tuple[np.ndarray, np.ndarray]:

@@ -531,3 +531,141 @@ def flip_pass(V, F, T, VH, val, cls, feat, falive, cnt):
             done += 1
     return done
     # END SOLUTION
+
+
+# --------------------------------------------------------------------------------------------
+# the final clean-up (given): slivers left where the surface bends faster than the target length
+
+
+@njit(cache=True)
+def corner_angle(ax, ay, az, V, j, k):
+    """Angle (radians) at the point ``(ax, ay, az)`` between the directions to ``V[j]`` and ``V[k]``."""
+    ux, uy, uz = V[j, 0] - ax, V[j, 1] - ay, V[j, 2] - az
+    wx, wy, wz = V[k, 0] - ax, V[k, 1] - ay, V[k, 2] - az
+    cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    return np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
+
+
+@njit(cache=True)
+def face_min_angle(V, i, j, k):
+    """Smallest angle (radians) of triangle ``(V[i], V[j], V[k])``."""
+    a = corner_angle(V[i, 0], V[i, 1], V[i, 2], V, j, k)
+    b = corner_angle(V[j, 0], V[j, 1], V[j, 2], V, k, i)
+    return min(a, b, np.pi - a - b)
+
+
+@njit(cache=True)
+def _min_angle_moved(V, F, T, VH, a, b, p, hes):
+    """Smallest angle of the faces around ``a`` and ``b`` that stay when ``b`` merges into ``a`` at ``p``."""
+    worst = np.pi
+    tmp = np.empty((1, 3))
+    tmp[0, 0], tmp[0, 1], tmp[0, 2] = p[0], p[1], p[2]
+    for v in (a, b):
+        n = ring(F, T, VH, v, hes)
+        for i in range(n):
+            g = hes[i]
+            x, y = dst(F, g), org(F, pv(g))
+            if x == a or x == b or y == a or y == b:
+                continue
+            # angles of (p, x, y): at p, at x, at y
+            ap = corner_angle(p[0], p[1], p[2], V, x, y)
+            ux, uy, uz = V[y, 0] - V[x, 0], V[y, 1] - V[x, 1], V[y, 2] - V[x, 2]
+            wx, wy, wz = p[0] - V[x, 0], p[1] - V[x, 1], p[2] - V[x, 2]
+            cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+            ax = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
+            worst = min(worst, ap, ax, np.pi - ap - ax)
+    return worst
+
+
+@njit(cache=True)
+def _flip_gain(V, F, T, h):
+    """``(min angle before, min angle after)`` of the two faces of interior half-edge ``h`` if it were flipped."""
+    t = T[h]
+    a, b = org(F, h), dst(F, h)
+    c, d = org(F, pv(h)), org(F, pv(t))
+    before = min(face_min_angle(V, a, b, c), face_min_angle(V, b, a, d))
+    after = min(face_min_angle(V, c, a, d), face_min_angle(V, d, b, c))
+    return before, after
+
+
+@njit(cache=True)
+def _clean_flip_ok(V, F, T, VH, val, feat, h, hes, nb1):
+    """:func:`flip_check`, with its normal test measured against the two old faces together.
+
+    A sliver's own normal says little (a 170° cap is almost a segment): the new faces must not
+    turn over against the area-weighted normal of the old pair, nor against each other.
+    """
+    code = flip_check(V, F, T, VH, val, feat, h, hes, nb1)
+    if code != FLIP:
+        return code == OK
+    t = T[h]
+    a, b = org(F, h), dst(F, h)
+    c, d = org(F, pv(h)), org(F, pv(t))
+    o1, o2 = normal(V, a, b, c), normal(V, b, a, d)
+    no = (o1[0] + o2[0], o1[1] + o2[1], o1[2] + o2[2])
+    lo = np.sqrt(dot(no, no))
+    n1, n2 = normal(V, c, a, d), normal(V, d, b, c)
+    l1, l2 = np.sqrt(dot(n1, n1)), np.sqrt(dot(n2, n2))
+    if l1 <= 1e-12 or l2 <= 1e-12 or lo <= 1e-12:
+        return False
+    return dot(n1, no) > 0.0 and dot(n2, no) > 0.0 and dot(n1, n2) > 0.0
+
+
+@njit(cache=True)
+def clean_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, min_angle):
+    """One pass over the faces whose smallest angle is below ``min_angle`` (radians); returns the edits made.
+
+    For such a face: flip one of its edges when that raises the smallest angle of the edge's two
+    faces (checks of :func:`flip_check`); else collapse its shortest edge into one of its ends (which
+    lie on the surface) when :func:`collapse_check` allows it, no edge longer than the split bound
+    appears and the smallest angle around rises. Ends keep the rules of the collapse pass:
+    corners stay, a feature vertex only moves along its line.
+    """
+    hes = np.empty(RING, np.int64)
+    nb1 = np.empty(RING, np.int64)
+    nb2 = np.empty(RING, np.int64)
+    done = 0
+    for f in range(cnt[1]):
+        if not falive[f]:
+            continue
+        worst = face_min_angle(V, F[f, 0], F[f, 1], F[f, 2])
+        if worst >= min_angle:
+            continue
+        # flips first: the edge whose flip gives the largest smallest angle
+        best_h, best = -1, worst
+        for k in range(3):
+            h = 3 * f + k
+            if T[h] < 0 or feat[h]:
+                continue
+            before, after = _flip_gain(V, F, T, h)
+            if after > best and after > before:
+                best_h, best = h, after
+        if best_h >= 0 and _clean_flip_ok(V, F, T, VH, val, feat, best_h, hes, nb1):
+            flip(V, F, T, VH, val, feat, best_h)
+            done += 1
+            continue
+        # the shortest edge, into the end that keeps the face's neighbourhood best
+        hs, ls = -1, np.inf
+        for k in range(3):
+            h = 3 * f + k
+            L = length(V, F, h)
+            if L < ls:
+                hs, ls = h, L
+        best_hh, best = -1, worst
+        for side in range(2):
+            hh = hs if side == 0 else T[hs]
+            if hh < 0:
+                continue
+            a, b = org(F, hh), dst(F, hh)
+            if cls[b] > cls[a] or cls[b] == 2 or (cls[b] == 1 and not feat[hh]):
+                continue
+            q = _min_angle_moved(V, F, T, VH, a, b, V[a], hes)
+            if q > best:
+                best_hh, best = hh, q
+        if best_hh >= 0:
+            a, b = org(F, best_hh), dst(F, best_hh)
+            p = V[a].copy()
+            if collapse_check(V, F, T, VH, val, cls, feat, best_hh, p, min(high[a], high[b]), hes, nb1, nb2) == OK:
+                collapse(V, F, T, VH, val, cls, feat, falive, best_hh, p, hes)
+                done += 1
+    return done

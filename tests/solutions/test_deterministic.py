@@ -43,6 +43,7 @@ NO_JIT_RUNS = [
     "remeshing/hidden-split-torus",
     "remeshing/remesh-wavy-patch",
     "remeshing/hidden-remesh-height-field",
+    "remeshing/remesh-box-features",  # the sliver clean-up's collapses (kernels.clean_pass)
     "sdf/hidden-bvh-closest-box",
     "sdf/hidden-bvh-band-wedge",
     "sdf/hidden-vote-wedge",
