@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from geomlib.validate import MeshError, check_choice, check_float, check_mesh
+from geomlib.validate import MeshError, check_choice, check_float, check_mesh, checked
 
 from .contraction import make_state, state_mesh
 from .greedy import candidate_pairs, greedy_collapse
@@ -131,19 +131,20 @@ def qem_simplify(
     if not isinstance(refit, bool | np.bool_):
         raise MeshError(f"{where}: refit must be True, False or None, got {refit!r}")
 
-    Q = vertex_quadrics(V, F, weighting, boundary_weight if preserve_boundary else 0.0)
-    if method == "greedy":
-        state = make_state(V, F, Q)
-        _, others = candidate_pairs(V, F, pair_threshold)
-        greedy_collapse(state, others, target_faces, min_cos)
-        V_out, F_out = state_mesh(state)
-        normals0 = state.face_normal0[state.face_alive]
-    else:
-        from .compiled import compiled_collapse  # imports numba (0.2-0.5 s): only when asked for
+    with checked(V, F, manifold=True):  # the quadric and contraction helpers receive the checked mesh
+        Q = vertex_quadrics(V, F, weighting, boundary_weight if preserve_boundary else 0.0)
+        if method == "greedy":
+            state = make_state(V, F, Q)
+            _, others = candidate_pairs(V, F, pair_threshold)
+            greedy_collapse(state, others, target_faces, min_cos)
+            V_out, F_out = state_mesh(state)
+            normals0 = state.face_normal0[state.face_alive]
+        else:
+            from .compiled import compiled_collapse  # imports numba (0.2-0.5 s): only when asked for
 
-        V_out, F_out, normals0 = compiled_collapse(V, F, Q, target_faces, min_cos)
-    if refit and len(F_out) and not pair_threshold > 0:
-        V_out = refine_positions(V, F, V_out, F_out, normals0=normals0)
+            V_out, F_out, normals0 = compiled_collapse(V, F, Q, target_faces, min_cos)
+        if refit and len(F_out) and not pair_threshold > 0:
+            V_out = refine_positions(V, F, V_out, F_out, normals0=normals0)
 
     if len(F_out) > target_faces + 2:
         msg = (
