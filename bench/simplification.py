@@ -80,7 +80,7 @@ def builtin_meshes(quick: bool) -> dict:
     }
 
 
-def shared_meshes(quick: bool) -> dict:
+def shared_meshes(quick: bool, folder: Path = SHARED) -> dict:
     """Every triangle mesh of ``../shared/data/meshes``, as ``igl.read_triangle_mesh`` loads it.
 
     The independent reader's arrays go to every contender unchanged (same vertex order, same
@@ -91,9 +91,10 @@ def shared_meshes(quick: bool) -> dict:
 
     quick_names = ("fandisk.obj", "camelhead.off")
     out = {}
-    if not SHARED.is_dir():
+    if not folder.is_dir():
+        print(f"no shared meshes: {folder} is not a folder (give --meshes DIR)")
         return out
-    for path in sorted(SHARED.iterdir()):
+    for path in sorted(folder.iterdir()):
         if path.suffix not in (".obj", ".off", ".ply") or (quick and path.name not in quick_names):
             continue
         _, F_stored = read_mesh(path)
@@ -276,6 +277,7 @@ def main() -> None:
     ap.add_argument("--levels", nargs="*", type=float, default=[0.1, 0.01])
     ap.add_argument("--breakdown", action="store_true", help="where the fast path's time goes, against igl.qslim")
     ap.add_argument("--repeats", type=int, help="timed runs per contender, best kept (default 3, 1 with --quick)")
+    ap.add_argument("--meshes", type=Path, default=SHARED, help=f"folder of the shared meshes (default {SHARED})")
     ap.add_argument("--shared-only", action="store_true", help="only the meshes of ../shared/data/meshes")
     ap.add_argument("--contenders", nargs="*", help="labels of the contenders to run (igl.qslim always runs)")
     ap.add_argument("--no-permutation", action="store_true", help="skip the vertex-order check")
@@ -283,7 +285,7 @@ def main() -> None:
     args = ap.parse_args()
     repeats = args.repeats or (1 if args.quick else 3)
     n_samples = 20_000 if args.quick else 50_000
-    shared = shared_meshes(args.quick)
+    shared = shared_meshes(args.quick, args.meshes)
     meshes = shared if args.shared_only else {**builtin_meshes(args.quick), **shared}
     if args.only:
         meshes = {k: v for k, v in meshes.items() if any(s in k for s in args.only)}

@@ -10,7 +10,7 @@ from geomlib.validate import MeshError, check_choice, check_float, check_mesh, c
 
 from .contraction import make_state, state_mesh
 from .greedy import candidate_pairs, greedy_collapse
-from .quadrics import WEIGHTINGS, vertex_quadrics
+from .quadrics import WEIGHTINGS, crease_quadrics, vertex_quadrics
 from .refit import refine_positions
 
 __all__ = ["qem_simplify", "SimplificationWarning"]
@@ -50,6 +50,8 @@ def qem_simplify(
     method: str = "greedy",
     weighting: str = "area",
     boundary_weight: float = 10.0,
+    crease_angle: float | None = 60.0,
+    crease_weight: float = 1.0,
     min_cos: float = 0.0,
     on_unreachable: str = "raise",
     refit: bool | None = None,
@@ -86,6 +88,12 @@ def qem_simplify(
         Face quadric weights (see :func:`~solutions.simplification.quadrics.face_quadrics`).
     boundary_weight : float
         Weight of the boundary penalty quadrics.
+    crease_angle : float in [0, 180] or None
+        Edges whose faces meet at a dihedral angle above this (degrees) are sharp features: they
+        get constraint-plane quadrics (:func:`~solutions.simplification.quadrics.crease_quadrics`)
+        so creases and corners of CAD-like parts keep their place. None: no crease quadrics.
+    crease_weight : float
+        Weight of the crease quadrics.
     min_cos : float in [-1, 1)
         Flip test threshold: a contraction is refused when a face normal turns so that
         ``cos(angle) <= min_cos`` (0: refuse turns of 90° and more).
@@ -121,6 +129,9 @@ def qem_simplify(
     check_choice(method, "method", METHODS, where=where)
     check_choice(weighting, "weighting", WEIGHTINGS, where=where)
     boundary_weight = check_float(boundary_weight, "boundary_weight", minimum=0.0, where=where)
+    if crease_angle is not None:
+        crease_angle = check_float(crease_angle, "crease_angle", minimum=0.0, maximum=180.0, where=where)
+    crease_weight = check_float(crease_weight, "crease_weight", minimum=0.0, where=where)
     min_cos = check_float(min_cos, "min_cos", minimum=-1.0, maximum=0.999, where=where)
     check_choice(on_unreachable, "on_unreachable", ("raise", "warn"), where=where)
     if method == "fast" and pair_threshold > 0:
@@ -133,6 +144,8 @@ def qem_simplify(
 
     with checked(V, F, manifold=True):  # the quadric and contraction helpers receive the checked mesh
         Q = vertex_quadrics(V, F, weighting, boundary_weight if preserve_boundary else 0.0)
+        if crease_angle is not None and crease_weight > 0:
+            Q += crease_quadrics(V, F, crease_angle, crease_weight)
         if method == "greedy":
             state = make_state(V, F, Q)
             _, others = candidate_pairs(V, F, pair_threshold)
