@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh, checked
 
 from .analytic import as_points
 from .bvh import build_bvh, bvh_closest
@@ -60,9 +60,10 @@ def signed_distance(V, F, P, *, sign: str = "pseudonormal") -> np.ndarray:
     check_choice(sign, "sign", SIGN_METHODS, where=where)
     if len(P) == 0:
         return np.zeros(0)
-    B = build_bvh(V, F)
-    sq, face, C, region = bvh_closest(B, V, F, P)
-    return np.sqrt(sq) * _sign(V, F, P, face, C, region, sign, B)
+    with checked(V, F):  # the BVH and sign helpers receive the checked mesh
+        B = build_bvh(V, F)
+        sq, face, C, region = bvh_closest(B, V, F, P)
+        return np.sqrt(sq) * _sign(V, F, P, face, C, region, sign, B)
 
 
 def grid_sdf_values(V, F, origin, spacing: float, shape, *, band: float | None = None, sign: str = "pseudonormal"):
@@ -146,5 +147,6 @@ def sdf_grid(V, F, res: int, *, padding: float = 0.1, band: float | None = None,
     res = check_int(res, "res", minimum=2, maximum=2048, where=where)
     padding = check_float(padding, "padding", minimum=0.0, where=where)
     origin, spacing = grid_box(V, res, padding)
-    values = grid_sdf_values(V, F, origin, spacing, (res, res, res), band=band, sign=sign)
+    with checked(V, F):
+        values = grid_sdf_values(V, F, origin, spacing, (res, res, res), band=band, sign=sign)
     return SDFGrid(values, origin, spacing)

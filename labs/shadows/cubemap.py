@@ -13,10 +13,11 @@ import numpy as np
 
 from geomlib.camera import look_at, perspective
 from geomlib.raster import MAX_SIZE
-from geomlib.validate import MeshError, as_array, check_float, check_int, check_mesh
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh
 
 from .depth import CULL_MODES, depth_map
 from .lookup import DEFAULT_MAX_SLOPE, shadow_visibility
+from .options import ShadowOptions, keyword_defaults
 
 __all__ = [
     "CUBE_FACES",
@@ -96,8 +97,7 @@ def cube_depth_maps(V, F, position, size: int, near: float, far: float, cull: st
     where = "cube_depth_maps"
     V, F = check_mesh(V, F, where=where, allow_degenerate=True, allow_duplicate=True)
     size = check_int(size, "size", minimum=1, maximum=MAX_SIZE, where=where)
-    if cull not in CULL_MODES:
-        raise MeshError(f"{where}: cull must be one of {', '.join(map(repr, CULL_MODES))}; got {cull!r}")
+    check_choice(cull, "cull", CULL_MODES, where=where)
     Ms = cube_light_matrices(position, near, far)
     return np.stack([depth_map(V, F, M, size, cull) for M in Ms])
 
@@ -116,6 +116,7 @@ def point_shadow_visibility(
     max_slope: float = DEFAULT_MAX_SLOPE,
     pcf_sampling: str = "grid",
     pcf_samples: int = 16,
+    options: ShadowOptions | None = None,
 ) -> np.ndarray:
     """Visibility of a point light through its cube of shadow maps.
 
@@ -132,6 +133,8 @@ def point_shadow_visibility(
     bias, slope_bias, pcf, max_slope, pcf_sampling, pcf_samples
         As in :func:`shadow_visibility`, passed on to it (PCF does not cross cube faces: it reads the
         face's border).
+    options : ShadowOptions, optional
+        All of them at once, checked when made (then leave the keywords at their defaults).
 
     Returns
     -------
@@ -148,4 +151,12 @@ def point_shadow_visibility(
         raise MeshError(f"{where}: maps has shape {maps.shape}, expected (6, size, size): one map per cube face")
     pos = as_array(position, "position", shape=(3,), where=where)
     near, far = _near_far(near, far, where)
-    raise NotImplementedError("Task 8 (cube map): face = cube_face_index(P - position); shadow_visibility with maps[face], Ms[face] for each face's points (pass the other options on)")
+    keywords = dict(
+        bias=bias, slope_bias=slope_bias, pcf=pcf, max_slope=max_slope, pcf_sampling=pcf_sampling,
+        pcf_samples=pcf_samples,
+    )  # fmt: skip
+    opts = ShadowOptions.of(options, where, keywords, _POINT_DEFAULTS)
+    raise NotImplementedError("Task 8 (cube map): face = cube_face_index(P - position); shadow_visibility with maps[face], Ms[face] for each face's points (options=opts passes the other options on)")
+
+
+_POINT_DEFAULTS = keyword_defaults(point_shadow_visibility)

@@ -19,10 +19,9 @@ import numpy as np
 from geomlib.raster import MAX_SIZE, rasterize
 from geomlib.validate import as_array, check_choice, check_int, check_mesh
 
-__all__ = ["CULL_MODES", "cull_faces", "depth_map"]
+from .options import CULL_MODES
 
-#: Accepted values of ``cull``.
-CULL_MODES = ("front", "back", "none")
+__all__ = ["CULL_MODES", "cull_faces", "depth_map"]
 
 
 def cull_faces(V, F, M, cull: str = "front") -> np.ndarray:

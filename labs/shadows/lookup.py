@@ -26,6 +26,15 @@ import numpy as np
 from geomlib.raster import MAX_SIZE
 from geomlib.validate import MeshError, as_array, check_float, check_int
 
+from .options import (
+    DEFAULT_BIAS_TEXELS,
+    DEFAULT_MAX_SLOPE,
+    DEFAULT_SLOPE_BIAS,
+    PCF_SAMPLINGS,
+    ShadowOptions,
+    keyword_defaults,
+)
+
 __all__ = [
     "DEFAULT_BIAS_TEXELS",
     "DEFAULT_SLOPE_BIAS",
@@ -42,16 +51,6 @@ __all__ = [
     "poisson_pcf_visibility",
     "shadow_visibility",
 ]
-
-#: Default constant bias, in window-depth units times the map size: ``bias = 1 / size``.
-DEFAULT_BIAS_TEXELS = 1.0
-#: Default slope factor: how many times the tangent plane's depth change within half a texel is added.
-DEFAULT_SLOPE_BIAS = 1.5
-#: Steepest NDC depth slope ``|dz/dx|`` used for the bias (surfaces seen edge-on by the light).
-DEFAULT_MAX_SLOPE = 20.0
-#: How :func:`shadow_visibility` places its PCF samples: a k x k block of texels, or a rotated Poisson disk.
-PCF_SAMPLINGS = ("grid", "poisson")
-
 
 # --------------------------------------------------------------------------------------------
 # input checks (given)
@@ -430,6 +429,7 @@ def shadow_visibility(
     max_slope: float = DEFAULT_MAX_SLOPE,
     pcf_sampling: str = "grid",
     pcf_samples: int = 16,
+    options: ShadowOptions | None = None,
 ) -> np.ndarray:
     """How much of the light reaches each point: 1 lit, 0 in shadow, fractions at soft PCF edges (given).
 
@@ -462,6 +462,9 @@ def shadow_visibility(
         the hard 0/1 test either way.
     pcf_samples : int
         Disk samples for ``pcf_sampling="poisson"``.
+    options : ShadowOptions, optional
+        All of the above at once, checked when made (then leave the keywords at their defaults);
+        ``cull`` and ``bounds`` in it are not used here.
 
     Returns
     -------
@@ -480,23 +483,19 @@ def shadow_visibility(
     D = check_shadow_map(D, where)
     M = as_array(M, "M", shape=(4, 4), where=where)
     size = D.shape[0]
-    bias = DEFAULT_BIAS_TEXELS / size if bias is None else check_float(bias, "bias", minimum=0.0, where=where)
-    slope_bias = (
-        DEFAULT_SLOPE_BIAS if slope_bias is None else check_float(slope_bias, "slope_bias", minimum=0.0, where=where)
-    )
-    k = _pcf_size(pcf, where)
-    if pcf_sampling not in PCF_SAMPLINGS:
-        raise MeshError(
-            f"{where}: pcf_sampling must be one of {', '.join(map(repr, PCF_SAMPLINGS))}; got {pcf_sampling!r}"
-        )
-    pcf_samples = check_int(pcf_samples, "pcf_samples", minimum=1, maximum=256, where=where)
-    if not isinstance(frustum_fix, bool | np.bool_):
-        raise MeshError(f"{where}: frustum_fix must be True or False, got {frustum_fix!r}")
+    keywords = dict(
+        bias=bias, slope_bias=slope_bias, pcf=pcf, frustum_fix=frustum_fix, max_slope=max_slope,
+        pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
+    )  # fmt: skip
+    opts = ShadowOptions.of(options, where, keywords, _SHADOW_VISIBILITY_DEFAULTS)
+    bias = DEFAULT_BIAS_TEXELS / size if opts.bias is None else opts.bias
+    slope_bias = DEFAULT_SLOPE_BIAS if opts.slope_bias is None else opts.slope_bias
+    k, max_slope, pcf_sampling, pcf_samples = opts.pcf, opts.max_slope, opts.pcf_sampling, opts.pcf_samples
 
     vis = np.ones(len(P))
     uvz = light_uvz(P, M)
     ok = np.isfinite(uvz).all(axis=1)
-    if frustum_fix:
+    if opts.frustum_fix:
         ok[ok] = ~outside_frustum(uvz[ok])
     idx = np.flatnonzero(ok)
     if len(idx) == 0:
@@ -514,3 +513,6 @@ def shadow_visibility(
     else:
         vis[idx] = pcf_visibility(D, uvz, b, k, gradient=g)
     return vis
+
+
+_SHADOW_VISIBILITY_DEFAULTS = keyword_defaults(shadow_visibility)

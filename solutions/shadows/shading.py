@@ -22,9 +22,10 @@ from geomlib.raster import rasterize
 from geomlib.validate import MeshError, as_array, check_float, check_int
 
 from .cubemap import cube_depth_maps, point_shadow_visibility
-from .depth import CULL_MODES, depth_map
+from .depth import depth_map
 from .lights import directional_light_matrix, spot_light_matrix
 from .lookup import DEFAULT_MAX_SLOPE, shadow_visibility
+from .options import ShadowOptions, keyword_defaults
 from .scene import Scene, as_camera, as_light, as_scene
 
 __all__ = [
@@ -171,28 +172,30 @@ def light_visibility(
     max_slope: float = DEFAULT_MAX_SLOPE,
     pcf_sampling: str = "grid",
     pcf_samples: int = 16,
+    options: ShadowOptions | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Both passes for the eye's points: ``(visibility (k,), shadow maps (1 or 6, s, s))`` (given)."""
+    """Both passes for the eye's points: ``(visibility (k,), shadow maps (1 or 6, s, s))`` (given).
+
+    The shadow options come as keywords or, all at once, as ``options`` (a :class:`ShadowOptions`).
+    """
     where = "light_visibility"
     S = as_scene(scene, where)
     map_size = check_int(map_size, "map_size", minimum=1, maximum=2**15, where=where)
-    if cull not in CULL_MODES:
-        raise MeshError(f"{where}: cull must be one of {', '.join(map(repr, CULL_MODES))}; got {cull!r}")
-    setup = light_setup(S, light, bounds=bounds)
+    keywords = dict(
+        bias=bias, slope_bias=slope_bias, pcf=pcf, cull=cull, frustum_fix=frustum_fix, bounds=bounds,
+        max_slope=max_slope, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
+    )  # fmt: skip
+    opts = ShadowOptions.of(options, where, keywords, _LIGHT_VISIBILITY_DEFAULTS)
+    setup = light_setup(S, light, bounds=opts.bounds)
     if setup.light["type"] == "point":
-        maps = cube_depth_maps(S.V, S.F, setup.light["position"], map_size, setup.near, setup.far, cull)
+        maps = cube_depth_maps(S.V, S.F, setup.light["position"], map_size, setup.near, setup.far, opts.cull)
         vis = point_shadow_visibility(
-            eb.P, eb.N_face, maps, setup.light["position"], setup.near, setup.far, bias, slope_bias, pcf,
-            max_slope=max_slope, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
-        )  # fmt: skip
+            eb.P, eb.N_face, maps, setup.light["position"], setup.near, setup.far, options=opts
+        )
         return vis, maps
     M = setup.matrices[0]
-    D = depth_map(S.V, S.F, M, map_size, cull)
-    vis = shadow_visibility(
-        eb.P, eb.N_face, D, M, bias, slope_bias, pcf,
-        frustum_fix=frustum_fix, max_slope=max_slope, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
-    )  # fmt: skip
-    return vis, D[None]
+    D = depth_map(S.V, S.F, M, map_size, opts.cull)
+    return shadow_visibility(eb.P, eb.N_face, D, M, options=opts), D[None]
 
 
 def _light_dirs(L: dict, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -275,6 +278,7 @@ def render_with_shadows(
     specular: float = 0.25,
     shininess: float = 48.0,
     return_visibility: bool = False,
+    options: ShadowOptions | None = None,
 ):
     """Render a scene with Blinn-Phong shading and shadow-mapped shadows (given).
 
@@ -303,6 +307,8 @@ def render_with_shadows(
         max(n.h, 0)^shininess [n.l > 0]`` with ``v`` the visibility and ``s`` the spot-cone factor.
     return_visibility : bool
         Also return the visibility image.
+    options : ShadowOptions, optional
+        The shadow options at once, checked when made (then leave their keywords at the defaults).
 
     Returns
     -------
@@ -316,13 +322,19 @@ def render_with_shadows(
     w, h = _size(size, where)
     eb = eye_gbuffer(S, camera, (w, h), fov_deg)
     L = as_light(light, where)
-    vis, _ = light_visibility(
-        S, eb, L, map_size=map_size, bias=bias, slope_bias=slope_bias, pcf=pcf, cull=cull,
-        frustum_fix=frustum_fix, bounds=bounds, pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
+    keywords = dict(
+        bias=bias, slope_bias=slope_bias, pcf=pcf, cull=cull, frustum_fix=frustum_fix, bounds=bounds,
+        pcf_sampling=pcf_sampling, pcf_samples=pcf_samples,
     )  # fmt: skip
+    opts = ShadowOptions.of(options, where, keywords, _RENDER_DEFAULTS)
+    vis, _ = light_visibility(S, eb, L, map_size=map_size, options=opts)
     image = shade(eb, vis, L, ambient=ambient, diffuse=diffuse, specular=specular, shininess=shininess)
     if not return_visibility:
         return image
     V = np.full((h, w), np.nan)
     V.ravel()[eb.mask.ravel()] = vis
     return image, V
+
+
+_LIGHT_VISIBILITY_DEFAULTS = keyword_defaults(light_visibility)
+_RENDER_DEFAULTS = keyword_defaults(render_with_shadows)

@@ -6,11 +6,11 @@ import warnings
 
 import numpy as np
 
-from geomlib.validate import MeshError, check_choice, check_float, check_mesh
+from geomlib.validate import MeshError, check_choice, check_float, check_mesh, checked
 
 from .contraction import make_state, state_mesh
 from .greedy import candidate_pairs, greedy_collapse
-from .quadrics import WEIGHTINGS, vertex_quadrics
+from .quadrics import WEIGHTINGS, crease_quadrics, vertex_quadrics
 from .refit import refine_positions
 
 __all__ = ["qem_simplify", "SimplificationWarning"]
@@ -50,6 +50,8 @@ def qem_simplify(
     method: str = "greedy",
     weighting: str = "area",
     boundary_weight: float = 10.0,
+    crease_angle: float | None = 60.0,
+    crease_weight: float = 1.0,
     min_cos: float = 0.0,
     on_unreachable: str = "raise",
     refit: bool | None = None,
@@ -86,6 +88,12 @@ def qem_simplify(
         Face quadric weights (see :func:`~solutions.simplification.quadrics.face_quadrics`).
     boundary_weight : float
         Weight of the boundary penalty quadrics.
+    crease_angle : float in [0, 180] or None
+        Edges whose faces meet at a dihedral angle above this (degrees) are sharp features: they
+        get constraint-plane quadrics (:func:`~solutions.simplification.quadrics.crease_quadrics`)
+        so creases and corners of CAD-like parts keep their place. None: no crease quadrics.
+    crease_weight : float
+        Weight of the crease quadrics.
     min_cos : float in [-1, 1)
         Flip test threshold: a contraction is refused when a face normal turns so that
         ``cos(angle) <= min_cos`` (0: refuse turns of 90° and more).
@@ -121,6 +129,9 @@ def qem_simplify(
     check_choice(method, "method", METHODS, where=where)
     check_choice(weighting, "weighting", WEIGHTINGS, where=where)
     boundary_weight = check_float(boundary_weight, "boundary_weight", minimum=0.0, where=where)
+    if crease_angle is not None:
+        crease_angle = check_float(crease_angle, "crease_angle", minimum=0.0, maximum=180.0, where=where)
+    crease_weight = check_float(crease_weight, "crease_weight", minimum=0.0, where=where)
     min_cos = check_float(min_cos, "min_cos", minimum=-1.0, maximum=0.999, where=where)
     check_choice(on_unreachable, "on_unreachable", ("raise", "warn"), where=where)
     if method == "fast" and pair_threshold > 0:
@@ -131,19 +142,22 @@ def qem_simplify(
     if not isinstance(refit, bool | np.bool_):
         raise MeshError(f"{where}: refit must be True, False or None, got {refit!r}")
 
-    Q = vertex_quadrics(V, F, weighting, boundary_weight if preserve_boundary else 0.0)
-    if method == "greedy":
-        state = make_state(V, F, Q)
-        _, others = candidate_pairs(V, F, pair_threshold)
-        greedy_collapse(state, others, target_faces, min_cos)
-        V_out, F_out = state_mesh(state)
-        normals0 = state.face_normal0[state.face_alive]
-    else:
-        from .compiled import compiled_collapse  # imports numba (0.2-0.5 s): only when asked for
+    with checked(V, F, manifold=True):  # the quadric and contraction helpers receive the checked mesh
+        Q = vertex_quadrics(V, F, weighting, boundary_weight if preserve_boundary else 0.0)
+        if crease_angle is not None and crease_weight > 0:
+            Q += crease_quadrics(V, F, crease_angle, crease_weight)
+        if method == "greedy":
+            state = make_state(V, F, Q)
+            _, others = candidate_pairs(V, F, pair_threshold)
+            greedy_collapse(state, others, target_faces, min_cos)
+            V_out, F_out = state_mesh(state)
+            normals0 = state.face_normal0[state.face_alive]
+        else:
+            from .compiled import compiled_collapse  # imports numba (0.2-0.5 s): only when asked for
 
-        V_out, F_out, normals0 = compiled_collapse(V, F, Q, target_faces, min_cos)
-    if refit and len(F_out) and not pair_threshold > 0:
-        V_out = refine_positions(V, F, V_out, F_out, normals0=normals0)
+            V_out, F_out, normals0 = compiled_collapse(V, F, Q, target_faces, min_cos)
+        if refit and len(F_out) and not pair_threshold > 0:
+            V_out = refine_positions(V, F, V_out, F_out, normals0=normals0)
 
     if len(F_out) > target_faces + 2:
         msg = (
