@@ -99,8 +99,14 @@ def test_a_forged_sparse_shape_is_refused_before_anything_is_allocated(tmp_path)
 
 def test_the_whole_run_stops_at_its_time_budget_and_still_writes_results(tmp_path):
     r = _grade("slow", tmp_path, GEOMLIB_TIME_LIMIT="2", GEOMLIB_TIME_BUDGET="12")
-    assert r["seconds"] < 12 + 30  # the budget plus start-up and the pure-Python tests
-    assert any("time budget of 12 s for the whole submission" in t["text"] for t in r["results"]["tests"])
+    texts = [t["text"] for t in r["results"]["tests"]]
+    assert any("time budget of 12 s for the whole submission" in t for t in texts)
+    # Within a 12 s budget at most 12 / 2 calls can each use up their 2 s (plus the one running when
+    # the budget ran out); every later call fails at once. (Counted, not timed: a loaded machine is
+    # slower but cannot fit more 2 s waits into 12 s; it may spend the budget before the first one.)
+    waited = [t for t in texts if "did not finish within 2 s" in t]
+    assert len(waited) <= 12 // 2 + 1, len(waited)
+    assert r["seconds"] < 12 + 300  # a hang (the grader did not stop at its budget), not slowness
 
 
 def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(tmp_path):
