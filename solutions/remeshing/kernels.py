@@ -5,6 +5,10 @@ could otherwise go stale), so every edit would rebuild it in O(h log h). The rem
 tens of thousands of local edits, so they run here on plain arrays and the structure is rebuilt
 (and checked) around them once per public call.
 
+Longer than most modules (about 670 lines) on purpose: one mutable corner table and every compiled
+edit on it (split, collapse, flip, the sliver clean-up) share private helpers and numba's typing;
+split across modules they would need to export those helpers to each other.
+
 The state (all arrays, edited in place):
 
 * ``V (ncap, 3)`` positions, ``F (mcap, 3)`` faces; half-edge ``h = 3 f + k`` runs from
