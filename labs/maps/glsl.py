@@ -33,9 +33,9 @@ __all__ = ["SHADERS", "shader_path", "glsl_tbn", "glsl_shade", "glsl_displace"]
 SHADERS = ("tbn.vert", "normalmap.frag", "displace.vert")
 #: The task each shader file is.
 TASKS = {
-    "tbn.vert": "Task 7: TBN in the vertex shader",
-    "normalmap.frag": "Task 8: normal mapping in the fragment shader",
-    "displace.vert": "Task 9: displacement in the vertex shader",
+    "tbn.vert": "Task 7: vertex TBN",
+    "normalmap.frag": "Task 8: fragment normal mapping",
+    "displace.vert": "Task 9: vertex displacement",
 }
 #: The most lights ``normalmap.frag`` takes (its uniform arrays have this length).
 MAX_LIGHTS = 4
