@@ -28,8 +28,8 @@ out vec4 result;
 // weights have only a few bits of precision). Row r of the image is GL row h - 1 - r.
 vec3 texel(sampler2D tex, ivec2 size, int x, int y) {
     if (repeat_wrap != 0) {
-        x = ((x % size.x) + size.x) % size.x;
-        y = ((y % size.y) + size.y) % size.y;
+        x -= size.x * int(floor(float(x) / float(size.x)));  // GLSL's % of a negative int is undefined
+        y -= size.y * int(floor(float(y) / float(size.y)));
     } else {
         x = clamp(x, 0, size.x - 1);
         y = clamp(y, 0, size.y - 1);

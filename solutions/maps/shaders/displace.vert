@@ -19,8 +19,8 @@ flat out float offset;
 // Given: one texel, clamped to the edge or tiled (row r of the image is GL row s - 1 - r).
 float texel(ivec2 size, int x, int y) {
     if (repeat_wrap != 0) {
-        x = ((x % size.x) + size.x) % size.x;
-        y = ((y % size.y) + size.y) % size.y;
+        x -= size.x * int(floor(float(x) / float(size.x)));  // GLSL's % of a negative int is undefined
+        y -= size.y * int(floor(float(y) / float(size.y)));
     } else {
         x = clamp(x, 0, size.x - 1);
         y = clamp(y, 0, size.y - 1);
