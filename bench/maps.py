@@ -11,6 +11,8 @@ Targets of the issue (this 2-core machine):
   ``line_mesh_intersection`` for the same texel points and directions (the ray casts alone).
 - ``tangent_frames`` on ~1M faces <= 1 s. No installed library computes tangent frames; the anchor
   is ``igl.per_vertex_normals`` (area-weighted) on the same mesh, a scatter of the same size.
+- The GLSL route (issue 27): one 512 x 512 normal-mapped frame by NumPy ``shade``, by the lab's
+  ``shaders/normalmap.frag`` (``glsl_shade``) and by pyrender, in one run.
 
 Times are the best of a few runs with the contenders interleaved (the machine is shared and
 noisy); next to the wall time of the solution, its CPU time (``time.process_time``, all threads),
@@ -35,6 +37,7 @@ from solutions.maps import (
     bake_normal_map,
     displace,
     encode_normal_map,
+    glsl_shade,
     height_to_normal_map,
     rasterize_mesh,
     shade,
@@ -204,6 +207,35 @@ def bench_bake(quick: bool, repeat: int) -> None:
         bench_bake_case(f"{fname} -> decimated, triangle atlas", V, F, Vs, Fs, UV, size, repeat)
 
 
+def bench_glsl(repeat: int) -> None:
+    """One 512 x 512 normal-mapped frame three ways: NumPy ``shade``, ``shaders/normalmap.frag`` (``glsl_shade``:
+    G-buffer upload, draw, read-back) and a pyrender frame, all on the same G-buffer / scene (OSMesa here)."""
+    size = 512
+    V, F, UV, N, tangents, nmap, eye, view, M = torus_scene(size, 512)
+    g = rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
+    lights = [{"direction": (-1.0, 1.0, -2.0)}, {"direction": (1.0, 0.5, -0.5), "intensity": 0.4}]
+    print(f"GLSL route: one {size}x{size} frame of the normal-mapped uv_torus, {int(g.mask.sum()):,} covered pixels")
+    ref = shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)
+    got = glsl_shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)  # warm: context, compilation
+    try:
+        renderer, scene = pyrender_frame(V, F, UV, N, tangents, nmap, view, size)
+        renderer.render(scene)
+    except Exception as e:  # no headless OpenGL for pyrender: report the two routes alone
+        print(f"  (pyrender unavailable: {type(e).__name__}: {e})")
+        renderer = None
+    t_np, t_gl, t_pr = [], [], []
+    for _ in range(repeat):
+        t_np.append(timed(lambda: shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)))
+        t_gl.append(timed(lambda: glsl_shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)))
+        if renderer is not None:
+            t_pr.append(timed(lambda: renderer.render(scene)))
+    pr = f"{min(t_pr):.3f} s" if t_pr else "n/a"
+    print(f"  NumPy shade {min(t_np):.3f} s   normalmap.frag (llvmpipe) {min(t_gl):.3f} s   pyrender frame {pr}")
+    print(f"  NumPy vs GLSL: max difference {np.abs(got - ref).max():.2g} per pixel")
+    if renderer is not None:
+        renderer.delete()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller inputs, one repetition")
@@ -213,6 +245,7 @@ def main(argv: list[str] | None = None) -> int:
     bench_tangents(args.quick, repeat)
     bench_shade(args.quick, repeat)
     bench_bake(args.quick, repeat)
+    bench_glsl(repeat)
     return 0
 
 

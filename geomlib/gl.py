@@ -42,7 +42,7 @@ import numpy as np
 
 from geomlib.errors import MeshError
 
-__all__ = ["ShaderError", "QUAD_VERTEX_SHADER", "render_quad", "render_mesh", "renderer_info", "close"]
+__all__ = ["ShaderError", "QUAD_VERTEX_SHADER", "render_quad", "render_mesh", "render_points", "renderer_info", "close"]
 
 #: Vertex shader of :func:`render_quad`: a full-screen quad passing ``uv`` in [0, 1]² (v up).
 QUAD_VERTEX_SHADER = """#version 330 core
@@ -505,3 +505,56 @@ def _render_mesh(GL, vertex, fragment, attributes, F, size, textures, uniforms, 
         GL.glDeleteBuffers(len(buffers) + 1, [*buffers, ebo])
         GL.glDeleteVertexArrays(1, [vao])
     return out[0] if outputs == 1 else out
+
+
+def render_points(
+    vertex: str,
+    fragment: str,
+    attributes: Mapping[str, np.ndarray],
+    size,
+    *,
+    textures: Mapping[str, np.ndarray] | None = None,
+    uniforms: Mapping[str, object] | None = None,
+    outputs: int = 1,
+    filter: str = "nearest",
+    wrap: str = "clamp",
+    version: str = "330 core",
+    name: str = "vertex shader",
+) -> np.ndarray | list[np.ndarray]:
+    """Draw every vertex as one point (``GL_POINTS``): read a vertex shader's per-vertex results back.
+
+    The vertex shader places vertex ``gl_VertexID`` on a pixel of its own (e.g. ``i % width, i / width``)
+    and passes its results as ``flat`` outputs; ``fragment`` writes them to the colour targets.
+    Arguments and result as in :func:`render_mesh` (no triangles, no depth test).
+    """
+    size = _size(size)
+    n = None
+    for key, a in attributes.items():
+        a = np.asarray(a)
+        if a.ndim != 2 or not 1 <= a.shape[1] <= 4 or (n is not None and len(a) != n):
+            raise MeshError(
+                f"geomlib.gl.render_points: attribute {key!r} has shape {a.shape}; expected (n, 1..4), same n for all"
+            )
+        n = len(a)
+    if not n:
+        raise MeshError("geomlib.gl.render_points: no vertices (give at least one attribute with rows)")
+    GL = _gl()
+    _note_shader(name)
+    try:
+        prog = _program(GL, vertex, fragment, name, version)
+        vao, buffers = _vertex_array(GL, prog, attributes)
+
+        def draw():
+            GL.glBindVertexArray(vao)
+            GL.glDrawArrays(GL.GL_POINTS, 0, n)
+
+        try:
+            out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
+        finally:
+            GL.glBindVertexArray(0)
+            if buffers:
+                GL.glDeleteBuffers(len(buffers), buffers)
+            GL.glDeleteVertexArrays(1, [vao])
+        return out[0] if outputs == 1 else out
+    finally:
+        _note_shader(None)

@@ -31,10 +31,13 @@ TASK = re.compile(r"NotImplementedError\(\s*['\"]Task (\d+[a-z]?)\b")
 
 
 def stub_tasks(lab: str) -> set[str]:
-    """Task labels of the stubs' ``NotImplementedError`` messages (``"2"``, ``"1a"``)."""
+    """Task labels of the stubs' ``NotImplementedError`` messages (``"2"``, ``"1a"``) and of their
+    shaders' ``#error Task N`` directives (``shaders/*.frag``, ``*.vert``)."""
     found: set[str] = set()
     for f in (ROOT / "labs" / lab).glob("*.py"):
         found |= set(TASK.findall(f.read_text(encoding="utf-8")))
+    for f in (ROOT / "labs" / lab / "shaders").glob("*"):
+        found |= set(re.findall(r"^\s*#error Task (\d+[a-z]?)\b", f.read_text(encoding="utf-8"), re.M))
     return found
 
 

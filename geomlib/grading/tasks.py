@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,6 +29,9 @@ from geomlib.grading.registry import graded_module
 from geomlib.taskref import find_task
 
 __all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
+
+#: A shader named in a lab function: ``"parallax"`` (``shaders/parallax.frag``) or ``"tbn.vert"``.
+_SHADER = re.compile(r"[A-Za-z_]\w*(\.(?:frag|vert))?")
 
 
 @dataclass
@@ -102,8 +106,8 @@ def derive(lab_dir: str | Path) -> TaskTable:
             # A function that runs one of the lab's shaders (``_run("parallax", ...)``) holds the
             # shader's tasks: the student writes them in ``shaders/parallax.frag``.
             for n in ast.walk(node):
-                if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value.isidentifier():
-                    shader = Path(lab_dir) / "shaders" / f"{n.value}.frag"
+                if isinstance(n, ast.Constant) and isinstance(n.value, str) and _SHADER.fullmatch(n.value):
+                    shader = Path(lab_dir) / "shaders" / (n.value if "." in n.value else f"{n.value}.frag")
                     if shader.is_file():
                         shader_marks += [(n, t, node.name) for n, t in _marks(shader.read_text().splitlines())]
             calls = set()

@@ -91,3 +91,23 @@ def test_no_usable_platform_names_the_fix():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=120)
     assert out.returncode != 0
     assert "could not create a headless OpenGL context" in out.stderr and "apt-get install libosmesa6" in out.stderr
+
+
+def test_points_read_back_every_vertex_s_own_result():
+    """render_points: vertex i on pixel (i % w, i // w) of a (w, h) target; its flat output read back exactly."""
+    vs = (
+        "in vec3 p; uniform ivec2 grid; flat out vec4 r;\n"
+        "void main() {\n"
+        "    r = vec4(2.0 * p, float(gl_VertexID));\n"
+        "    vec2 px = vec2(float(gl_VertexID % grid.x), float(gl_VertexID / grid.x)) + 0.5;\n"
+        "    gl_Position = vec4(px * 2.0 / vec2(grid) - 1.0, 0.0, 1.0);\n"
+        "}\n"
+    )
+    fs = "flat in vec4 r; out vec4 o;\nvoid main() { o = r; }"
+    P = np.arange(21, dtype=np.float64).reshape(7, 3) / 8
+    out = gl.render_points(vs, fs, {"p": P}, (3, 3), uniforms={"grid": np.array([3, 3], np.int32)})
+    rows = out[::-1].reshape(-1, 4)  # read-back row 0 is the top: GL row 2
+    assert np.array_equal(rows[:7, :3], 2 * P) and np.array_equal(rows[:7, 3], np.arange(7))
+    assert np.all(rows[7:] == 0)  # no vertex there
+    with pytest.raises(MeshError, match="no vertices"):
+        gl.render_points(vs, fs, {}, (1, 1))

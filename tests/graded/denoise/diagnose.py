@@ -10,6 +10,7 @@ TASKS = {
     "denoise_with_map": (5,),
     "weld_seams": (6,),
     "seam_mean": (6,),
+    "glsl_denoise_with_map": (7,),
 }
 TITLES = {
     1: "uniform offsets",
@@ -18,9 +19,11 @@ TITLES = {
     4: "bake",
     5: "denoising through the map",
     6: "seam fix, weld",
+    7: "vertex denoising",
 }
 COMPOSITES = {
     "denoise_vertices": ("laplacian_offsets", "normal_offsets", "seam_mean", "weld_seams"),
     "laplacian_offsets": ("weld_seams",),
     "denoise_with_map": ("seam_mean", "weld_seams"),
+    "glsl_denoise_with_map": ("seam_mean", "weld_seams"),
 }

@@ -517,3 +517,60 @@ def test_rejects_non_square_maps(lab):
     N = np.tile(UP, (5, 1))
     expect_rejected(lab, "denoise_with_map", V, F, UV, N, np.zeros((4, 8)), 0, 1, 0.5, match="square")
     expect_rejected(lab, "denoise_with_map", V, F, UV, N, np.zeros((4, 4, 3)), 0, 1, 0.5, match="single-channel")
+
+
+# ------------------------------------------------------------------------------ the GLSL route (task 7)
+
+#: shaders/denoise.vert against the stored NumPy references of the map route: measured (llvmpipe,
+#: float32) p99 9.0e-8, p99.9 1.1e-7, max 1.1e-7 mesh units over the three map cases, welded or not;
+#: the tolerance 1e-5 is 90x the max and far below a wrong sign or a missing lam (>= 1e-3 here).
+GLSL_ATOL = 1e-5
+
+
+def check_glsl_denoise(lab, case_id: str) -> None:
+    """``glsl_denoise_with_map`` (shaders/denoise.vert, the vertex stage) on a map case: its stored reference."""
+    from geomlib.grading.cases import load_reference
+
+    from .cases_hidden import CASES as HIDDEN
+
+    case = {c.id: c for c in (*CASES, *HIDDEN)}[case_id]
+    inp = case.inputs()
+    got = np.asarray(lab.glsl_denoise_with_map(**inp, **case.params), float)
+    expected = load_reference("denoise", case)["V"]
+    label = f'glsl_denoise_with_map (shaders/denoise.vert, the vertex stage) on "{case_id}"'
+    if got.shape != expected.shape:
+        raise Mismatch(f"{label}: the shader's output has shape {got.shape}, expected {expected.shape}")
+    per = np.abs(got - expected).max(axis=1)
+    bad = ~(per <= GLSL_ATOL)  # NaN counts as wrong
+    if bad.any():
+        i = int(np.argmax(bad))
+        nan = " (NaN: the shader wrote NaN)" if np.isnan(got[i]).any() else ""
+        raise Mismatch(
+            f"{label}: vertex {i} expected {expected[i].round(7).tolist()}, got {got[i].round(7).tolist()}{nan}; "
+            f"{int(bad.sum())} of {len(per)} vertices differ by more than {GLSL_ATOL:g}",
+            failure_picture(label, got, expected, name="V", mesh=(inp["V"], inp["F"]), atol=GLSL_ATOL),
+        )
+
+
+@graded(points=2, part="vertex denoising", timeout=60)
+def test_glsl_denoise_with_map(lab):
+    """shaders/denoise.vert against denoise_with_map's references (a 16-bit torus map, an 8-bit sphere map)"""
+    check_glsl_denoise(lab, "map-uv-torus-16bit")
+    check_glsl_denoise(lab, "map-uv-sphere-8bit")
+
+
+@graded(points=1, part="vertex denoising", timeout=60)
+def test_glsl_denoise_keeps_seams_closed(lab):
+    """weld=True: the copies of every seam vertex of the UV torus end at one position (the CPU-side seam fix)"""
+    case = {c.id: c for c in CASES}["map-uv-torus-16bit"]
+    inp = case.inputs()
+    got = np.asarray(lab.glsl_denoise_with_map(**inp, **{**case.params, "weld": True}), float)
+    V = np.asarray(inp["V"], float)
+    _, first, group = np.unique(V.round(12), axis=0, return_index=True, return_inverse=True)
+    gap = np.abs(got - got[first][group.ravel()]).max(axis=1)
+    if not gap.max() <= 1e-6:
+        i = int(np.argmax(gap))
+        raise Mismatch(
+            f"glsl_denoise_with_map(weld=True) (shaders/denoise.vert, the vertex stage, then the given seam fix): "
+            f"vertex {i} is {gap[i]:.3g} away from its seam copy (the seam cracks open)"
+        )

@@ -369,3 +369,136 @@ def test_wrong_image_modes(lab):
     expect_rejected(
         lab, "shade", g, LIGHT, eye, (1, 1, 1), np.zeros((4, 4)), match="1 channel", label="shade(grey normal map)"
     )
+
+
+# ------------------------------------------------------------------------------ the GLSL route (tasks 7-9)
+
+#: Tolerances of the GLSL route, from the measured agreement of the solution's shaders with the
+#: stored NumPy references (llvmpipe, float32; the handout's table lists p99 / p99.9 / max):
+#: frames agree to 2.4e-7 at most, so 1e-5 (40x that, still 1e-5 rad of a frame's direction);
+#: shading to 2.1e-6 at most, so the lab's own shading tolerance 1e-4 (a quarter of an 8-bit level);
+#: displaced positions to 3.6e-7 mesh units at most, so 1e-5 (lam (bias + scale h) is at most 0.5 here).
+GLSL_FRAME_ATOL = 1e-5
+GLSL_SHADE_ATOL = 1e-4
+GLSL_DISPLACE_ATOL = 1e-5
+STAGE = {
+    "glsl_tbn": ("shaders/tbn.vert", "vertex stage"),
+    "glsl_shade": ("shaders/normalmap.frag", "fragment stage"),
+    "glsl_displace": ("shaders/displace.vert", "vertex stage"),
+}
+
+
+def _case(case_id: str):
+    from .cases_hidden import CASES as HIDDEN
+
+    return {c.id: c for c in (*CASES, *HIDDEN)}[case_id]
+
+
+def expect_glsl_rows(label: str, got, expected, atol: float, mesh=None, name: str = "output") -> None:
+    """Per-vertex (or per-pixel) results of a shader within ``atol`` of the NumPy reference, everywhere."""
+    e = np.asarray(expected, float)
+    g = np.asarray(got, float)
+    if g.shape != e.shape:
+        raise Mismatch(f"{label}: the shader's output has shape {g.shape}, expected {e.shape}")
+    per = np.abs(g - e).reshape(len(e), -1).max(axis=1) if e.ndim == 2 else np.abs(g - e).max(axis=-1)
+    bad = ~(per <= atol)  # NaN counts as wrong
+    if not bad.any():
+        return
+    first = tuple(int(i) for i in np.argwhere(bad)[0])
+    where = f"vertex {first[0]}" if e.ndim == 2 else f"pixel [{first[0]}, {first[1]}]"
+    nan = " (NaN: a division by zero or normalize(0)?)" if np.isnan(g[first]).any() else ""
+    raise Mismatch(
+        f"{label}: {where} expected {format_vec(e[first])}, got {format_vec(g[first])}{nan}; "
+        f"{int(bad.sum())} of {bad.size} {'vertices' if e.ndim == 2 else 'pixels'} differ by more than {atol:g}",
+        failure_picture(label, g, e, name=name, mesh=mesh, atol=atol),
+    )
+
+
+def _label(function: str, case_id: str) -> str:
+    path, stage = STAGE[function]
+    return f'{function} ({path}, the {stage}) on "{case_id}"'
+
+
+def check_glsl_tbn(lab, case_id: str, model=None) -> None:
+    """``shaders/tbn.vert`` fed the stored frame of a tangent case (``N``, ``[T, w]``) gives it back in world
+    space: with ``model = s R + t`` (rotation R, uniform scale s) the expected frame is ``R T, R B, R N``."""
+    from geomlib.grading.cases import load_reference
+
+    case = _case(case_id)
+    ref = load_reference("maps", case)
+    R = np.eye(3) if model is None else np.asarray(model, float)[:3, :3]
+    R = R / np.cbrt(np.linalg.det(R))  # the rotation of s R
+    inp = case.inputs()
+    got = lab.glsl_tbn(ref["N"], np.column_stack([ref["T"], ref["w"]]), model)
+    label = _label("glsl_tbn", case_id) + ("" if model is None else " with a rotated and scaled model matrix")
+    for k, g in zip("TBN", got, strict=True):
+        expect_glsl_rows(f"{label}, {k}", g, ref[k] @ R.T, GLSL_FRAME_ATOL, mesh=(inp["V"], inp["F"]), name=k)
+
+
+def check_glsl_shade(lab, case_id: str) -> None:
+    from geomlib.grading.cases import load_reference
+
+    case = _case(case_id)
+    got = lab.glsl_shade(**case.inputs(), **case.params)
+    expect_glsl_rows(
+        _label("glsl_shade", case_id), got, load_reference("maps", case)["image"], GLSL_SHADE_ATOL, name="image"
+    )
+
+
+def check_glsl_displace(lab, case_id: str) -> None:
+    from geomlib.grading.cases import load_reference
+
+    case = _case(case_id)
+    inp = case.inputs()
+    got = lab.glsl_displace(**inp, **case.params)
+    b, s = case.params.get("bias", 0.0), case.params.get("scale", 1.0)
+    label = _label("glsl_displace", case_id) + f" (bias, scale) = ({b:g}, {s:g})"
+    expect_glsl_rows(label, got, load_reference("maps", case)["V"], GLSL_DISPLACE_ATOL, mesh=(inp["V"], inp["F"]))
+
+
+def rotation_model() -> np.ndarray:
+    """2 R_z(30 deg) R_x(-50 deg) plus a translation (the translation must not reach directions)."""
+    a, b = np.radians(30), np.radians(-50)
+    Rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    Rx = np.array([[1, 0, 0], [0, np.cos(b), -np.sin(b)], [0, np.sin(b), np.cos(b)]])
+    M = np.eye(4)
+    M[:3, :3] = 2.0 * Rz @ Rx
+    M[:3, 3] = (0.3, -1.0, 2.0)
+    return M
+
+
+@graded(points=1, part="vertex TBN", timeout=60)
+def test_glsl_tbn_by_hand(lab):
+    """non-uniform scale diag(2, 1, 1): normals by the inverse transpose, B = w N' x T'"""
+    # n = (1, 0, 1)/sqrt2: M^-T n ~ (1/2, 0, 1) -> N' = (1, 0, 2)/sqrt5; T = (1, 0, -1)/sqrt2: M T ~ (2, 0, -1),
+    # already orthogonal to N' -> T' = (2, 0, -1)/sqrt5; N' x T' = (0, 1, 0), so B' = (0, w, 0).
+    n = np.array([[1.0, 0, 1], [1.0, 0, 1]]) / np.sqrt(2)
+    t = np.array([[1.0, 0, -1, np.sqrt(2)], [1.0, 0, -1, -np.sqrt(2)]]) / np.sqrt(2)  # w = +1, then -1
+    T, B, N = lab.glsl_tbn(n, t, np.diag([2.0, 1.0, 1.0, 1.0]))
+    label = "glsl_tbn (shaders/tbn.vert, the vertex stage) with model = diag(2, 1, 1)"
+    expect_glsl_rows(label + ", N", N, np.tile([1.0, 0, 2], (2, 1)) / np.sqrt(5), GLSL_FRAME_ATOL, name="N")
+    expect_glsl_rows(label + ", T", T, np.tile([2.0, 0, -1], (2, 1)) / np.sqrt(5), GLSL_FRAME_ATOL, name="T")
+    expect_glsl_rows(label + ", B (w = +1, -1)", B, [[0.0, 1, 0], [0.0, -1, 0]], GLSL_FRAME_ATOL, name="B")
+
+
+@graded(points=2, part="vertex TBN", timeout=60)
+def test_glsl_tbn(lab):
+    """shaders/tbn.vert against the NumPy frames: a UV sphere, a mirrored torus (w = -1), a rotated model"""
+    check_glsl_tbn(lab, "tangents-uv-sphere")
+    check_glsl_tbn(lab, "tangents-mirrored-torus")
+    check_glsl_tbn(lab, "tangents-mirrored-torus", rotation_model())
+
+
+@graded(points=3, part="fragment normal mapping", timeout=60)
+def test_glsl_shade(lab):
+    """shaders/normalmap.frag against shade(): no map, a float map, a uint8 map, a torus with two lights"""
+    for case_id in ("shade-quad-plain", "shade-quad-float-map", "shade-quad-uint8-map", "shade-torus-two-lights"):
+        check_glsl_shade(lab, case_id)
+
+
+@graded(points=2, part="vertex displacement", timeout=60)
+def test_glsl_displace(lab):
+    """shaders/displace.vert against displace(), the lecture's three (bias, scale): (0, 1), (-1, 2), (-1, 5)"""
+    check_glsl_displace(lab, "displace-grid-wave")
+    check_glsl_displace(lab, "displace-sphere-bias-1-scale-2")
+    check_glsl_displace(lab, "displace-sphere-unwelded")

@@ -1,0 +1,98 @@
+"""Given: run the lab's GLSL shader ``shaders/denoise.vert`` (task 7) headless.
+
+``glsl_denoise_with_map`` takes the arguments of :func:`denoise_with_map` and computes the same
+positions in single precision on the GPU (llvmpipe, through :mod:`geomlib.gl`): every vertex is
+drawn as one point, the vertex shader reads its offset from the map and moves it, and vertex ``i``
+writes ``p'`` and ``s`` to pixel ``(i % width, i // width)`` of float render targets, read back here.
+The seam fix stays on the CPU side: with ``weld`` the copies of a seam vertex (:func:`weld_seams`)
+then move by the mean of their offsets ``s`` (read back from the shader) along their mean normal.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geomlib import gl
+from geomlib.textures import WRAP_MODES
+from geomlib.validate import check_choice, check_float, check_mesh
+
+from .inputs import as_offset_image, as_unit_normals, check_uv, check_weld, normalize_rows
+from .seams import seam_mean, weld_seams
+
+__all__ = ["SHADERS", "shader_path", "glsl_denoise_with_map"]
+
+#: The shader files of the lab, in task order.
+SHADERS = ("denoise.vert",)
+#: The task each shader file is.
+TASKS = {"denoise.vert": "Task 7: vertex denoising"}
+
+#: Given fragment shader of the per-vertex route: copy the vertex shader's flat outputs to the targets.
+_POINTS = """#version 330 core
+flat in vec3 moved;
+flat in float offset;
+layout(location = 0) out vec4 out_p;
+layout(location = 1) out vec4 out_s;
+void main() { out_p = vec4(moved, 1.0); out_s = vec4(offset, 0.0, 0.0, 1.0); }
+"""
+
+
+def shader_path(name: str) -> Path:
+    """``shaders/<name>`` next to this file."""
+    return Path(__file__).resolve().parent / "shaders" / name
+
+
+def _run_points(name: str, n: int, attributes: dict, textures: dict, uniforms: dict) -> list[np.ndarray]:
+    source = shader_path(name).read_text()
+    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
+    if todo:
+        raise NotImplementedError(f"shaders/{name}: {todo[0]}")
+    width = int(min(n, 1024))
+    size = (width, int(-(-n // width)))
+    try:
+        out = gl.render_points(
+            source,
+            _POINTS,
+            attributes,
+            size,
+            textures=textures,
+            uniforms={**uniforms, "grid": np.array(size, dtype=np.int32)},
+            outputs=2,
+            name=f"shaders/{name}",
+        )
+    except gl.ShaderError as e:  # name the task with the file: the message leads with both
+        msg = str(e).replace(f"shaders/{name}", f"shaders/{name} ({TASKS[name]})", 1)
+        raise gl.ShaderError(msg, log=e.log, lines=e.lines) from None
+    return [o[::-1].reshape(-1, 4)[:n] for o in out]  # read-back row 0 is the top: GL row size[1] - 1
+
+
+def glsl_denoise_with_map(
+    V, F, UV, N, image, bias: float, scale: float, lam: float, *, weld: bool = True, wrap: str = "clamp"
+) -> np.ndarray:
+    """:func:`denoise_with_map` computed by ``shaders/denoise.vert``: ``p' = p - lam (bias + scale h(uv)) n``."""
+    where = "glsl_denoise_with_map"
+    V, F = check_mesh(V, F, where=where)
+    UV = check_uv(UV, len(V), where, in_range=True)
+    N = as_unit_normals(N, len(V), where)
+    H = as_offset_image(image, where)
+    bias = check_float(bias, "bias", where=where)
+    scale = check_float(scale, "scale", where=where)
+    lam = check_float(lam, "lam", minimum=0.0, maximum=1.0, where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    weld = check_weld(weld, where)
+    P, s = _run_points(
+        "denoise.vert",
+        len(V),
+        {"position": V, "normal": N, "uv": UV},
+        {"height": H},
+        {"lam": lam, "bias": bias, "scale": scale, "repeat_wrap": int(wrap == "repeat")},
+    )
+    V_new = P[:, :3].astype(np.float64)
+    if weld:  # the CPU's part: copies of a seam vertex move together
+        _, _, group = weld_seams(V, F)
+        seam = np.bincount(group)[group] > 1
+        sm = seam_mean(s[:, 0].astype(np.float64), group)[group]
+        Nm = normalize_rows(seam_mean(N, group))[group]
+        V_new[seam] = V[seam] - lam * sm[seam, None] * Nm[seam]
+    return V_new

@@ -1,0 +1,250 @@
+"""Given: run the lab's GLSL shaders (``shaders/tbn.vert``, ``normalmap.frag``, ``displace.vert``, tasks 7-9) headless.
+
+``glsl_tbn``, ``glsl_shade`` and ``glsl_displace`` compute in single precision on the GPU (llvmpipe,
+through :mod:`geomlib.gl`) what :func:`geomlib.tangent_space.surface_frames` (taken to world space),
+:func:`shade` and :func:`displace` compute in NumPy; the graders compare them with the NumPy
+reference outputs.
+
+* The vertex shaders run once per vertex, drawn as points (:func:`geomlib.gl.render_points`): vertex
+  ``i`` writes its results to pixel ``(i % width, i // width)`` of float render targets, which are
+  read back (the per-vertex route: no rasterisation in between).
+* ``normalmap.frag`` runs once per pixel of a G-buffer (:func:`rasterize_mesh`): the pixel's
+  interpolated attributes arrive as float textures read with ``texelFetch``, so the shader sees the
+  same values as the NumPy code (rounded to float32).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from geomlib import gl
+from geomlib.textures import WRAP_MODES, weld_by_position
+from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float, check_mesh
+
+from .displacement import group_mean, welded_vertex_normals
+from .inputs import as_height_map, as_normal_map, as_tangents, as_unit_vectors, check_lights, check_uv, normalize_rows
+from .shading import _check_gbuffer
+
+__all__ = ["SHADERS", "shader_path", "glsl_tbn", "glsl_shade", "glsl_displace"]
+
+#: The shader files of the lab, in task order.
+SHADERS = ("tbn.vert", "normalmap.frag", "displace.vert")
+#: The task each shader file is.
+TASKS = {
+    "tbn.vert": "Task 7: vertex TBN",
+    "normalmap.frag": "Task 8: fragment normal mapping",
+    "displace.vert": "Task 9: vertex displacement",
+}
+#: The most lights ``normalmap.frag`` takes (its uniform arrays have this length).
+MAX_LIGHTS = 4
+
+#: Given fragment shaders of the per-vertex route: copy the vertex shader's flat outputs to the targets.
+_POINTS_TBN = """#version 330 core
+flat in vec3 T_world;
+flat in vec3 B_world;
+flat in vec3 N_world;
+layout(location = 0) out vec4 out_T;
+layout(location = 1) out vec4 out_B;
+layout(location = 2) out vec4 out_N;
+void main() { out_T = vec4(T_world, 1.0); out_B = vec4(B_world, 1.0); out_N = vec4(N_world, 1.0); }
+"""
+_POINTS_DISPLACE = """#version 330 core
+flat in vec3 moved;
+flat in float offset;
+layout(location = 0) out vec4 out_P;
+layout(location = 1) out vec4 out_d;
+void main() { out_P = vec4(moved, 1.0); out_d = vec4(offset, 0.0, 0.0, 1.0); }
+"""
+
+
+def shader_path(name: str) -> Path:
+    """``shaders/<name>`` next to this file (``name`` with or without its suffix)."""
+    if "." not in name:
+        name = next(s for s in SHADERS if s.split(".")[0] == name)
+    return Path(__file__).resolve().parent / "shaders" / name
+
+
+def _source(name: str) -> str:
+    source = shader_path(name).read_text()
+    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
+    if todo:
+        raise NotImplementedError(f"shaders/{name}: {todo[0]}")
+    return source
+
+
+def _renamed(e: gl.ShaderError, name: str) -> gl.ShaderError:
+    """The harness's error with the task after the file name: the message leads with both."""
+    msg = str(e).replace(f"shaders/{name}", f"shaders/{name} ({TASKS[name]})", 1)
+    return gl.ShaderError(msg, log=e.log, lines=e.lines)
+
+
+def _grid(n: int) -> tuple[int, int]:
+    width = int(min(n, 1024))
+    return width, int(-(-n // width))
+
+
+def _run_points(name: str, fragment: str, n: int, attributes: dict, textures: dict, uniforms: dict, outputs: int):
+    """Run the vertex shader ``shaders/<name>`` on ``n`` vertices; ``outputs`` arrays ``(n, 4)``."""
+    source = _source(name)
+    size = _grid(n)
+    try:
+        out = gl.render_points(
+            source,
+            fragment,
+            attributes,
+            size,
+            textures=textures,
+            uniforms={**uniforms, "grid": np.array(size, dtype=np.int32)},
+            outputs=outputs,
+            name=f"shaders/{name}",
+        )
+    except gl.ShaderError as e:
+        raise _renamed(e, name) from None
+    # Read-back row 0 is the top of the image: GL row size[1] - 1.
+    return [o[::-1].reshape(-1, 4)[:n] for o in out]
+
+
+def _model(model, where: str) -> np.ndarray:
+    M = np.eye(4) if model is None else as_array(model, "model", shape=(4, 4), where=where)
+    if abs(np.linalg.det(M[:3, :3])) < 1e-12:
+        raise MeshError(f"{where}: model's 3x3 part is singular (det = 0); normals cannot be transformed")
+    return M
+
+
+def glsl_tbn(N, tangents, model=None):
+    """World-space frames ``T, B, N`` ``(n, 3)`` per vertex computed by ``shaders/tbn.vert``.
+
+    With ``M`` the 3x3 part of ``model`` (identity by default)::
+
+        N' = normalize(M^-T N),  T' = normalize(M T - (N' . M T) N'),  B' = sign(w) N' x T'
+
+    which for ``model = None`` is :func:`geomlib.tangent_space.surface_frames` per vertex.
+    """
+    where = "glsl_tbn"
+    N = as_array(N, "N", shape=(None, 3), where=where)
+    T = as_tangents(tangents, len(N), where)
+    M = _model(model, where)
+    if not np.isfinite(N).all() or not np.isfinite(T).all():
+        raise MeshError(f"{where}: N and tangents must be finite")
+    out = _run_points(
+        "tbn.vert", _POINTS_TBN, len(N), {"normal": N, "tangent": T}, {}, {"model": M.astype(np.float32)}, 3
+    )
+    return tuple(o[:, :3].astype(np.float64) for o in out)
+
+
+def glsl_shade(
+    gbuffer,
+    lights,
+    eye,
+    albedo,
+    normal_map=None,
+    *,
+    ambient: float = 0.1,
+    specular: float = 0.3,
+    shininess: float = 32.0,
+    wrap: str = "clamp",
+    background=(1.0, 1.0, 1.0),
+) -> np.ndarray:
+    """:func:`shade` computed by ``shaders/normalmap.frag`` (same arguments, same result)."""
+    where = "glsl_shade"
+    need = ("position", "normal", "uv", "tangent")
+    texture_albedo = np.ndim(albedo) == 3
+    _check_gbuffer(gbuffer, need[: 2 + (normal_map is not None or texture_albedo) + (normal_map is not None)], where)
+    L = check_lights(lights, where)
+    if len(L) > MAX_LIGHTS:
+        raise MeshError(f"{where}: at most {MAX_LIGHTS} lights (normalmap.frag's uniform arrays), got {len(L)}")
+    eye = as_array(eye, "eye", shape=(3,), where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    ambient = check_float(ambient, "ambient", minimum=0.0, where=where)
+    specular = check_float(specular, "specular", minimum=0.0, where=where)
+    shininess = check_float(shininess, "shininess", minimum=0.0, where=where)
+    bg = as_array(background, "background", shape=(3,), where=where)
+    mask = np.asarray(gbuffer.mask)
+    h, w = mask.shape
+    attrs = gbuffer.attributes
+
+    def attr(key, k):
+        a = np.asarray(attrs[key], dtype=np.float32).reshape(h, w, -1) if key in attrs else np.zeros((h, w, k))
+        return a
+
+    textures = {
+        "position_in": attr("position", 3),
+        "normal_in": attr("normal", 3),
+        "uv_in": attr("uv", 2),
+        "tangent_in": attr("tangent", 4),
+        "normal_map": np.zeros((1, 1, 3)),
+        "albedo_map": np.zeros((1, 1, 3)),
+    }
+    uniforms = {"use_normal_map": 0, "use_albedo_map": int(texture_albedo), "albedo": np.zeros(3)}
+    if normal_map is not None:
+        nmap = as_normal_map(normal_map, where)  # decoded vectors; the shader decodes 2 rgb - 1 again
+        raw = np.asarray(normal_map)
+        textures["normal_map"] = raw / 255.0 if raw.dtype == np.uint8 else (nmap + 1.0) / 2.0
+        uniforms["use_normal_map"] = 1
+    if texture_albedo:
+        tex = as_image(albedo, "albedo", channels=3, where=where)
+        textures["albedo_map"] = tex / 255.0 if tex.dtype == np.uint8 else as_array(tex, "albedo", where=where)
+    else:
+        uniforms["albedo"] = as_array(albedo, "albedo", shape=(3,), where=where)
+    uniforms.update(
+        eye=eye,
+        ambient=ambient,
+        specular=specular,
+        shininess=shininess,
+        repeat_wrap=int(wrap == "repeat"),
+        n_lights=len(L),
+    )
+    for i, (kind, vec, rgb) in enumerate(L):
+        uniforms[f"light_kind[{i}]"] = int(kind == "point")
+        uniforms[f"light_vec[{i}]"] = vec
+        uniforms[f"light_rgb[{i}]"] = rgb
+    source = _source("normalmap.frag")
+    try:
+        img = gl.render_quad(source, (w, h), textures=textures, uniforms=uniforms, name="shaders/normalmap.frag")
+    except gl.ShaderError as e:
+        raise _renamed(e, "normalmap.frag") from None
+    out = np.empty((h, w, 3))
+    out[...] = bg
+    out[mask] = np.clip(img[..., :3][mask].astype(np.float64), 0.0, 1.0)
+    return out
+
+
+def glsl_displace(
+    V, F, UV, N, height, lam: float = 1.0, bias: float = 0.0, scale: float = 1.0, *, weld_seams=True, wrap="clamp"
+):
+    """:func:`displace` computed by ``shaders/displace.vert`` (positions only).
+
+    The vertex shader moves every vertex by its own map value; the seam fix stays on the CPU side:
+    with ``weld_seams`` the copies of a seam vertex (:func:`geomlib.textures.weld_by_position`) are
+    then moved by the mean of their offsets ``d`` (read back from the shader) along their mean normal.
+    """
+    where = "glsl_displace"
+    V, F = check_mesh(V, F, where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    UV = check_uv(UV, len(V), where, in_range=(wrap == "clamp"))
+    Hm = as_height_map(height, where, name="height", unit_range=True, what="displacement map")
+    lam = check_float(lam, "lam", where=where)
+    bias = check_float(bias, "bias", where=where)
+    scale = check_float(scale, "scale", where=where)
+    if not isinstance(weld_seams, bool | np.bool_):
+        raise MeshError(f"{where}: weld_seams must be True or False, got {weld_seams!r}")
+    group, k = weld_by_position(V) if weld_seams else (np.arange(len(V)), len(V))
+    n = welded_vertex_normals(V, F, group) if N is None else as_unit_vectors(N, len(V), where)
+    P, d = _run_points(
+        "displace.vert",
+        _POINTS_DISPLACE,
+        len(V),
+        {"position": V, "normal": n, "uv": UV},
+        {"height": np.asarray(Hm, dtype=np.float64)},
+        {"lam": lam, "bias": bias, "scale": scale, "repeat_wrap": int(wrap == "repeat")},
+        2,
+    )
+    V_new = P[:, :3].astype(np.float64)
+    if weld_seams and k < len(V):  # the CPU's part: copies of a seam vertex move together
+        seam = np.bincount(group, minlength=k)[group] > 1
+        dm = group_mean(d[:, :1].astype(np.float64), group, k)[group, 0]
+        nm = normalize_rows(group_mean(n, group, k), fallback=(0.0, 0.0, 1.0))[group]
+        V_new[seam] = V[seam] + lam * dm[seam, None] * nm[seam]
+    return V_new

@@ -1,0 +1,167 @@
+"""The maps lab's shaders (tasks 7-9) keep the relief route's guarantees (issue 27): a shader that does
+not compile, writes NaN or reads outside its textures fails with a message naming its file, line or
+stage and task; a loop that does not end is named with its task; the untouched stubs compile once
+their task is written and fail only their own tests."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from geomlib.grading import shader_watch
+from geomlib.grading.cases import load_cases
+from geomlib.grading.errors import GradingFailure, Mismatch
+from geomlib.grading.sandbox import LabProxy
+from geomlib.grading.stubs import make_stub
+
+from .course import planted_solution
+
+COURSE = Path(__file__).resolve().parents[2]
+CASE = {c.id: c for c in load_cases("maps")}
+
+
+def _replace(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
+    path.write_text(text.replace(old, new))
+
+
+def _line_of(path: Path, text: str) -> int:
+    return next(i for i, ln in enumerate(path.read_text().splitlines(), start=1) if text in ln)
+
+
+def _call(edit, function: str, **kwargs):
+    """``function(**kwargs)`` on a copy of the maps solution changed by ``edit(folder)``; the GradingFailure."""
+    dest = planted_solution("maps", edit)
+    try:
+        with pytest.raises(GradingFailure) as e:
+            LabProxy("maps", dest).call(function, **kwargs)
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    return str(e.value)
+
+
+def _shade_inputs():
+    c = CASE["shade-quad-float-map"]
+    return {**c.inputs(), **c.params}
+
+
+def _displace_inputs():
+    c = CASE["displace-sphere-bias-1-scale-2"]
+    return {**c.inputs(), **c.params}
+
+
+def _tbn_inputs():
+    import numpy as np
+
+    return {"N": np.array([[0.0, 0, 1], [0, 1, 0]]), "tangents": np.array([[1.0, 0, 0, 1], [1, 0, 0, -1]])}
+
+
+@pytest.mark.parametrize(
+    ("shader", "function", "inputs", "needle", "typo", "task"),
+    [
+        (
+            "tbn.vert",
+            "glsl_tbn",
+            _tbn_inputs,
+            "B = (t.w < 0.0 ? -1.0 : 1.0) * cross(N, T);",
+            "cross",
+            "Task 7: vertex TBN",
+        ),
+        ("normalmap.frag", "glsl_shade", _shade_inputs, "vec3 v = normalize(eye - P);", "eye", "Task 8: fragment "),
+        ("displace.vert", "glsl_displace", _displace_inputs, "return P + lam * d * n;", "lam", "Task 9: vertex "),
+    ],
+)
+def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, task):
+    path = COURSE / "solutions" / "maps" / "shaders" / shader
+    line = _line_of(path, needle)
+
+    def misspelt(dest: Path) -> None:  # an undeclared name: the driver names this very line
+        _replace(dest / "shaders" / shader, needle, needle.replace(typo, typo + "_misspelt", 1))
+
+    first = _call(misspelt, function, **inputs()).splitlines()[0]
+    head = rf"{function}: shaders/{re.escape(shader)} \({task}[^)]*\)( \(vertex shader\))? did not compile, line (\d+)"
+    m = re.match(head, first)
+    assert m, first
+    assert int(m.group(2)) == line, (first, line)
+    assert "_misspelt" in first and "glsl.py" not in first, first
+
+
+def _fail_of(edit, check: str, case_id: str) -> str:
+    """The Mismatch message of the graded check ``check`` (test_maps) on a planted copy."""
+    from tests.graded.maps import test_maps
+
+    dest = planted_solution("maps", edit)
+    try:
+        with pytest.raises(Mismatch) as e:
+            getattr(test_maps, check)(LabProxy("maps", dest), case_id)
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    return str(e.value)
+
+
+def test_nan_from_the_vertex_stage_is_named():
+    def nan(dest: Path) -> None:
+        _replace(
+            dest / "shaders" / "displace.vert", "return P + lam * d * n;", "return P + lam * d * n * sqrt(d - 9.0);"
+        )
+
+    msg = _fail_of(nan, "check_glsl_displace", "displace-grid-wave")
+    assert "shaders/displace.vert, the vertex stage" in msg and "NaN" in msg, msg
+
+
+def test_nan_from_the_fragment_stage_is_named():
+    def nan(dest: Path) -> None:
+        old = "return colour * (ambient + diffuse) + specular * spec;"
+        _replace(dest / "shaders" / "normalmap.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));")
+
+    msg = _fail_of(nan, "check_glsl_shade", "shade-quad-plain")
+    assert "shaders/normalmap.frag, the fragment stage" in msg and "NaN" in msg, msg
+
+
+def test_reads_outside_the_texture_fail_the_shader_s_own_check():
+    def outside(dest: Path) -> None:  # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
+        _replace(
+            dest / "shaders" / "displace.vert", "        x = clamp(x, 0, size.x - 1);\n", "        x = x + size.x;\n"
+        )
+
+    msg = _fail_of(outside, "check_glsl_displace", "displace-grid-wave")
+    assert "shaders/displace.vert, the vertex stage" in msg and "differ by more than 1e-05" in msg, msg
+
+
+def test_a_wrong_stage_is_named_by_its_shader():
+    def wrong_normal(dest: Path) -> None:  # the model matrix instead of its inverse transpose
+        _replace(dest / "shaders" / "tbn.vert", "N = normalize(transpose(inverse(m)) * n);", "N = normalize(m * n);")
+
+    from tests.graded.maps import test_maps
+
+    dest = planted_solution("maps", wrong_normal)
+    try:
+        with pytest.raises(Mismatch) as e:
+            test_maps.test_glsl_tbn_by_hand(LabProxy("maps", dest))
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    assert "shaders/tbn.vert, the vertex stage" in str(e.value) and ", N" in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("shader", ["tbn.vert", "normalmap.frag", "displace.vert"])
+def test_a_hanging_shader_is_named_with_its_task(shader):
+    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / "maps"])
+    n = {"tbn.vert": 7, "normalmap.frag": 8, "displace.vert": 9}[shader]
+    assert f"shaders/{shader} (Task {n} (" in msg and "a loop that does not end" in msg, msg
+
+
+@pytest.mark.parametrize("shader", ["tbn.vert", "normalmap.frag", "displace.vert"])
+def test_the_stubs_are_the_solutions_with_error_directives_and_compile_once_written(shader):
+    """The stub differs from the solution only by ``#error`` lines where the solution blocks were; with
+    the solution's lines put back it is the solution (which compiles: the graded tests run it)."""
+    solution = (COURSE / "solutions" / "maps" / "shaders" / shader).read_text()
+    stub = (COURSE / "labs" / "maps" / "shaders" / shader).read_text()
+    assert stub == make_stub(solution, f"shaders/{shader}")
+    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
+    assert errors and all(e.startswith("#error Task ") for e in errors), errors
+    n = {"tbn.vert": 7, "normalmap.frag": 8, "displace.vert": 9}[shader]
+    assert all(e.startswith(f"#error Task {n} (") for e in errors), errors
