@@ -426,6 +426,20 @@ def _render_quad(GL, fragment, size, textures, uniforms, outputs, filter, wrap, 
     return out[0] if outputs == 1 else out
 
 
+def _vertex_count(attributes: Mapping[str, np.ndarray], where: str) -> int | None:
+    """The number of vertices ``n`` the per-vertex ``attributes`` (each ``(n, 1..4)``) describe, or
+    None when there are none; a mismatched shape raises :class:`MeshError` naming the attribute."""
+    n = None
+    for key, a in attributes.items():
+        a = np.asarray(a)
+        if a.ndim != 2 or not 1 <= a.shape[1] <= 4 or (n is not None and len(a) != n):
+            raise MeshError(
+                f"geomlib.gl.{where}: attribute {key!r} has shape {a.shape}; expected (n, 1..4), same n for all"
+            )
+        n = len(a)
+    return n
+
+
 def render_mesh(
     vertex: str,
     fragment: str,
@@ -464,14 +478,7 @@ def render_mesh(
         raise MeshError(
             f"geomlib.gl.render_mesh: F must be an (m, 3) integer array, got shape {F.shape}, dtype {F.dtype}"
         )
-    n = None
-    for key, a in attributes.items():
-        a = np.asarray(a)
-        if a.ndim != 2 or not 1 <= a.shape[1] <= 4 or (n is not None and len(a) != n):
-            raise MeshError(
-                f"geomlib.gl.render_mesh: attribute {key!r} has shape {a.shape}; expected (n, 1..4), same n for all"
-            )
-        n = len(a)
+    n = _vertex_count(attributes, "render_mesh")
     if n is None or F.size and (F.min() < 0 or F.max() >= n):
         raise MeshError("geomlib.gl.render_mesh: F indexes vertices that have no attributes")
     GL = _gl()
@@ -528,14 +535,7 @@ def render_points(
     Arguments and result as in :func:`render_mesh` (no triangles, no depth test).
     """
     size = _size(size)
-    n = None
-    for key, a in attributes.items():
-        a = np.asarray(a)
-        if a.ndim != 2 or not 1 <= a.shape[1] <= 4 or (n is not None and len(a) != n):
-            raise MeshError(
-                f"geomlib.gl.render_points: attribute {key!r} has shape {a.shape}; expected (n, 1..4), same n for all"
-            )
-        n = len(a)
+    n = _vertex_count(attributes, "render_points")
     if not n:
         raise MeshError("geomlib.gl.render_points: no vertices (give at least one attribute with rows)")
     GL = _gl()
