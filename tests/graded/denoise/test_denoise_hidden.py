@@ -8,7 +8,7 @@ from .test_denoise import check_glsl_denoise
 test_hidden_references = reference_tests(HIDDEN_CASES)
 
 
-@graded(points=3, part="vertex denoising", visibility="hidden", timeout=60)
+@graded(points=4, part="vertex denoising", visibility="hidden", timeout=60)
 def test_glsl_denoise_with_map_hidden(lab):
     """shaders/denoise.vert on a hidden map (a grid, 16 bits, repeat wrap)"""
     check_glsl_denoise(lab, "hidden-map-uv-grid-repeat")

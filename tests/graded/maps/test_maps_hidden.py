@@ -8,7 +8,7 @@ from .test_maps import check_glsl_displace, check_glsl_shade, check_glsl_tbn, ro
 test_hidden_references = reference_tests(HIDDEN_CASES)
 
 
-@graded(points=3, part="vertex TBN", visibility="hidden", timeout=60)
+@graded(points=4, part="vertex TBN", visibility="hidden", timeout=60)
 def test_glsl_tbn_hidden(lab):
     """shaders/tbn.vert on hidden meshes (an atlas with mirrored charts, given normals), rotated"""
     check_glsl_tbn(lab, "tangents-rock-atlas")
