@@ -51,6 +51,13 @@ def backend() -> str:
     if chosen:
         return chosen
     if "OpenGL.platform" in sys.modules:
+        # PyOpenGL chose its platform at import. A headless one (OSMesa or EGL) is what we would
+        # choose, so record it; an on-screen one (GLX) cannot render here.
+        current = type(getattr(sys.modules["OpenGL.platform"], "PLATFORM", None)).__name__.lower()
+        for name in ("osmesa", "egl"):
+            if current.startswith(name):
+                os.environ["PYOPENGL_PLATFORM"] = name
+                return name
         raise RuntimeError(
             "geomlib.render: PyOpenGL was imported before a headless platform was chosen, so it uses an "
             "on-screen platform. Set the environment variable PYOPENGL_PLATFORM=osmesa (or egl) before "
