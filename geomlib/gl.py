@@ -42,7 +42,16 @@ import numpy as np
 
 from geomlib.errors import MeshError
 
-__all__ = ["ShaderError", "QUAD_VERTEX_SHADER", "render_quad", "render_mesh", "render_points", "renderer_info", "close"]
+__all__ = [
+    "ShaderError",
+    "QUAD_VERTEX_SHADER",
+    "MOVED_OFFSET_FRAGMENT_SHADER",
+    "render_quad",
+    "render_mesh",
+    "render_points",
+    "renderer_info",
+    "close",
+]
 
 #: Vertex shader of :func:`render_quad`: a full-screen quad passing ``uv`` in [0, 1]² (v up).
 QUAD_VERTEX_SHADER = """#version 330 core
@@ -512,6 +521,18 @@ def _render_mesh(GL, vertex, fragment, attributes, F, size, textures, uniforms, 
         GL.glDeleteBuffers(len(buffers) + 1, [*buffers, ebo])
         GL.glDeleteVertexArrays(1, [vao])
     return out[0] if outputs == 1 else out
+
+
+#: Fragment shader for :func:`render_points` when a vertex shader moves each vertex: it writes the
+#: ``flat`` outputs ``moved`` (the new position) to target 0 and ``offset`` (the scalar it moved by) to
+#: target 1, so both read back exactly (maps' ``displace.vert``, denoise's ``denoise.vert``).
+MOVED_OFFSET_FRAGMENT_SHADER = """#version 330 core
+flat in vec3 moved;
+flat in float offset;
+layout(location = 0) out vec4 out_moved;
+layout(location = 1) out vec4 out_offset;
+void main() { out_moved = vec4(moved, 1.0); out_offset = vec4(offset, 0.0, 0.0, 1.0); }
+"""
 
 
 def render_points(

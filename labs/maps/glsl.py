@@ -50,13 +50,6 @@ layout(location = 1) out vec4 out_B;
 layout(location = 2) out vec4 out_N;
 void main() { out_T = vec4(T_world, 1.0); out_B = vec4(B_world, 1.0); out_N = vec4(N_world, 1.0); }
 """
-_POINTS_DISPLACE = """#version 330 core
-flat in vec3 moved;
-flat in float offset;
-layout(location = 0) out vec4 out_P;
-layout(location = 1) out vec4 out_d;
-void main() { out_P = vec4(moved, 1.0); out_d = vec4(offset, 0.0, 0.0, 1.0); }
-"""
 
 
 def shader_path(name: str) -> Path:
@@ -234,7 +227,7 @@ def glsl_displace(
     n = welded_vertex_normals(V, F, group) if N is None else as_unit_vectors(N, len(V), where)
     P, d = _run_points(
         "displace.vert",
-        _POINTS_DISPLACE,
+        gl.MOVED_OFFSET_FRAGMENT_SHADER,
         len(V),
         {"position": V, "normal": n, "uv": UV},
         {"height": np.asarray(Hm, dtype=np.float64)},

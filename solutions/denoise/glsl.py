@@ -28,15 +28,6 @@ SHADERS = ("denoise.vert",)
 #: The task each shader file is.
 TASKS = {"denoise.vert": "Task 7: vertex denoising"}
 
-#: Given fragment shader of the per-vertex route: copy the vertex shader's flat outputs to the targets.
-_POINTS = """#version 330 core
-flat in vec3 moved;
-flat in float offset;
-layout(location = 0) out vec4 out_p;
-layout(location = 1) out vec4 out_s;
-void main() { out_p = vec4(moved, 1.0); out_s = vec4(offset, 0.0, 0.0, 1.0); }
-"""
-
 
 def shader_path(name: str) -> Path:
     """``shaders/<name>`` next to this file."""
@@ -53,7 +44,7 @@ def _run_points(name: str, n: int, attributes: dict, textures: dict, uniforms: d
     try:
         out = gl.render_points(
             source,
-            _POINTS,
+            gl.MOVED_OFFSET_FRAGMENT_SHADER,
             attributes,
             size,
             textures=textures,
