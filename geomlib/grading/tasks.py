@@ -217,11 +217,19 @@ def _dedent(fn) -> str:
 
 
 def _tree(fn):
-    """The syntax tree of ``fn``'s source, or None where it has no readable source."""
-    try:
-        return ast.parse(_dedent(fn))
-    except (OSError, TypeError, SyntaxError):
-        return None
+    """The syntax tree of ``fn``'s source, or None where it has no readable source (parsed once
+    per function: a ``--task N`` run asks for every collected test's tasks)."""
+    key = (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None), getattr(fn, "__code__", None))
+    if key not in _TREES:
+        try:
+            _TREES[key] = ast.parse(_dedent(fn))
+        except (OSError, TypeError, SyntaxError):
+            _TREES[key] = None
+    return _TREES[key]
+
+
+#: :func:`_tree` by function (module, name and code object: a reloaded test module parses again).
+_TREES: dict = {}
 
 
 def _lab_calls_direct(fn, tree=None) -> list[str]:
