@@ -54,6 +54,27 @@ def _read_source(path: Path) -> str:
         return f.read(4 << 20).decode("utf-8", errors="replace")
 
 
+#: Syntax trees parsed in this worker, by path: ``find_function`` looks for the function in every
+#: file of the lab, then the import merges the stub and the submission's file; each file is read and
+#: parsed once per call (a worker serves one call). Trees are never changed (merging copies).
+_TREES: dict = {}
+
+
+def _parsed(path: Path, *, student: bool) -> ast.Module:
+    """``path``'s syntax tree (a submission's file read without following links); raises SyntaxError."""
+    key = (str(path), student)
+    if key not in _TREES:
+        try:
+            text = _read_source(path) if student else path.read_text(encoding="utf-8")
+            _TREES[key] = ast.parse(text, filename=str(path))
+        except SyntaxError as e:
+            _TREES[key] = e
+    tree = _TREES[key]
+    if isinstance(tree, SyntaxError):
+        raise tree
+    return tree
+
+
 def _is_plain_file(path: Path) -> bool:
     return path.is_file() and not path.is_symlink()
 
@@ -161,8 +182,7 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
 
     Returns a list of ``(statement, filename)`` to execute in order in the module's namespace.
     """
-    stub_src = stub_path.read_text(encoding="utf-8")
-    stub = ast.parse(stub_src, filename=str(stub_path))
+    stub = _parsed(stub_path, student=False)
     tasks = task_names(stub)
     given = set().union(*(_bound_names(s) for s in stub.body)) - tasks if stub.body else set()
     sfile = str(stub_path)
@@ -170,7 +190,7 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
         return [(s, sfile) for s in stub.body]
     pfile = str(student_path)
     try:
-        student = ast.parse(_read_source(student_path), filename=pfile)
+        student = _parsed(student_path, student=True)
     except SyntaxError as e:
         where = f"{student_path.parent.name}/{student_path.name} line {e.lineno}: {e.msg}"
         text = (e.text or "").strip()
@@ -245,11 +265,11 @@ class _LabFinder(importlib.abc.MetaPathFinder):
 def _student_defines(path: Path, name: str) -> bool:
     if not _is_plain_file(path):
         return False
-    text = _read_source(path)
     try:
-        tree = ast.parse(text)
+        tree = _parsed(path, student=True)
         return _defines(tree, name) or _imports(tree, name)
     except SyntaxError:
+        text = _read_source(path)
         return re.search(rf"^\s*(async\s+)?def\s+{re.escape(name)}\b", text, re.M) is not None
 
 
@@ -270,13 +290,13 @@ def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None
     stub_files = sorted(p for p in stubs_dir.glob("*.py") if p.name != "__init__.py") if stubs_dir else []
     stub_stems = {p.stem for p in stub_files}
     own_files = sorted(p for p in lab_dir.glob("*.py") if p.name != "__init__.py" and p.stem not in stub_stems)
-    stub_trees = [(p.stem, ast.parse(p.read_text(encoding="utf-8"))) for p in stub_files]
+    stub_trees = [(p.stem, _parsed(p, student=False)) for p in stub_files]
     own_trees = []
     for path in own_files:
         if not _is_plain_file(path):
             continue
         try:
-            own_trees.append((path.stem, ast.parse(_read_source(path), filename=str(path))))
+            own_trees.append((path.stem, _parsed(path, student=True)))
         except SyntaxError as e:
             broken.append(f"{path.name} line {e.lineno}: {e.msg}")
 
