@@ -365,6 +365,10 @@ def serve(sock: socket.socket) -> None:
             break
         result_fd, out_fd = fds
         t0 = time.monotonic()
+        try:
+            _worker.prepare_stubs(req.get("stubs_dir"))  # the course's stubs, parsed once for every worker
+        except Exception:  # noqa: BLE001 - the worker parses them itself
+            pass
         pid = os.fork()
         if pid == 0:
             sock.close()
