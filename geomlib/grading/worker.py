@@ -80,6 +80,8 @@ def _parsed(path: Path, *, student: bool) -> ast.Module:
 #: top-level stub statement by ``id`` of the statement.
 _STUB_STAT: dict = {}
 _STUB_CODE: dict = {}
+#: ``id(stub tree) -> (task names, given names)`` (:func:`merge_module`), for the trees in ``_TREES``.
+_STUB_NAMES: dict = {}
 
 
 def prepare_stubs(stubs_dir: str | None) -> None:
@@ -99,11 +101,17 @@ def prepare_stubs(stubs_dir: str | None) -> None:
         old = _TREES.pop((str(path), False), None)
         for stmt in getattr(old, "body", ()):  # their ids may be reused once the old tree is freed
             _STUB_CODE.pop(id(stmt), None)
+        _STUB_NAMES.pop(id(old), None)
         _STUB_STAT[str(path)] = (st.st_mtime_ns, st.st_size)
         try:
             tree = _parsed(path, student=False)
         except (SyntaxError, OSError, ValueError):
             continue
+        tasks = task_names(tree)
+        _STUB_NAMES[id(tree)] = (
+            tasks,
+            set().union(*(_bound_names(s) for s in tree.body)) - tasks if tree.body else set(),
+        )
         for stmt in tree.body:
             try:
                 _STUB_CODE[id(stmt)] = compile(
@@ -221,8 +229,13 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
     Returns a list of ``(statement, filename)`` to execute in order in the module's namespace.
     """
     stub = _parsed(stub_path, student=False)
-    tasks = task_names(stub)
-    given = set().union(*(_bound_names(s) for s in stub.body)) - tasks if stub.body else set()
+    if id(stub) not in _STUB_NAMES:  # the zygote's stubs come with them (prepare_stubs)
+        tasks = task_names(stub)
+        _STUB_NAMES[id(stub)] = (
+            tasks,
+            set().union(*(_bound_names(s) for s in stub.body)) - tasks if stub.body else set(),
+        )
+    tasks, given = _STUB_NAMES[id(stub)]
     sfile = str(stub_path)
     if student_path is None or not _is_plain_file(student_path):
         return [(s, sfile) for s in stub.body]

@@ -52,6 +52,7 @@ PRELOAD = (
     "scipy.sparse.linalg",
     "scipy.spatial",
     "scipy.ndimage",
+    "scipy.fft",  # vdm's transport: 0.1 s per call otherwise
     "igl",
     "geomlib.validate",
     "geomlib.topology",

@@ -44,10 +44,12 @@ def _write(folder, text):
 
 @pytest.fixture
 def fresh_cache():
-    saved = (dict(worker._TREES), dict(worker._STUB_STAT), dict(worker._STUB_CODE))
-    worker._TREES.clear(), worker._STUB_STAT.clear(), worker._STUB_CODE.clear()
+    caches = (worker._TREES, worker._STUB_STAT, worker._STUB_CODE, worker._STUB_NAMES)
+    saved = [dict(d) for d in caches]
+    for d in caches:
+        d.clear()
     yield
-    for d, old in zip((worker._TREES, worker._STUB_STAT, worker._STUB_CODE), saved, strict=True):
+    for d, old in zip(caches, saved, strict=True):
         d.clear()
         d.update(old)
 
