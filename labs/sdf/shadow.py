@@ -117,7 +117,7 @@ def ambient_occlusion(sdf, P, N, *, taps: int = 5, delta: float = 0.05) -> np.nd
     N = as_array(N, "N", shape=(len(P), 3), where=where)
     taps = check_int(taps, "taps", minimum=1, maximum=64, where=where)
     delta = check_float(delta, "delta", positive=True, where=where)
-    raise NotImplementedError('Task 9 (soft shadows): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)')
+    raise NotImplementedError('Task 9 (ambient occlusion): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)')
 
 
 def push_out(sdf, P, *, radius: float = 0.0, iterations: int = 4, h: float = 1e-3) -> np.ndarray:
@@ -142,4 +142,4 @@ def push_out(sdf, P, *, radius: float = 0.0, iterations: int = 4, h: float = 1e-
     P = as_points(P, where).copy()
     radius = check_float(radius, "radius", minimum=0.0, where=where)
     iterations = check_int(iterations, "iterations", minimum=1, maximum=100, where=where)
-    raise NotImplementedError('Task 9 (soft shadows): push-out: repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points')
+    raise NotImplementedError('Task 9 (push-out): push-out: repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points')

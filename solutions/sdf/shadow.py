@@ -144,7 +144,7 @@ def ambient_occlusion(sdf, P, N, *, taps: int = 5, delta: float = 0.05) -> np.nd
     N = as_array(N, "N", shape=(len(P), 3), where=where)
     taps = check_int(taps, "taps", minimum=1, maximum=64, where=where)
     delta = check_float(delta, "delta", positive=True, where=where)
-    # BEGIN SOLUTION: Task 9 (soft shadows): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)
+    # BEGIN SOLUTION: Task 9 (ambient occlusion): AO: w_i = 2^-i / sum_j 2^-j; AO = clamp(1 - sum_i w_i (i delta - phi(p + i delta n)) / (i delta), 0, 1)
     i = np.arange(1, taps + 1)
     w = 0.5**i / np.sum(0.5**i)
     occ = np.zeros(len(P))
@@ -176,7 +176,7 @@ def push_out(sdf, P, *, radius: float = 0.0, iterations: int = 4, h: float = 1e-
     P = as_points(P, where).copy()
     radius = check_float(radius, "radius", minimum=0.0, where=where)
     iterations = check_int(iterations, "iterations", minimum=1, maximum=100, where=where)
-    # BEGIN SOLUTION: Task 9 (soft shadows): push-out: repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points
+    # BEGIN SOLUTION: Task 9 (push-out): push-out: repeat: pen = max(radius - phi(p), 0); p += pen * gradient_tetra(sdf, p, h) for the penetrating points
     for _ in range(iterations):  # fixed-point iterations, vectorised over points
         pen = np.maximum(radius - np.asarray(phi(P), np.float64), 0.0)
         m = pen > 0
