@@ -98,7 +98,7 @@ def check_glsl_cube_face(lab, prefix: str, size: int, face: int) -> None:
     M = stored_input("shadows", f"{prefix}cube-matrices")["Ms"][face]
     got = lab.glsl_depth_map(V, F, M, size, "front")
     expected = stored_input("shadows", f"{prefix}cube-depth-{size}-{face}")["D"]
-    expect_depth_map(f"{DEPTH_LABEL} on cube face {face} of a point light (cull=\"front\")", got, expected)
+    expect_depth_map(f'{DEPTH_LABEL} on cube face {face} of a point light (cull="front")', got, expected)
 
 
 def check_glsl_shadow(lab, case_id: str) -> None:
