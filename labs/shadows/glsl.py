@@ -67,7 +67,9 @@ def _renamed(e: gl.ShaderError, fragment: str, vertex: str | None = None) -> gl.
     """The harness's error with the task after the file name (and the vertex shader's own file name)."""
     msg = str(e)
     if vertex is not None and f"shaders/{fragment} (vertex shader)" in msg:
-        msg = msg.replace(f"shaders/{fragment} (vertex shader)", f"shaders/{vertex} ({TASKS[vertex]}) (vertex shader)", 1)
+        msg = msg.replace(
+            f"shaders/{fragment} (vertex shader)", f"shaders/{vertex} ({TASKS[vertex]}) (vertex shader)", 1
+        )
     else:
         msg = msg.replace(f"shaders/{fragment}", f"shaders/{fragment} ({TASKS[fragment]})", 1)
     return gl.ShaderError(msg, log=e.log, lines=e.lines)
