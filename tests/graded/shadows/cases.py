@@ -430,3 +430,9 @@ def _point_inputs(size, seed, n=400, near=0.2, far=12.0, prefix=""):
     maps = np.stack([stored(f"{prefix}cube-depth-{size}-{i}")["D"] for i in range(6)])
     P, N = _points(seed, n)
     return {"P": P, "N": N, "maps": maps, "position": CUBE_POS, "near": near, "far": far}
+
+
+# The GLSL route's stored NumPy references (tasks 9-10): cases_glsl.py.
+from .cases_glsl import STORED as _GLSL_STORED  # noqa: E402
+
+STORED += _GLSL_STORED

@@ -154,3 +154,9 @@ CASES = [
         visibility="hidden",
     ),
 ]
+
+
+# The GLSL route's hidden stored NumPy references (tasks 9-10): cases_glsl.py.
+from .cases_glsl import STORED_HIDDEN as _GLSL_STORED  # noqa: E402
+
+STORED += _GLSL_STORED

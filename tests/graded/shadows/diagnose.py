@@ -16,6 +16,8 @@ TASKS = {
     "shadow_bias": (4,),
     "outside_frustum": (6,),
     "pcf_visibility": (7,),
+    "glsl_depth_map": (9,),
+    "glsl_shadow_visibility": (10,),
 }
 TITLES = {
     1: "light matrix",
@@ -26,6 +28,8 @@ TITLES = {
     6: "frustum handling",
     7: "PCF",
     8: "cube map",
+    9: "light pass",
+    10: "fragment shadow test",
 }
 #: The shadow test of one receiver point, in task order.
 _VISIBILITY = (

@@ -1,0 +1,167 @@
+"""The shadows lab's shaders (tasks 9-10: depth.vert, depth.frag, shadow.frag) keep the relief route's
+guarantees (issue 27): a shader that does not compile names its file, line and task; NaN, reads outside
+the map and a wrong stage fail the shader's own check with the pass and stage named; a broken shader
+costs only its own task's tests; a hang is named with its task; the stubs are the solutions with
+``#error`` directives."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from geomlib.grading import shader_watch
+from geomlib.grading.errors import GradingFailure, Mismatch
+from geomlib.grading.sandbox import LabProxy
+from geomlib.grading.stubs import make_stub
+from tests.graded.shadows.support import ortho_light, small_scene
+
+from .course import planted_solution
+
+COURSE = Path(__file__).resolve().parents[2]
+SHADERS = COURSE / "solutions" / "shadows" / "shaders"
+TASK = {"depth.vert": 9, "depth.frag": 9, "shadow.frag": 10}
+
+
+def _replace(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
+    path.write_text(text.replace(old, new))
+
+
+def _edit(shader: str, old: str, new: str):
+    return lambda dest: _replace(dest / "shaders" / shader, old, new)
+
+
+def _line_of(shader: str, text: str) -> int:
+    return next(i for i, ln in enumerate((SHADERS / shader).read_text().splitlines(), start=1) if text in ln)
+
+
+def _depth_inputs():
+    V, F = small_scene()
+    return {"V": V, "F": F, "M": ortho_light(), "size": 16, "cull": "front"}
+
+
+def _shadow_inputs():
+    P = np.array([[0.0, 0.0, 0.0], [1.0, -0.6, 1.0], [2.5, 2.5, 0.0]])
+    N = np.tile([0.0, 0.0, 1.0], (3, 1))
+    return {"P": P, "N": N, "D": np.ones((8, 8)), "M": ortho_light(), "pcf": 3}
+
+
+@pytest.mark.parametrize(
+    ("shader", "function", "inputs", "needle", "typo", "stage"),
+    [
+        ("depth.vert", "glsl_depth_map", _depth_inputs, "gl_Position = lightSpaceMatrix * vec4(position, 1.0);",
+         "lightSpaceMatrix", " \\(vertex shader\\)"),
+        ("depth.frag", "glsl_depth_map", _depth_inputs, "result = vec4(gl_FragCoord.z, 1.0, 0.0, 1.0);", "result", ""),
+        ("shadow.frag", "glsl_shadow_visibility", _shadow_inputs, "vec4 c = lightSpaceMatrix * vec4(P, 1.0);",
+         "lightSpaceMatrix", ""),
+    ],
+)  # fmt: skip
+def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, stage):
+    line = _line_of(shader, needle)
+    dest = planted_solution("shadows", _edit(shader, needle, needle.replace(typo, typo + "_misspelt", 1)))
+    try:
+        with pytest.raises(GradingFailure) as e:
+            LabProxy("shadows", dest, timeout=180).call(function, **inputs())
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    first = str(e.value).splitlines()[0]
+    m = re.match(
+        rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage} did not compile, line (\d+)",
+        first,
+    )
+    assert m, first
+    assert int(m.group(1)) == line, (first, line)
+    assert "_misspelt" in first and "glsl.py" not in first, first
+
+
+def _fail_of(edit, check: str, *args) -> str:
+    """The Mismatch message of the graded check ``check`` (test_shadows_glsl) on a planted copy."""
+    from tests.graded.shadows import test_shadows_glsl
+
+    dest = planted_solution("shadows", edit)
+    try:
+        with pytest.raises(Mismatch) as e:
+            getattr(test_shadows_glsl, check)(LabProxy("shadows", dest, timeout=180), *args)
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    return str(e.value)
+
+
+def test_nan_from_the_shadow_pass_is_named():
+    old = "return lit / float(pcf * pcf);"
+    msg = _fail_of(_edit("shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));"), "check_glsl_shadow",
+                   "glsl-eye-spot-pcf3")  # fmt: skip
+    assert "shaders/shadow.frag, the shadow pass's fragment stage" in msg and "NaN" in msg, msg
+
+
+def test_nan_from_the_depth_pass_is_named():
+    old = "result = vec4(gl_FragCoord.z, 1.0, 0.0, 1.0);"
+    new = "result = vec4(sqrt(-1.0 - gl_FragCoord.z), 1.0, 0.0, 1.0);"
+    msg = _fail_of(_edit("depth.frag", old, new), "check_glsl_depth", "depth-ortho-64")
+    assert "the depth pass from the light" in msg and "NaN" in msg and "depth.frag" in msg, msg
+
+
+def test_reads_outside_the_map_fail_the_shader_s_own_check():
+    def outside(dest: Path) -> None:  # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
+        _replace(
+            dest / "shaders" / "shadow.frag",
+            "    col = clamp(col, 0, size - 1);\n    row = clamp(row, 0, size - 1);\n",
+            "",
+        )
+
+    msg = _fail_of(outside, "check_glsl_shadow", "hidden-glsl-eye-partial-nofix")
+    assert "shaders/shadow.frag, the shadow pass's fragment stage" in msg and "differ by more than 1e-06" in msg, msg
+
+
+def test_a_wrong_vertex_stage_is_named():
+    old = "gl_Position = lightSpaceMatrix * vec4(position, 1.0);"
+    msg = _fail_of(_edit("depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
+                   "check_glsl_depth", "depth-ortho-64")  # fmt: skip
+    assert "the vertex stage (depth.vert" in msg and "covered in one map and empty" in msg, msg
+
+
+def test_a_wrong_fragment_stage_is_named():
+    old = "result = vec4(gl_FragCoord.z, 1.0, 0.0, 1.0);"
+    msg = _fail_of(_edit("depth.frag", old, "result = vec4(2.0 * gl_FragCoord.z - 1.0, 1.0, 0.0, 1.0);"),
+                   "check_glsl_depth", "depth-ortho-64")  # fmt: skip
+    assert "the fragment stage (depth.frag) must write the window depth" in msg, msg
+
+
+def test_missing_culling_is_caught():
+    old = "if ((cull == 1 && gl_FrontFacing) || (cull == 2 && !gl_FrontFacing)) {"
+    msg = _fail_of(_edit("depth.frag", old, "if (false) {"), "check_glsl_depth", "depth-front-culled")
+    assert 'cull="front"' in msg and "depth.frag" in msg, msg
+
+
+def test_a_broken_shadow_shader_costs_only_its_own_tests():
+    """shadow.frag that does not compile: the light pass's check still passes on the same copy."""
+    from tests.graded.shadows import test_shadows_glsl
+
+    dest = planted_solution("shadows", _edit("shadow.frag", "behind = c.w <= 0.0;", "behind = c.w <= 0.0"))
+    try:
+        lab = LabProxy("shadows", dest, timeout=180)
+        test_shadows_glsl.check_glsl_depth(lab, "depth-ortho-64")
+        with pytest.raises(GradingFailure, match=r"shaders/shadow.frag \(Task 10"):
+            test_shadows_glsl.check_glsl_shadow(lab, "glsl-eye-ortho-defaults")
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+
+
+@pytest.mark.parametrize("shader", ["depth.frag", "shadow.frag"])
+def test_a_hanging_shader_is_named_with_its_task(shader):
+    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / "shadows"])
+    assert f"shaders/{shader} (Task {TASK[shader]} (" in msg and "a loop that does not end" in msg, msg
+
+
+@pytest.mark.parametrize("shader", ["depth.vert", "depth.frag", "shadow.frag"])
+def test_the_stubs_are_the_solutions_with_error_directives(shader):
+    solution = (SHADERS / shader).read_text()
+    stub = (COURSE / "labs" / "shadows" / "shaders" / shader).read_text()
+    assert stub == make_stub(solution, f"shaders/{shader}")
+    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
+    assert errors and all(e.startswith(f"#error Task {TASK[shader]} (") for e in errors), errors
