@@ -141,6 +141,8 @@ def meshes(quick: bool, folder: Path, only: list[str] | None = None) -> tuple[li
                 skipped.append((name, str(e)))
                 continue
             out.append((name, V, F))
+        if only:  # in the order asked for (small meshes first keeps a loaded run's early rows)
+            out.sort(key=lambda c: only.index(c[0]))
     else:
         V, F = datasets.icosphere(4)
         out.append(("bumpy sphere", datasets.add_noise(V, 0.01, seed=0, direction="normal", F=F), F))
@@ -273,6 +275,8 @@ def main() -> None:
                 else:
                     others.append((name, factor, tool, q))
             print(f"{name} at {factor}x (h = {h:.4g}) done", flush=True)
+            if cases and cases[-1]["mesh"] == name and cases[-1]["factor"] == factor:
+                print(table(cases[-1:]).splitlines()[2], flush=True)  # the row now: a run cut short keeps it
     cols = ("time", "faces", "min_angle", "below_30", "edge_cv", "valence6", "hausdorff")
     if others:
         print(f"{'mesh':<20}{'h':>6} {'method':<12}" + "".join(f"{c:>11}" for c in cols))

@@ -222,7 +222,7 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
         f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
         "Vertices are coloured by valence (blue below 6, grey 6, red above); the captions give the faces, the "
         "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6; the "
-        "plots the distribution of the corner angles, which remeshing gathers around 60°.",
+        "plots show the distribution of the corner angles, which remeshing gathers around 60°.",
     )
 
 
