@@ -15,8 +15,7 @@ from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import marked_picture
 
 from ..common import expect_rejected
-from .cases import CASES
-from .cases import LIGHT_DIR
+from .cases import CASES, LIGHT_DIR
 from .support import CAMERA, SCENE_BOUNDS, ortho_light, scene_meshes, small_scene
 
 test_references = reference_tests(CASES)
@@ -279,11 +278,15 @@ def test_outside_the_map_is_lit(lab):
     P = np.c_[np.array(np.meshgrid(g, g)).reshape(2, -1).T, np.zeros(29 * 29)]
     L = -LIGHT_DIR / np.linalg.norm(LIGHT_DIR)
     truth = _truth(V, F, P, np.tile(L, (len(P), 1)), None)
-    vis = np.asarray(lab.shadow_visibility(P, np.tile([0.0, 0, 1], (len(P), 1)), D, M, bias=0.01, slope_bias=0.0, pcf=1))
+    vis = np.asarray(
+        lab.shadow_visibility(P, np.tile([0.0, 0, 1], (len(P), 1)), D, M, bias=0.01, slope_bias=0.0, pcf=1)
+    )
     dark = ~truth
     if dark.sum() < 20 or np.mean(vis[dark] < 0.5) < 0.9:
-        fail(f"of {int(dark.sum())} floor points inside the map that ray casting finds in shadow, only "
-             f"{int((vis[dark] < 0.5).sum())} are dark: outside_frustum must be False inside [0, 1]^2 with z <= 1")
+        fail(
+            f"of {int(dark.sum())} floor points inside the map that ray casting finds in shadow, only "
+            f"{int((vis[dark] < 0.5).sum())} are dark: outside_frustum must be False inside [0, 1]^2 with z <= 1"
+        )
 
 
 # ------------------------------------------------------------------------------------------ Task 7
