@@ -351,6 +351,10 @@ def test_cube_face_index_by_hand(lab):
     """the face is the axis of the largest |component| and its sign: +x, -x, +y, -y, +z, -z"""
     d = [[2, 1, -1], [-3, 1, 2], [0.1, 0.5, 0.2], [0, -1, 0.5], [1, 1, 1.5], [0.2, -0.3, -0.9]]
     expect_close("cube_face_index", lab.cube_face_index(d), [0, 1, 2, 3, 4, 5], atol=0)
+    # The docstring's rules for the edge cases: ties go to the first axis, the zero direction to face 0 (+x).
+    ties = [[1, -1, 0], [0, -2, 2], [-1, 1, 1], [0, 0, 0]]
+    expect_close("cube_face_index on ties and the zero direction", lab.cube_face_index(ties), [0, 3, 1, 0], atol=0,
+                 hint="a = argmax |d_i| (the first axis on ties); face = 2 a + (d_a < 0), so 0 counts as +")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ all together
