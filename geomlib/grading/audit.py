@@ -33,8 +33,9 @@ against that one tree, and both pick mutation sites over whole modules. Here a m
 *separate folder* graded with ``--impl FOLDER`` (the sandbox snapshots the folder and merges it
 with the course's stubs), only code inside solution blocks may change, and each mutant must be
 traced to its task; with either tool the copy, the restriction to blocks and the task mapping
-would all be rewritten around it. Blocks in GLSL shaders (the relief lab's ``.frag`` files) are
-not mutated; the report says how many there are.
+would all be rewritten around it. Blocks in GLSL shaders (``.vert``/``.frag``: relief, maps 7-9,
+denoise 7) get the same two kinds from :mod:`geomlib.grading.glsl_mutants` (a tokenizer, no
+``ast``); their probe sets the block's results to NaN, since GLSL cannot raise.
 
 Grading many mutants: ``--jobs`` worker processes each grade mutants one after another in one
 interpreter (the sandbox's zygote and pytest's imports are reused: about 1.5 s per task instead of
@@ -64,6 +65,7 @@ import zlib
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from geomlib.grading import glsl_mutants
 from geomlib.grading import impl as _impl
 from geomlib.taskref import find_task
 
@@ -107,7 +109,7 @@ class _Block:
 
 
 def _blocks(lab_dir: Path) -> tuple[list[_Block], list[str]]:
-    """The Python solution blocks of a lab and the names of the (skipped) shader files with blocks."""
+    """The solution blocks of a lab (Python and GLSL) and the names of the shader files with blocks."""
     from geomlib.grading import stubs
 
     out, shaders = [], []
@@ -120,7 +122,6 @@ def _blocks(lab_dir: Path) -> tuple[list[_Block], list[str]]:
             continue
         if f.suffix != ".py":
             shaders.append(f"{rel} ({len(blocks)} block{'s' if len(blocks) != 1 else ''})")
-            continue
         for b in blocks:
             m = find_task(b.task, titled=True)
             if not m:
@@ -440,17 +441,24 @@ def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
 # ---------------------------------------------------------------------------------- generation
 
 
-def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[str]]:
-    """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated."""
+def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) -> tuple[list[Mutant], list[str]]:
+    """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated.
+
+    ``check_glsl``: drop the GLSL operator mutants that do not compile (asks the driver in a child
+    process; a few seconds for its GL context)."""
     lab_dir = Path(lab_dir or _impl.course_root() / "solutions" / lab)
     if not lab_dir.is_dir():
         raise AuditError(f"no solution folder {lab_dir}")
     blocks, shaders = _blocks(lab_dir)
-    notes = [f"GLSL blocks not mutated: {', '.join(shaders)}"] if shaders else []
+    notes = []
     out: list[Mutant] = []
     seen: set[str] = set()
     texts: dict[str, tuple[str, ast.Module]] = {}
+    glsl: list[Mutant] = []
     for b in blocks:
+        if not b.file.endswith(".py"):
+            glsl += _glsl_mutants(lab, lab_dir, b, notes)
+            continue
         if b.file not in texts:
             text = (lab_dir / b.file).read_text()
             texts[b.file] = (text, ast.parse(text))
@@ -482,7 +490,52 @@ def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[
             while any(m.id == mid for m in out):
                 mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
             out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), fname, src))
+    ok = (
+        glsl_mutants.compiles([(Path(m.file).suffix, m.source) for m in glsl if m.kind == "operator"])
+        if check_glsl
+        else []
+    )
+    if ok is None and glsl:
+        notes.append(
+            "GLSL operator mutants not compile-checked (no GL context): the ones that do not compile count as killed"
+        )
+    ok = iter(ok or [])
+    dropped = [m for m in glsl if m.kind == "operator" and not next(ok, True)]
+    if dropped:
+        notes.append(f"GLSL: {len(dropped)} operator mutant(s) dropped because they do not compile (type errors)")
+    out += [m for m in glsl if m not in dropped]
     return out, notes
+
+
+def _glsl_mutants(lab: str, lab_dir: Path, b: _Block, notes: list[str]) -> list[Mutant]:
+    """The mutants of one GLSL block (:mod:`geomlib.grading.glsl_mutants`), before the compile check."""
+    text = (lab_dir / b.file).read_text()
+    shape = glsl_mutants.Shape(text, b.start, b.end)
+    out: list[Mutant] = []
+    if shape.why:
+        notes.append(f"{b.file}:{b.start} (Task {b.task}): {shape.why}")
+    seen = {text}
+    for mode in glsl_mutants.MODES:
+        src = shape.nothing(mode)
+        if src is None or src in seen:
+            continue
+        seen.add(src)
+        diff = f"- (block at line {b.start + 1}: its results)\n+ {mode} of the same type"
+        if mode == "input":
+            diff = f"- (block at line {b.start + 1}: its results)\n+ the function's input of the same type (else zeros)"
+        mid = f"{b.file}:{b.start}:nothing-{mode}"
+        out.append(Mutant(mid, lab, b.file, b.start, b.task, b.title, "nothing", mode, diff, shape.fn, src))
+    for a, z, new, label, line, col in shape.operators() if not shape.why else ():
+        src = _apply(text, [(a, z, new)])
+        if src in seen:
+            continue
+        seen.add(src)
+        mid = f"{b.file}:{line}:{col}:{label}"
+        k = 2
+        while any(m.id == mid for m in out):
+            mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
+        out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), shape.fn, src))
+    return out
 
 
 def quick_sample(mutants: list[Mutant], lab: str, n: int = QUICK_PER_LAB) -> list[Mutant]:
@@ -803,15 +856,17 @@ def audit(
             def prepare_probe(key=key, d=d):
                 lab, file, line, task = key
                 _copy_lab(root / "solutions" / lab, d / lab)
-                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line))
+                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line, file))
                 return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
 
             probes.append({"prepare": prepare_probe, "key": key})
 
         def probe_done(i, r, res):
             shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
-            if res.get("ok"):
-                covered[probes[i]["key"][:3]] = {t["name"] for t in res["tests"] if not t["passed"]}
+            if res.get("ok"):  # a test stopped by its time limit (a loaded machine) says nothing about the block
+                covered[probes[i]["key"][:3]] = {
+                    t["name"] for t in res["tests"] if not t["passed"] and not _TIMED_OUT.search(t["output"])
+                }
 
         if progress and probes:
             sys.stderr.write(f"finding the tests that run each block ({len(probes)} probe runs)...\n")
@@ -845,7 +900,7 @@ def audit(
             if eq is not None:
                 status = "equivalent" if status == "survived" else f"ERROR: declared equivalent but {status}"
             failure = _first_failure(res)
-            timeout = bool(re.search(r"time budget|timed out|took longer|time limit", failure, re.I))
+            timeout = bool(_TIMED_OUT.search(failure))
             row = {
                 **{k: v for k, v in asdict(m).items() if k != "source"},
                 "status": status,
@@ -892,8 +947,17 @@ def audit(
     return report
 
 
-def _probe_source(text: str, line: int) -> str:
-    """``text`` with a ``raise`` as the first statement of the block whose BEGIN marker is on ``line``."""
+_TIMED_OUT = re.compile(r"time budget|timed out|took longer|time limit", re.I)
+
+
+def _probe_source(text: str, line: int, file: str = ".py") -> str:
+    """``text`` with a ``raise`` as the first statement of the block whose BEGIN marker is on ``line``
+    (a GLSL block, which cannot raise, gives NaN: see :mod:`geomlib.grading.glsl_mutants`)."""
+    if not file.endswith(".py"):
+        from geomlib.grading import stubs
+
+        end = next(b.end for b in stubs._scan(text, file)[0] if b.start == line)
+        return glsl_mutants.Shape(text, line, end).nothing("probe") or text
     lines = text.split("\n")
     indent = re.match(r"\s*", lines[line - 1]).group(0)
     lines.insert(line, f'{indent}raise RuntimeError("geomlib audit: probe (this block runs)")')

@@ -121,6 +121,18 @@ def test_flat_meshes_have_zero_interior_offsets(lab):
         atol=1e-10, hint="cotangent weights reproduce linear functions exactly: on a plane the weighted mean is the vertex",
         mesh=(Vj, F, interior),
     )  # fmt: skip
+    # On the boundary the neighbours lie on one side: at a corner of the grid their mean is half an
+    # edge away or more, with either weighting.
+    corner = np.argmin(V[:, 0] + V[:, 1])
+    h = np.linalg.norm(V[F[:, 0]] - V[F[:, 1]], axis=1).min()
+    for weights, W in (("uniform", V), ("cotan", Vj)):
+        d = np.asarray(lab.laplacian_offsets(W, F, weights, weld=False))
+        expect_true(
+            f"laplacian_offsets(weights={weights!r}) at the grid's corner",
+            np.linalg.norm(d[corner]) > 0.4 * h,
+            f"the corner's offset is {np.linalg.norm(d[corner]):.3g}, expected at least half an edge ({0.5 * h:.3g}): "
+            "delta = p - the weighted mean of its neighbours, which all lie on one side of a corner",
+        )
 
 
 # --------------------------------------------------------------------------------------------
@@ -165,6 +177,9 @@ def test_lambda_zero_changes_nothing(lab):
     Vn, N = noisy(V, F, 0.3, 1)
     X = lab.denoise_vertices(Vn, F, N, 0.0, weld=False)
     expect_close("denoise_vertices(lam=0)", X, Vn, atol=0.0, name="V'", mesh=(Vn, F))
+    X = np.asarray(lab.denoise_vertices(Vn, F, N, 0.5, weld=False), float)
+    expect_true("denoise_vertices(lam=0.5)", np.abs(X - Vn).max() > 1e-3,
+                "with lam = 0.5 the noisy vertices should move (p' = p - lam s n)")  # fmt: skip
 
 
 @graded(points=1, part="direct denoising")
@@ -177,6 +192,8 @@ def test_vertices_move_along_their_normals(lab):
         "cross(V' - V, N) after denoise_vertices", np.cross(D, N), 0 * D, atol=1e-12,
         hint="move by s_i n_i, not by delta_i", mesh=(Vn, F),
     )  # fmt: skip
+    expect_true("denoise_vertices(lam=0.7)", np.abs(D).max() > 1e-3,
+                "the noisy vertices should move (p' = p - lam s n); they stayed where they were")  # fmt: skip
 
 
 @graded(points=1, part="direct denoising")
@@ -430,6 +447,16 @@ def test_welded_offsets_match_the_seamless_torus(lab):
     _, idx = cKDTree(Vt).query(Vu)  # uv_torus vertex -> torus vertex at the same position
     d_cut = lab.laplacian_offsets(Vn[idx], Fu, weld=True)
     d_ref = np.asarray(lab.laplacian_offsets(Vn, Ft, weld=False))[idx]
+    # Offsets of a noisy torus vary from vertex to vertex and (uniform weights) stay within the longest
+    # edge at the vertex: p minus a mean of neighbours.
+    longest = np.linalg.norm(Vn[Ft] - Vn[np.roll(Ft, 1, axis=1)], axis=2).max()
+    expect_true(
+        "laplacian_offsets(weld=False) on the noisy torus",
+        np.ptp(d_ref, axis=0).max() > 1e-3 and np.linalg.norm(d_ref, axis=1).max() <= longest,
+        "the offsets should vary from vertex to vertex and each be at most one edge long (p minus the mean "
+        f"of its neighbours); got a spread of {np.ptp(d_ref, axis=0).max():.3g} and a longest offset of "
+        f"{np.linalg.norm(d_ref, axis=1).max():.3g} (longest edge {longest:.3g})",
+    )
     expect_close(
         "laplacian_offsets(weld=True) on the cut torus", d_cut, d_ref, atol=1e-10, name="delta",
         hint="compute the offsets on the welded mesh (weld_seams) and give every copy its group's offset",
@@ -442,10 +469,20 @@ def test_direct_route_keeps_seams_closed(lab):
     """denoise_vertices(weld=True) moves the copies of every seam vertex identically (needs Task 3)"""
     V, F, _ = datasets.uv_sphere(12, 24)
     Vn, N, group = noisy_cut(V, F, 1)
+    X = np.asarray(lab.denoise_vertices(Vn, F, N, 0.7), float)
     expect_closed_seams(
-        "denoise_vertices(weld=True) on a UV sphere", lab.denoise_vertices(Vn, F, N, 0.7), group,
+        "denoise_vertices(weld=True) on a UV sphere", X, group,
         "the seam cracks (weld for the offsets, and move every copy along the mean normal of its group)",
     )  # fmt: skip
+    # ... and the vertices do move, each by less than the longest edge (lam |s| <= |delta| <= one edge).
+    move = np.linalg.norm(X - Vn, axis=1)
+    longest = np.linalg.norm(Vn[F] - Vn[np.roll(F, 1, axis=1)], axis=2).max()
+    expect_true(
+        "denoise_vertices(weld=True) on a UV sphere",
+        move.max() > 1e-3 * longest and move.max() <= longest,
+        f"the vertices moved by at most {move.max():.3g}; a denoising step moves the noisy vertices, each by "
+        f"lam |s| <= one edge ({longest:.3g})",
+    )
 
 
 @graded(points=1, part="seam fix")
@@ -561,7 +598,7 @@ def test_glsl_denoise_with_map(lab):
 
 @graded(points=1, part="vertex denoising", timeout=60)
 def test_glsl_denoise_keeps_seams_closed(lab):
-    """weld=True: the copies of every seam vertex of the UV torus end at one position (the CPU-side seam fix)"""
+    """weld=True: the copies of every seam vertex of the UV torus end at one position (the CPU-side seam fix), the others where the reference puts them"""
     case = {c.id: c for c in CASES}["map-uv-torus-16bit"]
     inp = case.inputs()
     got = np.asarray(lab.glsl_denoise_with_map(**inp, **{**case.params, "weld": True}), float)
@@ -573,4 +610,18 @@ def test_glsl_denoise_keeps_seams_closed(lab):
         raise Mismatch(
             f"glsl_denoise_with_map(weld=True) (shaders/denoise.vert, the vertex stage, then the given seam fix): "
             f"vertex {i} is {gap[i]:.3g} away from its seam copy (the seam cracks open)"
+        )
+    # The seam fix touches only the copies of seam vertices: every other vertex ends where the case's
+    # stored reference (weld=False) puts it, so a vertex stage that moves nothing cannot pass.
+    from geomlib.grading.cases import load_reference
+
+    expected = load_reference("denoise", case)["V"]
+    single = np.bincount(group.ravel())[group.ravel()] == 1
+    per = np.abs(got - expected)[single].max(axis=1)
+    if not (per <= GLSL_ATOL).all():
+        i = int(np.flatnonzero(single)[np.argmax(~(per <= GLSL_ATOL))])
+        raise Mismatch(
+            f"glsl_denoise_with_map(weld=True): vertex {i}, not on the seam, expected {expected[i].round(7).tolist()}, "
+            f"got {got[i].round(7).tolist()}; {int((~(per <= GLSL_ATOL)).sum())} of {int(single.sum())} vertices off "
+            f"the seam differ by more than {GLSL_ATOL:g} (the seam fix leaves them as shaders/denoise.vert moved them)"
         )

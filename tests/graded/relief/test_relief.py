@@ -121,7 +121,7 @@ def test_parallax_by_hand(lab):
 
 @graded(points=1, part="relief mapping")
 def test_relief_on_flat_maps_by_hand(lab):
-    """h = 0: hit at the bottom layer; h = 1: at the polygon; h = 1/2: the refinements find d = 1/2"""
+    """h = 0: hit at the bottom layer; h = 1: at the polygon; h = 1/2: the refinements find d = 1/2; two flat halves"""
     uv = pixel_uv(4)
     v = direction(45, 0.0)  # view_z = cos 45: n = floor(8 + 24 (1 - 0.7071) + 0.5) = 15 layers
     for refine in ("none", "linear", "secant", "binary"):
@@ -145,6 +145,18 @@ def test_relief_on_flat_maps_by_hand(lab):
     _, depth, _ = lab.relief_uv(half, uv, v, scale=0.1, refine="binary", refine_steps=5)
     # 5 bisections of [7/15, 8/15] leave an interval of 1/480; its midpoint is within 1/960 of 1/2.
     expect_close("relief_uv(refine='binary') depth on h = 1/2", depth, np.full((4, 4), 0.05), atol=0.1 / 960 + 1e-12)
+    # Two flat halves: h = 1/4 for u < 1/2 (texel columns 0-3), h = 1/2 beyond. The rays of the pixels at
+    # u = 1/8, 3/8 stay left of u = 7/16 (last texel centre at 1/4) and those at u = 5/8, 7/8 right of
+    # 9/16, so each sees one flat height. h = 1/4: layer 12 (d = 12/15) is the first below;
+    # linear: 11/15 + (1/15)(1/60)/(1/60 + 1/20) = 3/4 exactly (depth 0.075).
+    steps_of = np.where(uv[..., 0] < 0.5, 12, 8)
+    depth_of = np.where(uv[..., 0] < 0.5, 0.075, 0.05)
+    halves = np.where(np.arange(8) < 4, 0.25, 0.5)[None, :].repeat(8, axis=0)
+    for refine in ("linear", "secant", "binary"):
+        _, depth, steps = lab.relief_uv(halves, uv, v, scale=0.1, refine=refine, refine_steps=5)
+        expect_close(f"relief_uv(refine={refine!r}) steps on h = 1/4 | 1/2", steps, steps_of, atol=0)
+        expect_close(f"relief_uv(refine={refine!r}) depth on h = 1/4 | 1/2", depth, depth_of,
+                     atol=0.1 / 960 + 1e-12 if refine == "binary" else 1e-12)  # fmt: skip
 
 
 # ------------------------------------------------------------------------------ task 4: self-shadowing

@@ -15,7 +15,7 @@ from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import marked_picture
 
 from ..common import expect_rejected
-from .cases import CASES
+from .cases import CASES, LIGHT_DIR
 from .support import CAMERA, SCENE_BOUNDS, ortho_light, scene_meshes, small_scene
 
 test_references = reference_tests(CASES)
@@ -106,6 +106,14 @@ def test_empty_map_is_the_far_plane(lab):
     expect_close(
         "a map that sees nothing", D, np.ones((8, 8)), atol=0, hint="rasterize marks empty pixels with inf; store 1.0"
     )
+    # Beside a covered area too: the square of test_depth_of_a_square_by_hand covers 100 of 256 texels
+    # at depth (0.5 + R - 0.25) / (2R); the other 156 hold exactly 1.0.
+    R = np.sqrt(3) / 2
+    M = ortho_light((0, 0, -1), UNIT, up=np.array([0.0, 1.0, 0.0]))
+    D = np.asarray(lab.depth_map(square(0.25), SQUARE_F, M, 16, cull="none"))
+    expect_close("number of texels at 1.0 beside the square", (D == 1.0).sum(), 156, atol=0,
+                 hint="texels no triangle covers hold 1.0; covered ones hold the triangle's depth")  # fmt: skip
+    expect_close("the covered texels' depth", D[D < 1.0], np.full(100, (0.5 + R - 0.25) / (2 * R)), atol=1e-9)
 
 
 # ------------------------------------------------------------------------------------------ Task 3
@@ -192,6 +200,22 @@ def test_no_acne_with_default_bias(lab):
         fail(f"with the default bias {int((vis < 0.5).sum())} of 500 points on a lit plane are shadowed (acne); "
              "the slope term must cover half a texel in u and in v: b = bias + slope_bias (|g_u| + |g_v|) / 2",
              marked_picture("shadow_visibility on a lit plane", V, SQUARE_F, P[vis < 0.5], "points shadowed (acne)"))  # fmt: skip
+    # The slope term alone (bias = 0) covers every plane with its own gradient: a second square beside
+    # the first, tilted the other way and much more steeply (z = 0.4 - 1.2 x), in the same map.
+    # slope_bias = 1.5 is 1.5x the largest depth change within a texel, so no point may be shadowed.
+    V2 = square(0.0) @ np.array([[1.0, 0, 0], [0, 1, 0], [-1.2, 0.0, 1]]).T + np.array([0.0, -2.0, 0.4])
+    VV, FF = np.vstack([V, V2]), np.vstack([SQUARE_F, SQUARE_F + 4])
+    B = np.array([VV.min(0) - 0.01, VV.max(0) + 0.01])
+    M = ortho_light((0.5, 0.2, -0.8), B)
+    D = np.asarray(lab.depth_map(VV, FF, M, 64, cull="none"))
+    P = np.einsum("ki,kij->kj", rng.dirichlet(np.ones(3), 1000), VV[FF[rng.integers(0, 4, 1000)]])
+    N = np.where((P[:, 1] > -0.5)[:, None], np.cross(V[1] - V[0], V[2] - V[0]), np.cross(V2[1] - V2[0], V2[2] - V2[0]))
+    vis = np.asarray(lab.shadow_visibility(P, N, D, M, bias=0.0, slope_bias=None, pcf=1))
+    if (vis < 0.5).any():
+        fail(f"with bias = 0 and the default slope_bias, {int((vis < 0.5).sum())} of 1000 points on two lit planes "
+             "of different tilts are shadowed (acne): each point needs the gradient of its own plane "
+             "(receiver_depth_gradient) and b = slope_bias (|g_u| + |g_v|) / 2",
+             marked_picture("shadow_visibility, bias 0", VV, FF, P[vis < 0.5], "points shadowed (acne)"))  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ Task 5
@@ -248,6 +272,21 @@ def test_outside_the_map_is_lit(lab):
     vis = np.asarray(lab.shadow_visibility(P, np.tile([0.0, 0, 1], (3, 1)), D, M, bias=0.01, slope_bias=0.0, pcf=1))
     expect_close("visibility of floor points outside the light's frustum", vis, [1, 1, 1], atol=0,
                  hint="outside_frustum must be True for them, and shadow_visibility then leaves them lit")  # fmt: skip
+    # Inside the map nothing changes: floor points that ray casting finds in shadow stay dark.
+    V, F = small_scene()
+    g = np.linspace(-1.4, 1.4, 29)
+    P = np.c_[np.array(np.meshgrid(g, g)).reshape(2, -1).T, np.zeros(29 * 29)]
+    L = -LIGHT_DIR / np.linalg.norm(LIGHT_DIR)
+    truth = _truth(V, F, P, np.tile(L, (len(P), 1)), None)
+    vis = np.asarray(
+        lab.shadow_visibility(P, np.tile([0.0, 0, 1], (len(P), 1)), D, M, bias=0.01, slope_bias=0.0, pcf=1)
+    )
+    dark = ~truth
+    if dark.sum() < 20 or np.mean(vis[dark] < 0.5) < 0.9:
+        fail(
+            f"of {int(dark.sum())} floor points inside the map that ray casting finds in shadow, only "
+            f"{int((vis[dark] < 0.5).sum())} are dark: outside_frustum must be False inside [0, 1]^2 with z <= 1"
+        )
 
 
 # ------------------------------------------------------------------------------------------ Task 7
@@ -269,9 +308,9 @@ def test_pcf_up_is_up(lab):
     D = np.ones((5, 5))
     D[0, :] = 0.2  # an occluder in the TOP row only
     uvz = [[0.5, 0.7, 0.5]]  # texel (row 1, col 2): its upper neighbours are row 0
-    expect_close(
-        "pcf_visibility just below the occluded top row", lab.pcf_visibility(D, uvz, 0.0, 3), [2 / 3], atol=1e-12
-    )
+    # and a second point at the bottom (row 4, col 2): its block (rows 3-5 clamped to 4) sees no occluder
+    expect_close("pcf_visibility just below the occluded top row, and at the bottom row",
+                 lab.pcf_visibility(D, [*uvz, [0.5, 0.1, 0.5]], 0.0, 3), [2 / 3, 1.0], atol=1e-12)  # fmt: skip
     # With a gradient, depth grows 0.1 per texel up: row 0 compares 0.6 <= 0.65 (lit), row 1 0.5 <= 0.55,
     # row 2 0.4 <= 0.55: all lit. The wrong sign or the wrong row direction darkens a row (2/3).
     D2 = np.full((5, 5), 0.55)
@@ -312,6 +351,10 @@ def test_cube_face_index_by_hand(lab):
     """the face is the axis of the largest |component| and its sign: +x, -x, +y, -y, +z, -z"""
     d = [[2, 1, -1], [-3, 1, 2], [0.1, 0.5, 0.2], [0, -1, 0.5], [1, 1, 1.5], [0.2, -0.3, -0.9]]
     expect_close("cube_face_index", lab.cube_face_index(d), [0, 1, 2, 3, 4, 5], atol=0)
+    # The docstring's rules for the edge cases: ties go to the first axis, the zero direction to face 0 (+x).
+    ties = [[1, -1, 0], [0, -2, 2], [-1, 1, 1], [0, 0, 0]]
+    expect_close("cube_face_index on ties and the zero direction", lab.cube_face_index(ties), [0, 3, 1, 0], atol=0,
+                 hint="a = argmax |d_i| (the first axis on ties); face = 2 a + (d_a < 0), so 0 counts as +")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ all together
@@ -329,7 +372,11 @@ def test_agrees_with_ray_casting(lab):
     V, F = small_scene()
     d = np.array([0.4, 0.5, -0.75])
     M = np.asarray(lab.directional_light_matrix(d, [V.min(0), V.max(0)]))
-    D = np.asarray(lab.depth_map(V, F, M, 1024))
+    for cull in ("front", "none"):  # without culling, the default bias alone must keep the lit faces lit
+        _agree_with_ray_casting(lab, V, F, d, M, np.asarray(lab.depth_map(V, F, M, 1024, cull=cull)), cull)
+
+
+def _agree_with_ray_casting(lab, V, F, d, M, D, cull):
     rng = np.random.default_rng(5)
     f = rng.integers(0, len(F), 4000)
     b = rng.dirichlet(np.ones(3), 4000)
@@ -345,7 +392,8 @@ def test_agrees_with_ray_casting(lab):
     acne = np.mean(vis[truth] < 0.5)
     if agree < 0.99 or acne > 0.005:
         wrong = P[(vis >= 0.5) != truth]
-        fail(f"shadow_visibility agrees with ray casting on {100 * agree:.2f}% of {len(P)} points (need >= 99%) "
+        fail(f"with a map made with cull={cull!r}, "
+             f"shadow_visibility agrees with ray casting on {100 * agree:.2f}% of {len(P)} points (need >= 99%) "
              f"and shades {100 * acne:.2f}% of truly lit points dark (acne, allowed 0.5%)",
              marked_picture("shadow_visibility vs ray casting", V, F, wrong, "points where the two disagree"))  # fmt: skip
 
