@@ -65,6 +65,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
+from geomlib.grading.course import course
 from geomlib.taskref import find_task
 
 __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
@@ -442,7 +443,7 @@ def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
 
 def generate(lab: str, lab_dir: Path | None = None) -> tuple[list[Mutant], list[str]]:
     """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated."""
-    lab_dir = Path(lab_dir or _impl.course_root() / "solutions" / lab)
+    lab_dir = Path(lab_dir or course().lab(lab).solution)
     if not lab_dir.is_dir():
         raise AuditError(f"no solution folder {lab_dir}")
     blocks, shaders = _blocks(lab_dir)
@@ -517,7 +518,7 @@ def equivalents(lab: str) -> dict[str, str]:
     """
     import tomllib
 
-    path = _impl.tests_dir() / "graded" / lab / "equivalent_mutants.toml"
+    path = course().lab(lab).mutants
     if not path.is_file():
         return {}
     try:
@@ -546,19 +547,12 @@ def pytest_collection_modifyitems(session, config, items):
 
     tables: dict = {}
     for item in items:
-        lab = plugin._lab_of(item.path)
+        lab = plugin.lab_of(item.path)
         if lab is None:
             continue
-        callspec = getattr(item, "callspec", None)
-        case = callspec.params.get("case") if callspec is not None else None
-        if case is not None and hasattr(case, "function"):
-            names = [case.function]
-        else:
-            if lab not in tables:
-                tables[lab] = tasks.table(lab)
-            names = tasks._lab_calls(item.function)
-            names += [n for n in tasks._named_functions(item.function, tables[lab]) if n not in names]
-        _CALLS[item.nodeid] = names
+        if lab not in tables:
+            tables[lab] = tasks.table(lab)
+        _CALLS[item.nodeid] = tasks.test_functions(item, tables[lab])
 
 
 def _worker_main() -> int:
@@ -715,7 +709,6 @@ def audit(
     unknown = [n for n in names if n not in known]
     if unknown:
         raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
-    root = _impl.course_root()
     work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
     os.chmod(work, 0o755)
     t_start = time.time()
@@ -738,7 +731,7 @@ def audit(
                 muts = quick_sample(muts, lab)
             elif sample:
                 muts = sample_mutants(muts, lab, sample)
-            tab = _tasks.derive(root / "solutions" / lab)
+            tab = _tasks.derive(course().lab(lab).solution)
             runs_of[lab] = {f: {f, *tab.composites.get(f, ())} for f in {*tab.tasks, *tab.composites}}
             tasks = sorted({m.task for m in muts})
             report["labs"][lab] = {
@@ -759,7 +752,7 @@ def audit(
         for lab, _muts, tasks in [] if quick else plan:
             d = work / "baseline"
             if not (d / lab).exists():
-                _copy_lab(root / "solutions" / lab, d / lab)
+                _copy_lab(course().lab(lab).solution, d / lab)
             base_reqs += [{"impl": str(d), "lab": lab, "task": t, "budget": None} for t in tasks]
         base: dict = {}
 
@@ -788,7 +781,7 @@ def audit(
                 d = work / f"{lab}-{k}"
 
                 def prepare(m=m, d=d, budget=budget):
-                    _copy_lab(root / "solutions" / m.lab, d / m.lab)
+                    _copy_lab(course().lab(m.lab).solution, d / m.lab)
                     (d / m.lab / m.file).write_text(m.source)
                     return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
 
@@ -802,8 +795,8 @@ def audit(
 
             def prepare_probe(key=key, d=d):
                 lab, file, line, task = key
-                _copy_lab(root / "solutions" / lab, d / lab)
-                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line))
+                _copy_lab(course().lab(lab).solution, d / lab)
+                (d / lab / file).write_text(_probe_source((course().lab(lab).solution / file).read_text(), line))
                 return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
 
             probes.append({"prepare": prepare_probe, "key": key})
