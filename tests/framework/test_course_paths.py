@@ -11,7 +11,19 @@ ROOT = Path(__file__).resolve().parents[2]
 GRADING = ROOT / "geomlib" / "grading"
 
 #: Folder names of the course layout (tests/graded, tests/reference/<lab>/hidden/inputs, ...).
-FOLDERS = {"tests", "graded", "reference", "solutions", "labs", "hidden", "inputs", "notebooks", "docs", "figures", "geomlib"}
+FOLDERS = {
+    "tests",
+    "graded",
+    "reference",
+    "solutions",
+    "labs",
+    "hidden",
+    "inputs",
+    "notebooks",
+    "docs",
+    "figures",
+    "geomlib",
+}
 #: Calls whose string arguments are paths or path patterns.
 PATH_CALLS = {"Path", "PurePath", "joinpath", "glob", "rglob", "_tree", "with_name", "relative_to"}
 
@@ -70,7 +82,7 @@ def folder_literals(source: str) -> list[tuple[int, str]]:
 
 def test_the_detector_finds_each_way_the_tooling_spelled_folders():
     """The rules catch every form the old modules used (release.py, impl.py, tasks.py, sandbox.py)."""
-    old = '''
+    old = """
 base = root / "tests"
 p = root / "solutions" / lab / "__init__.py"
 if parts[1] not in ("graded", "reference"): pass
@@ -80,7 +92,7 @@ out = _tree(root, "labs", keep)
 hidden = list(tests.glob("*/hidden")) + list(g.glob("*/*_hidden*.py"))
 folder = ref / lab / ("hidden" if hidden else "")
 hidden = any("hidden" in part for part in rel.parts)
-'''
+"""
     lines = {line for line, _ in folder_literals(old)}
     assert lines == set(range(2, 11)), lines
     fine = 'x = data["tests"]\nif visibility == "hidden": pass\nm = item.get_closest_marker("graded")\n'
