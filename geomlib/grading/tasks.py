@@ -24,6 +24,7 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from geomlib.gl import SHADER_FOLDER
 from geomlib.grading.course import course
 from geomlib.grading.registry import graded_module
 from geomlib.taskref import find_task
@@ -107,7 +108,7 @@ def derive(lab_dir: str | Path) -> TaskTable:
             # shader's tasks: the student writes them in ``shaders/parallax.frag``.
             for n in ast.walk(node):
                 if isinstance(n, ast.Constant) and isinstance(n.value, str) and _SHADER.fullmatch(n.value):
-                    shader = Path(lab_dir) / "shaders" / (n.value if "." in n.value else f"{n.value}.frag")
+                    shader = Path(lab_dir) / SHADER_FOLDER / (n.value if "." in n.value else f"{n.value}.frag")
                     if shader.is_file():
                         shader_marks += [(n, t, node.name) for n, t in _marks(shader.read_text().splitlines())]
             calls = set()
