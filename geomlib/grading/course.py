@@ -56,6 +56,8 @@ class Course:
 
     root: Path
     declared: tuple[str, ...] = ()
+    #: ``(lab, topic, what students write)`` per lab, from ``[tool.geomlib.readme]``: README.md's lab table.
+    summaries: tuple[tuple[str, str, str], ...] = ()
 
     @property
     def solutions_dir(self) -> Path:
@@ -170,6 +172,10 @@ class Course:
         found = [p.name for p in g.iterdir() if p.is_dir() and not p.name.startswith(("_", "."))] if g.is_dir() else []
         return self.order(found)
 
+    def summary(self, name: str) -> tuple[str, str]:
+        """``(topic, what students write)`` of lab ``name`` as README.md's lab table gives them (``[tool.geomlib.readme]``)."""
+        return next(((topic, tasks) for lab, topic, tasks in self.summaries if lab == name), ("", ""))
+
     @property
     def solution_labs(self) -> list[str]:
         """The declared or graded labs with a reference solution package, in course order."""
@@ -181,20 +187,26 @@ class Course:
         return [n for n in self.order([*self.declared, *self.labs]) if self.lab(n).figures.is_file()]
 
 
-def _declared(root: Path) -> tuple[str, ...]:
+def _declaration(root: Path) -> Course:
     path = root / "pyproject.toml"
     if not path.is_file():
-        return ()
+        return Course(root)
     with path.open("rb") as f:
-        labs = tomllib.load(f).get("tool", {}).get("geomlib", {}).get("labs", [])
+        table = tomllib.load(f).get("tool", {}).get("geomlib", {})
+    labs = table.get("labs", [])
     if not isinstance(labs, list) or not all(isinstance(n, str) for n in labs) or len(set(labs)) != len(labs):
         raise ValueError(f"{path}: [tool.geomlib] labs must be a list of distinct lab names, got {labs!r}")
-    return tuple(labs)
+    summaries = []
+    for lab, entry in table.get("readme", {}).items():
+        if not (isinstance(entry, dict) and all(isinstance(entry.get(k), str) for k in ("topic", "tasks"))):
+            raise ValueError(f'{path}: [tool.geomlib.readme] {lab} must be {{ topic = "...", tasks = "..." }}')
+        summaries.append((lab, entry["topic"], entry["tasks"]))
+    return Course(root, tuple(labs), tuple(summaries))
 
 
 @functools.lru_cache(maxsize=8)
 def _course(root: Path, stamp: float) -> Course:
-    return Course(root, _declared(root))
+    return _declaration(root)
 
 
 def course_root() -> Path:
