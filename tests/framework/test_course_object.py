@@ -149,7 +149,7 @@ def _course_test(root: Path, test_file: str, select: str, passed: int) -> None:
     env = {**os.environ, "GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
     cmd = [sys.executable, "-m", "pytest", test_file, "-q", "-p", "no:cacheprovider", "-k", select]
     p = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True, timeout=600)
-    assert p.returncode == 0 and f" {passed} passed" in p.stdout, p.stdout[-4000:] + p.stderr[-2000:]
+    assert p.returncode == 0 and re.search(rf"^{passed} passed\b", p.stdout, re.M), p.stdout[-4000:] + p.stderr[-2000:]
 
 
 def test_a_lab_added_by_the_documented_steps_appears_everywhere():
