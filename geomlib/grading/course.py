@@ -82,13 +82,9 @@ class Course:
     def docs_dir(self) -> Path:
         return self.root / "docs"
 
-    @property
-    def impl_names(self) -> tuple[str, str]:
-        """The implementations named by their folder (``--impl solutions``, ``--impl labs``)."""
-        return (self.solutions_dir.name, self.stubs_dir.name)
-
     def impl_dir(self, name: str) -> Path | None:
-        """The folder of lab folders of the named implementation (:attr:`impl_names`), else None."""
+        """The folder of lab folders of the implementation named by its folder (``--impl solutions``,
+        ``--impl labs``), else None (a submission's path)."""
         return {self.solutions_dir.name: self.solutions_dir, self.stubs_dir.name: self.stubs_dir}.get(str(name))
 
     @property
