@@ -71,9 +71,9 @@ def declared(lab: str, tests_dir: Path | None = None) -> dict[str, str]:
     from geomlib.grading.course import course
 
     c = course()
-    if tests_dir is not None:  # another course copy: the folder holding its tests/
-        c = course(Path(tests_dir).resolve().parent)
     path = c.lab(lab).package
+    if tests_dir is not None:  # another tests folder, laid out as the course's
+        path = Path(tests_dir) / path.relative_to(c.tests_dir)
     if not path.is_file():
         return {}
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
