@@ -10,7 +10,21 @@ changes nothing.
 
 from __future__ import annotations
 
+import os
+
 import pytest
+
+#: Seconds one feedback picture may take in the suite's runs (``GEOMLIB_PICTURE_TIME_LIMIT``, default
+#: 20 s). A picture takes about 2 s on a quiet machine, but the suite runs on 2 shared cores beside
+#: other CPU-bound processes, where one took more than 20 s and a test that expects a picture failed
+#: for the machine's speed: x10 above a loaded machine's need, still a limit for hangs. Set here, it
+#: reaches in-process runs and every grading subprocess that inherits the environment.
+PICTURE_TIME_LIMIT_S = "300"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    os.environ.setdefault("GEOMLIB_PICTURE_TIME_LIMIT", PICTURE_TIME_LIMIT_S)
+
 
 #: Seconds a module takes: the sum of its tests' durations in CI's run of 2026-11-26 (2 workers).
 #: Modules not listed are short and follow, in collection order.

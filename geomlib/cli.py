@@ -104,6 +104,12 @@ _GENERATED = {
         ok="labs/ is up to date",
         stale="labs/ is stale: run `geomlib stubs build`",
     ),
+    "readme": dict(
+        built="README.md: {n} file(s) written (changed), {same} unchanged",
+        problem="STALE {p}",
+        ok="README.md's lab table is up to date",
+        stale="README.md's lab table is stale: run `geomlib readme build`",
+    ),
 }
 
 
@@ -266,6 +272,13 @@ def build_parser() -> argparse.ArgumentParser:
     st.add_argument("action", choices=["build", "check"])
     st.add_argument("--lab")
     st.set_defaults(func=_cmd_generated)
+
+    rd = sub.add_parser(
+        "readme", help="write README.md's lab table (labs, topics, points) from the course, or check it"
+    )
+    rd.add_argument("action", choices=["build", "check"])
+    rd.add_argument("--lab", help=argparse.SUPPRESS)  # the table lists every lab
+    rd.set_defaults(func=_cmd_generated)
 
     g = sub.add_parser("grade", help="run the graded tests on an implementation; print scores, write results.json")
     g.add_argument(

@@ -34,9 +34,12 @@ Examples
 from __future__ import annotations
 
 import atexit
+import contextlib
 import ctypes
+import os
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from pathlib import Path
 
 import numpy as np
 
@@ -51,7 +54,15 @@ __all__ = [
     "render_points",
     "renderer_info",
     "close",
+    "SHADER_FOLDER",
+    "shader_finder",
+    "lab_shader_source",
+    "naming_task",
 ]
+
+#: The folder of a lab package that holds the lab's GLSL files (``shaders/<name>.vert``, ``.frag``).
+SHADER_FOLDER = "shaders"
+_SHADER_SUFFIXES = (".vert", ".frag", ".glsl")
 
 #: Vertex shader of :func:`render_quad`: a full-screen quad passing ``uv`` in [0, 1]² (v up).
 QUAD_VERTEX_SHADER = """#version 330 core
@@ -83,6 +94,62 @@ class ShaderError(RuntimeError):
 # --------------------------------------------------------------------------------------------
 
 _STATE: dict = {}
+
+
+def shader_finder(package: str | os.PathLike) -> Callable[[str], Path]:
+    """The ``shader_path(name)`` function of a lab package: a lab's ``glsl.py`` writes
+    ``shader_path = gl.shader_finder(__file__)``, so every lab finds its shaders the same way.
+
+    Parameters
+    ----------
+    package : path
+        The lab package's folder, or a file in it (a module's ``__file__``).
+
+    Returns
+    -------
+    callable
+        ``shader_path(name) -> Path``: ``shaders/<name>`` of the package; ``name`` is a file name
+        (``"tbn.vert"``) or the stem of exactly one shader file (``"parallax"`` for ``parallax.frag``).
+        A stem no file has, or more than one has, raises ``FileNotFoundError`` naming the files there.
+    """
+    folder = Path(package).resolve()
+    folder = (folder if folder.is_dir() else folder.parent) / SHADER_FOLDER
+
+    def shader_path(name: str) -> Path:
+        """``shaders/<name>`` of this lab (``name`` with or without its ``.vert``/``.frag`` suffix)."""
+        if Path(name).suffix in _SHADER_SUFFIXES:
+            return folder / name
+        found = sorted(p for p in folder.glob(f"{name}.*") if p.suffix in _SHADER_SUFFIXES)
+        if len(found) != 1:
+            have = ", ".join(sorted(p.name for p in folder.glob("*") if p.suffix in _SHADER_SUFFIXES)) or "none"
+            raise FileNotFoundError(f"{len(found) or 'no'} shader file(s) named {name!r} in {folder} (it has: {have})")
+        return found[0]
+
+    return shader_path
+
+
+def lab_shader_source(path: str | os.PathLike) -> str:
+    """The text of a lab's shader file; a stub's unfilled shader (an ``#error Task N ...`` directive,
+    which no driver compiles) raises ``NotImplementedError("shaders/<file>: Task N ...")`` instead, as
+    an unfilled Python task does."""
+    path = Path(path)
+    source = path.read_text()
+    todo = [ln.strip()[len("#error") :].strip() for ln in source.splitlines() if ln.strip().startswith("#error")]
+    if todo:
+        raise NotImplementedError(f"{SHADER_FOLDER}/{path.name}: {todo[0]}")
+    return source
+
+
+@contextlib.contextmanager
+def naming_task(label: str, task: str):
+    """Re-raise a :class:`ShaderError` of the shader ``label`` (``"shaders/relief.frag"``, the
+    ``name`` given to the harness) with its task after the file name, so the message leads with both:
+    ``shaders/relief.frag (Task 3: march and refine): line 12: ...``."""
+    try:
+        yield
+    except ShaderError as e:
+        msg = str(e).replace(label, f"{label} ({task})", 1)
+        raise ShaderError(msg, log=e.log, lines=e.lines) from None
 
 
 def _gl():

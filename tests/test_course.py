@@ -11,14 +11,11 @@ from pathlib import Path
 import pytest
 
 from geomlib.grading import impl, stubs
+from geomlib.grading.course import course
 from geomlib.grading.results import validate_results
 
 ROOT = Path(__file__).resolve().parents[1]
-LABS = (
-    [p.name for p in sorted((ROOT / "solutions").iterdir()) if (p / "__init__.py").is_file()]
-    if (ROOT / "solutions").is_dir()
-    else []
-)
+LABS = course(ROOT).solution_labs
 
 
 def _cli(*args: str, timeout: float = 600) -> subprocess.CompletedProcess:

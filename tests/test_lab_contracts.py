@@ -23,10 +23,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from geomlib.grading.course import course
 from geomlib.plot import Figure
 
 ROOT = Path(__file__).resolve().parents[1]
-LABS = sorted(p.name for p in (ROOT / "solutions").iterdir() if (p / "figures.py").is_file())
+LABS = course(ROOT).figure_labs
 TASK = re.compile(r"NotImplementedError\(\s*['\"]Task (\d+[a-z]?)\b")
 
 

@@ -67,6 +67,7 @@ from pathlib import Path
 
 from geomlib.grading import glsl_mutants
 from geomlib.grading import impl as _impl
+from geomlib.grading.course import course
 from geomlib.taskref import find_task
 
 __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
@@ -446,7 +447,7 @@ def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) 
 
     ``check_glsl``: drop the GLSL operator mutants that do not compile (asks the driver in a child
     process; a few seconds for its GL context)."""
-    lab_dir = Path(lab_dir or _impl.course_root() / "solutions" / lab)
+    lab_dir = Path(lab_dir or course().lab(lab).solution)
     if not lab_dir.is_dir():
         raise AuditError(f"no solution folder {lab_dir}")
     blocks, shaders = _blocks(lab_dir)
@@ -570,7 +571,7 @@ def equivalents(lab: str) -> dict[str, str]:
     """
     import tomllib
 
-    path = _impl.tests_dir() / "graded" / lab / "equivalent_mutants.toml"
+    path = course().lab(lab).mutants
     if not path.is_file():
         return {}
     try:
@@ -599,19 +600,12 @@ def pytest_collection_modifyitems(session, config, items):
 
     tables: dict = {}
     for item in items:
-        lab = plugin._lab_of(item.path)
+        lab = plugin.lab_of(item.path)
         if lab is None:
             continue
-        callspec = getattr(item, "callspec", None)
-        case = callspec.params.get("case") if callspec is not None else None
-        if case is not None and hasattr(case, "function"):
-            names = [case.function]
-        else:
-            if lab not in tables:
-                tables[lab] = tasks.table(lab)
-            names = tasks._lab_calls(item.function)
-            names += [n for n in tasks._named_functions(item.function, tables[lab]) if n not in names]
-        _CALLS[item.nodeid] = names
+        if lab not in tables:
+            tables[lab] = tasks.table(lab)
+        _CALLS[item.nodeid] = tasks.test_functions(item, tables[lab])
 
 
 def _worker_main() -> int:
@@ -768,7 +762,6 @@ def audit(
     unknown = [n for n in names if n not in known]
     if unknown:
         raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
-    root = _impl.course_root()
     work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
     os.chmod(work, 0o755)
     t_start = time.time()
@@ -791,7 +784,7 @@ def audit(
                 muts = quick_sample(muts, lab)
             elif sample:
                 muts = sample_mutants(muts, lab, sample)
-            tab = _tasks.derive(root / "solutions" / lab)
+            tab = _tasks.derive(course().lab(lab).solution)
             runs_of[lab] = {f: {f, *tab.composites.get(f, ())} for f in {*tab.tasks, *tab.composites}}
             tasks = sorted({m.task for m in muts})
             report["labs"][lab] = {
@@ -812,7 +805,7 @@ def audit(
         for lab, _muts, tasks in [] if quick else plan:
             d = work / "baseline"
             if not (d / lab).exists():
-                _copy_lab(root / "solutions" / lab, d / lab)
+                _copy_lab(course().lab(lab).solution, d / lab)
             base_reqs += [{"impl": str(d), "lab": lab, "task": t, "budget": None} for t in tasks]
         base: dict = {}
 
@@ -841,7 +834,7 @@ def audit(
                 d = work / f"{lab}-{k}"
 
                 def prepare(m=m, d=d, budget=budget):
-                    _copy_lab(root / "solutions" / m.lab, d / m.lab)
+                    _copy_lab(course().lab(m.lab).solution, d / m.lab)
                     (d / m.lab / m.file).write_text(m.source)
                     return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
 
@@ -855,8 +848,8 @@ def audit(
 
             def prepare_probe(key=key, d=d):
                 lab, file, line, task = key
-                _copy_lab(root / "solutions" / lab, d / lab)
-                (d / lab / file).write_text(_probe_source((root / "solutions" / lab / file).read_text(), line, file))
+                _copy_lab(course().lab(lab).solution, d / lab)
+                (d / lab / file).write_text(_probe_source((course().lab(lab).solution / file).read_text(), line, file))
                 return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
 
             probes.append({"prepare": prepare_probe, "key": key})

@@ -391,14 +391,14 @@ def _grade_one(
     user = sandbox_user() if user is None else user
     try:
         try:
-            skipped = copy_lab(find_lab(sub.folder, lab), work / "labs" / lab)
+            skipped = copy_lab(find_lab(sub.folder, lab), work / lab)  # `work` is the implementation graded
         except SubmissionError as e:
             data = _failure(f"Nothing was graded: {e}.")
             results.write_text(json.dumps(data, indent=1) + "\n")
             return data, "no lab"
         env = {**os.environ, "GEOMLIB_SANDBOX_USER": user}
         env.setdefault("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
-        cmd = [python or sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work / "labs"), "--lab", lab]
+        cmd = [python or sys.executable, "-m", "geomlib.cli", "grade", "--impl", str(work), "--lab", lab]
         cmd += ["--results", str(results), "--feedback", str(out / "feedback")]
         with open(out / "grader-output.txt", "w") as log:
             if skipped:

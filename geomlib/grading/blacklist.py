@@ -68,11 +68,12 @@ def declared(lab: str, tests_dir: Path | None = None) -> dict[str, str]:
     ValueError
         The declaration is not a literal ``dict`` of strings (naming the file).
     """
-    if tests_dir is None:
-        from geomlib.grading import impl
+    from geomlib.grading.course import course
 
-        tests_dir = impl.tests_dir()
-    path = Path(tests_dir) / "graded" / lab / "__init__.py"
+    c = course()
+    path = c.lab(lab).package
+    if tests_dir is not None:  # another tests folder, laid out as the course's
+        path = Path(tests_dir) / path.relative_to(c.tests_dir)
     if not path.is_file():
         return {}
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))

@@ -48,7 +48,7 @@ class _Selection:
         runs = {}
         for item in items:
             marker = item.get_closest_marker("graded")
-            lab = plugin._lab_of(item.path)
+            lab = plugin.lab_of(item.path)
             if marker is None or lab is None:
                 keep.append(item)
                 continue
@@ -77,7 +77,7 @@ class _Selection:
         if self.task is not None and not [i for i in keep if i.nodeid in self.tasks] and any(runs.values()):
             keep += [i for i in drop if runs.get(i.nodeid)]
             drop = [i for i in drop if not runs.get(i.nodeid)]
-            labs = sorted({plugin._lab_of(i.path) for i in keep if i.nodeid in runs})
+            labs = sorted({plugin.lab_of(i.path) for i in keep if i.nodeid in runs})
             titles = [self.titles[lab].describe(self.task) for lab in labs if lab in self.titles]
             self.through = (
                 f"{titles[0] if titles else f'Task {self.task}'} has no test of its own: "

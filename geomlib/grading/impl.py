@@ -30,7 +30,7 @@ def reference_dir() -> Path:
 
 def default_impl() -> str:
     """``solutions`` where the reference solutions are present (instructors, CI), else ``labs``."""
-    return "solutions" if (course_root() / "solutions").is_dir() else "labs"
+    return course().default_impl
 
 
 def resolve_impl(impl: str | os.PathLike | None) -> Path:
@@ -41,14 +41,13 @@ def resolve_impl(impl: str | os.PathLike | None) -> Path:
     FileNotFoundError
         With the path tried, when the folder does not exist.
     """
-    impl = default_impl() if impl is None else impl
-    root = course_root()
-    if str(impl) in ("solutions", "labs"):
-        p = root / str(impl)
-    else:
+    c = course()
+    impl = c.default_impl if impl is None else impl
+    p = c.impl_dir(str(impl))
+    if p is None:
         p = Path(impl).expanduser().resolve()
-        if (p / "labs").is_dir():
-            p = p / "labs"
+        if (p / c.stubs_dir.name).is_dir():
+            p = p / c.stubs_dir.name
     if not p.is_dir():
         raise FileNotFoundError(f"implementation folder not found: {p}")
     return p
@@ -73,8 +72,9 @@ def load_lab(lab: str, impl: str | os.PathLike | None = None) -> ModuleType:
     folder = resolve_impl(impl) / lab
     if not (folder / "__init__.py").is_file():
         raise FileNotFoundError(f"no lab {lab!r} in {folder.parent} (expected {folder}/__init__.py)")
-    root = course_root()
-    if folder.parent.parent == root and folder.parent.name in ("solutions", "labs"):
+    c = course()
+    root = c.root
+    if folder.parent in (c.solutions_dir, c.stubs_dir):
         if str(root) not in sys.path:
             sys.path.insert(0, str(root))
         return importlib.import_module(f"{folder.parent.name}.{lab}")

@@ -137,14 +137,15 @@ def _picture_allowed() -> bool:
 
 def _drawn_in_time(path, draw) -> str | None:
     """Run ``draw()`` (which writes ``path``) in a forked child, stopped after
-    :data:`~geomlib.grading.tolerances.PICTURE_TIME_S` or the rest of the run's time budget."""
+    ``GradingSettings.picture_time_limit`` or the rest of the run's time budget."""
     import time
 
-    from geomlib.grading import sandbox, tolerances
+    from geomlib.grading import sandbox
+    from geomlib.grading.settings import GradingSettings
 
     if not picture_wanted():
         return None
-    limit = tolerances.PICTURE_TIME_S
+    limit = GradingSettings.build().picture_time_limit
     left = sandbox.remaining_time()
     if left is not None:
         limit = min(limit, left - 1.0)

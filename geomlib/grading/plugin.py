@@ -21,6 +21,7 @@ import pytest
 
 from geomlib.grading import impl as _impl
 from geomlib.grading import sandbox, tolerances
+from geomlib.grading.course import course as _course
 from geomlib.grading.errors import GraderError, GradingFailure, NotImplementedYet
 from geomlib.grading.results import Record
 from geomlib.grading.sandbox import LabProxy
@@ -98,13 +99,10 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "graded(points, part, visibility, timeout, memory_mb): a graded test")
 
 
-def _lab_of(path: Path) -> str | None:
-    parts = Path(path).parts
-    if "graded" in parts:
-        i = parts.index("graded")
-        if i + 1 < len(parts) - 1:
-            return parts[i + 1]
-    return None
+def lab_of(path: Path) -> str | None:
+    """The lab whose graded tests hold the file ``path`` (``tests/graded/<lab>/...`` of any course
+    copy; see :meth:`geomlib.grading.course.Course.lab_of`), else None."""
+    return _course().lab_of(path)
 
 
 @pytest.fixture
@@ -119,7 +117,7 @@ def _feedback_pictures_of_this_test(request):
     ``expect_close`` and a lab's own comparisons draw them (``feedback/<lab>/<test>-<output>.png``)."""
     from geomlib.grading import feedback
 
-    name = _lab_of(request.path)
+    name = lab_of(request.path)
     folder = request.config.getoption("--feedback-dir", None)
     if name is None or not folder:
         yield
@@ -134,7 +132,7 @@ def _feedback_pictures_of_this_test(request):
 @pytest.fixture
 def lab(request) -> LabProxy:
     """The lab under test (from the test's folder ``tests/graded/<lab>/``), run in sandboxed workers."""
-    name = _lab_of(request.path)
+    name = lab_of(request.path)
     if name is None:
         raise RuntimeError("the `lab` fixture is for tests under tests/graded/<lab>/")
     root = _impl.resolve_impl(request.config.getoption("--impl") or grading_run(request.config).settings.impl)
@@ -190,7 +188,7 @@ def pytest_runtest_makereport(item, call):
             dataclasses.asdict(
                 Record(
                     nodeid=item.nodeid,
-                    lab=_lab_of(item.path) or "?",
+                    lab=lab_of(item.path) or "?",
                     part=marker.kwargs.get("part", "other"),
                     name=_display_name(item),
                     points=float(marker.kwargs.get("points", 0)),

@@ -14,6 +14,7 @@ from collections import OrderedDict
 
 from geomlib.grading import impl as _impl
 from geomlib.grading.course import course
+from geomlib.grading.registry import graded_package_modules
 
 __all__ = ["points_by_part", "graded_items"]
 
@@ -23,7 +24,7 @@ class _Collector:
         self.items: list[tuple[str, str, str, float, str]] = []
 
     def pytest_collection_modifyitems(self, items):
-        from geomlib.grading.plugin import _lab_of
+        from geomlib.grading.plugin import lab_of
 
         for it in items:
             m = it.get_closest_marker("graded")
@@ -31,7 +32,7 @@ class _Collector:
                 continue
             self.items.append(
                 (
-                    _lab_of(it.path) or "?",
+                    lab_of(it.path) or "?",
                     m.kwargs.get("part", "other"),
                     m.kwargs.get("visibility", "visible"),
                     float(m.kwargs.get("points", 0)),
@@ -49,12 +50,12 @@ def graded_items(labs: list[str] | None = None) -> list[tuple[str, str, str, flo
     args = [str(course().lab(n).graded) for n in names]
     args += ["--collect-only", "-qq", "-p", "no:cacheprovider", f"--rootdir={_impl.course_root()}"]
     # Another course's `graded` package (a test session may hold one) would shadow this one's.
-    saved = {k: sys.modules.pop(k) for k in list(sys.modules) if k == "graded" or k.startswith("graded.")}
+    saved = {k: sys.modules.pop(k) for k in graded_package_modules()}
     try:
         with contextlib.redirect_stdout(io.StringIO()) as out:
             code = pytest.main(args, plugins=[c])
     finally:
-        for k in [k for k in sys.modules if k == "graded" or k.startswith("graded.")]:
+        for k in graded_package_modules():
             del sys.modules[k]
         sys.modules.update(saved)
     if code not in (0, 5):

@@ -29,6 +29,7 @@ import numpy as np
 from geomlib.grading import impl as _impl
 from geomlib.grading.cases import Case, inputs_digest, load_cases, load_stored, reference_path, stored_path
 from geomlib.grading.checks import Context
+from geomlib.grading.course import course
 from geomlib.grading.errors import GradingFailure
 from geomlib.grading.stubs import Written
 
@@ -84,7 +85,7 @@ def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
 
 
 def _run_solution(lab: str, case: Case) -> tuple[dict, str]:
-    mod = _impl.load_lab(lab, "solutions")
+    mod = _impl.load_lab(lab, course().solutions_dir.name)
     fn = getattr(mod, case.function)
     inputs = case.inputs()
     digest = inputs_digest(inputs, case.params)
@@ -172,17 +173,17 @@ def build(labs: list[str] | None = None, *, log=print) -> Written:
     """
     labs = labs or _impl.lab_names()
     written = Written()
-    ref = _impl.reference_dir()
     for lab in labs:
+        paths = course().lab(lab)
         stored = load_stored(lab)
         parts = []
         if stored:  # before the cases, whose inputs may read them
-            folders = {False: ref / lab / "inputs", True: ref / lab / "hidden" / "inputs"}
+            folders = {False: paths.stored_inputs, True: paths.hidden_stored_inputs}
             note = "inputs of graded tests, from solutions/; do not edit by hand"
             parts.append(_build_outputs(lab, stored, stored_path, folders, note, log))
         cases = load_cases(lab)
         if cases:
-            folders = {False: ref / lab, True: ref / lab / "hidden"}
+            folders = {False: paths.references, True: paths.hidden_references}
             note = "generated from solutions/; do not edit by hand"
             parts.append(_build_outputs(lab, cases, reference_path, folders, note, log))
         for part in parts:
@@ -213,7 +214,7 @@ def graded_failures(lab: str, *, timeout: float = 3600) -> tuple[float, float, l
     env.setdefault("GEOMLIB_TIME_BUDGET", "0")
     with tempfile.TemporaryDirectory(prefix="geomlib-solutions-") as tmp:
         results = Path(tmp) / "results.json"
-        cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", "solutions", "--lab", lab]
+        cmd = [sys.executable, "-m", "geomlib.cli", "grade", "--impl", course().solutions_dir.name, "--lab", lab]
         cmd += ["--results", str(results), "--feedback", str(Path(tmp) / "feedback")]
         p = subprocess.run(cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout)
         if p.returncode != 0 or not results.is_file():
@@ -271,11 +272,12 @@ def check(labs: list[str] | None = None, *, grade: bool = True, log=print) -> li
         known = {(c.hidden, c.id) for c in cases}
         known_inputs = {(c.hidden, c.id) for c in inputs}
         for hidden in (False, True):
-            folder = _impl.reference_dir() / lab / ("hidden" if hidden else "")
+            paths = course().lab(lab)
+            folder = paths.hidden_references if hidden else paths.references
             for f in folder.glob("*.npz"):
                 if (hidden, f.stem) not in known:
                     problems.append(RefProblem(lab, f.stem, f"stale reference file {f.name} has no case"))
-            for f in (folder / "inputs").glob("*.npz"):
+            for f in (paths.hidden_stored_inputs if hidden else paths.stored_inputs).glob("*.npz"):
                 if (hidden, f.stem) not in known_inputs:
                     problems.append(RefProblem(lab, f.stem, f"stale stored input {f.name} has no STORED entry"))
         log(f"  {lab}: {len(inputs)} stored inputs and {len(cases)} cases checked")

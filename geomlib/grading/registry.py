@@ -29,7 +29,15 @@ __all__ = [
     "stored_input",
     "stored_path",
     "load_stored",
+    "graded_package_modules",
 ]
+
+
+def graded_package_modules() -> list[str]:
+    """Names in ``sys.modules`` of the imported graded-tests package (``graded``, the course's
+    ``tests/graded`` folder) and its modules: what must be forgotten before another course's is imported."""
+    package = course().graded_dir.name
+    return [m for m in sys.modules if m == package or m.startswith(package + ".")]
 
 
 def graded_module(lab: str, name: str):
@@ -48,11 +56,11 @@ def graded_module(lab: str, name: str):
         if tests in sys.path:
             sys.path.remove(tests)
         sys.path.insert(0, tests)
-    loaded = sys.modules.get("graded")
+    loaded = sys.modules.get(c.graded_dir.name)
     if loaded is not None and str(folder.parent) not in [str(Path(p)) for p in getattr(loaded, "__path__", [])]:
-        for mod in [m for m in sys.modules if m == "graded" or m.startswith("graded.")]:
+        for mod in graded_package_modules():
             del sys.modules[mod]
-    return importlib.import_module(f"graded.{lab}.{name}")
+    return importlib.import_module(f"{c.graded_dir.name}.{lab}.{name}")
 
 
 def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Case]:

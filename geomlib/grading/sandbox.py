@@ -129,19 +129,17 @@ def _geomlib_dir() -> Path:
 
 def _hidden_paths() -> list[Path]:
     """Course files student code must never read (hidden cases and references)."""
-    tests = _course_root() / "tests"
-    out = list((tests / "reference").glob("*/hidden"))
-    for p in (tests / "graded").glob("*/*_hidden*.py"):
-        out.append(p)
-    for p in (tests / "graded").glob("*/__pycache__/*_hidden*.pyc"):
-        out.append(p)
-    return out
+    from geomlib.grading.course import course
+
+    return course().hidden_paths()
 
 
 def _forbidden() -> list[Path]:
-    root = _course_root()
+    from geomlib.grading.course import course
+
+    c = course()
     extra = [Path(p) for p in setting("GEOMLIB_SANDBOX_HIDE", "").split(os.pathsep) if p]
-    return [root / "tests", root / "solutions", root / ".git", *extra]
+    return [c.tests_dir, c.solutions_dir, c.root / ".git", *extra]
 
 
 #: :func:`_readable_paths` by what it depends on (it resolves dozens of paths: once, not per call).
@@ -491,7 +489,9 @@ def _format_student_exception(function: str, info: dict) -> str:
 
 def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
     base = setting("GEOMLIB_STUBS")
-    stubs = Path(base) / lab if base else _course_root() / "labs" / lab
+    from geomlib.grading.course import course
+
+    stubs = Path(base) / lab if base else course().lab(lab).stubs
     if not stubs.is_dir() or stubs.resolve() == lab_dir.resolve():
         return None
     return stubs

@@ -20,6 +20,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from geomlib.grading.tolerances import PICTURE_TIME_S
+
 __all__ = ["VARIABLES", "GradingSettings", "env", "env_float", "markdown_table"]
 
 #: Every ``GEOMLIB_*`` environment variable: what it does (one line each; docs/autograder.md lists them).
@@ -30,6 +32,7 @@ VARIABLES: dict[str, str] = {
     "GEOMLIB_TIME_LIMIT": "seconds allowed per call into the implementation (`--time-limit`); default each test's own",
     "GEOMLIB_NO_FEEDBACK_PICTURES": "set (non-empty): draw no feedback pictures",
     "GEOMLIB_MAX_FEEDBACK_PICTURES": "at most this many feedback pictures per run (the autograder sets 8)",
+    "GEOMLIB_PICTURE_TIME_LIMIT": "seconds one feedback picture may take before it is given up (a limit for hangs; default 20; the test suite sets 300)",
     "GEOMLIB_SANDBOX_USER": "the user student code runs as (as root; empty: no sandbox user); the autograder sets `nobody`",
     "GEOMLIB_SANDBOX_UIDS": "`FIRST-LAST`: the private uids `grade-all` runs submissions as; `none`: all as the sandbox user",
     "GEOMLIB_SANDBOX_HIDE": "extra folders (os.pathsep-separated) student code may not read",
@@ -81,6 +84,9 @@ class GradingSettings:
         False when ``GEOMLIB_NO_FEEDBACK_PICTURES`` is set.
     max_pictures : int or None
         ``GEOMLIB_MAX_FEEDBACK_PICTURES``.
+    picture_time_limit : float
+        Seconds one feedback picture may take (``GEOMLIB_PICTURE_TIME_LIMIT``, default
+        :data:`~geomlib.grading.tolerances.PICTURE_TIME_S`): a limit for a drawing that hangs.
     """
 
     impl: str | None = None
@@ -89,6 +95,7 @@ class GradingSettings:
     time_limit: float | None = None
     pictures: bool = True
     max_pictures: int | None = None
+    picture_time_limit: float = PICTURE_TIME_S
 
     @classmethod
     def build(cls, **given) -> GradingSettings:
@@ -106,6 +113,7 @@ class GradingSettings:
             time_limit=env_float("GEOMLIB_TIME_LIMIT"),
             pictures=not env("GEOMLIB_NO_FEEDBACK_PICTURES"),
             max_pictures=_picture_cap(),
+            picture_time_limit=env_float("GEOMLIB_PICTURE_TIME_LIMIT") or PICTURE_TIME_S,
         )
         return cls(**{**values, **given})
 

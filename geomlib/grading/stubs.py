@@ -27,6 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from geomlib.grading import impl as _impl
+from geomlib.grading.course import course as _course
 
 __all__ = ["make_stub", "build", "check", "solution_lines", "solution_blocks", "StubError"]
 
@@ -144,17 +145,15 @@ def solution_blocks(text: str, name: str = "<solution>") -> list[tuple[str, list
 
 
 def _pairs(labs: list[str] | None):
-    root = _impl.course_root()
-    sol_root, lab_root = root / "solutions", root / "labs"
-    names = labs or sorted(p.name for p in sol_root.iterdir() if (p / "__init__.py").is_file())
-    for lab in names:
-        src = sol_root / lab
+    c = _course()
+    for lab in labs or c.solution_labs:
+        src, dst = c.lab(lab).solution, c.lab(lab).stubs
         if not src.is_dir():
             raise StubError(f"no solution folder {src}")
         for f in sorted(f for f in src.rglob("*") if f.suffix in STUB_SUFFIXES):
             if "__pycache__" in f.parts:
                 continue
-            yield lab, f, lab_root / lab / f.relative_to(src)
+            yield lab, f, dst / f.relative_to(src)
 
 
 class Written(list):
@@ -184,7 +183,7 @@ def build(labs: list[str] | None = None, *, log=print) -> Written:
             written.unchanged += 1
         expected.setdefault(lab, set()).add(dst)
     for lab, files in expected.items():
-        for f in (_impl.course_root() / "labs" / lab).rglob("*"):
+        for f in _course().lab(lab).stubs.rglob("*"):
             if f.suffix in STUB_SUFFIXES and f not in files and "__pycache__" not in f.parts:
                 f.unlink()
                 log(f"  removed {f.relative_to(_impl.course_root())} (no solution counterpart)")
@@ -215,7 +214,7 @@ def check(labs: list[str] | None = None, *, diff: bool = False) -> list[str]:
                 problem += "\n" + "".join(ln if ln.endswith("\n") else ln + "\n" for ln in lines).rstrip("\n")
             problems.append(problem)
     for lab, files in seen.items():
-        for f in (_impl.course_root() / "labs" / lab).rglob("*"):
+        for f in _course().lab(lab).stubs.rglob("*"):
             if f.suffix in STUB_SUFFIXES and f not in files and "__pycache__" not in f.parts:
                 problems.append(f"{f.relative_to(_impl.course_root())} has no solution counterpart")
     return problems

@@ -51,9 +51,12 @@ def find_lab(submission: str | os.PathLike, lab: str) -> Path:
         children = sorted(p for p in sub.iterdir() if _is_real_dir(p) and p.name not in _SKIP_DIRS)
     except OSError:
         children = []
-    tops += [c for c in children if c.name not in (lab, "labs")]
+    from geomlib.grading.course import course
+
+    labs = course().stubs_dir.name  # a student's checkout holds the lab in labs/<lab>/
+    tops += [c for c in children if c.name not in (lab, labs)]
     for top in tops:
-        for cand in (top / lab, top / "labs" / lab):
+        for cand in (top / lab, top / labs / lab):
             if _is_real_dir(cand.parent) and _is_real_dir(cand):
                 return cand
     try:

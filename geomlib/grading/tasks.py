@@ -24,11 +24,12 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from geomlib.grading import impl as _impl
+from geomlib.gl import SHADER_FOLDER
+from geomlib.grading.course import course
 from geomlib.grading.registry import graded_module
 from geomlib.taskref import find_task
 
-__all__ = ["TaskTable", "derive", "table", "test_tasks", "test_runs"]
+__all__ = ["TaskTable", "derive", "table", "lab_calls", "named_functions", "test_functions", "test_tasks", "test_runs"]
 
 #: A shader named in a lab function: ``"parallax"`` (``shaders/parallax.frag``) or ``"tbn.vert"``.
 _SHADER = re.compile(r"[A-Za-z_]\w*(\.(?:frag|vert))?")
@@ -107,7 +108,7 @@ def derive(lab_dir: str | Path) -> TaskTable:
             # shader's tasks: the student writes them in ``shaders/parallax.frag``.
             for n in ast.walk(node):
                 if isinstance(n, ast.Constant) and isinstance(n.value, str) and _SHADER.fullmatch(n.value):
-                    shader = Path(lab_dir) / "shaders" / (n.value if "." in n.value else f"{n.value}.frag")
+                    shader = Path(lab_dir) / SHADER_FOLDER / (n.value if "." in n.value else f"{n.value}.frag")
                     if shader.is_file():
                         shader_marks += [(n, t, node.name) for n, t in _marks(shader.read_text().splitlines())]
             calls = set()
@@ -184,27 +185,38 @@ def table(lab: str) -> TaskTable:
     mod = _declared(lab)
     if mod is not None and hasattr(mod, "TASKS"):
         return TaskTable(dict(mod.TASKS), dict(mod.TITLES), dict(getattr(mod, "COMPOSITES", {})))
-    for impl in ("solutions", "labs"):
-        d = _impl.course_root() / impl / lab
+    paths = course().lab(lab)
+    for d in (paths.solution, paths.stubs):
         if d.is_dir():
             return derive(d)
     return TaskTable()
 
 
-def _lab_calls(fn) -> list[str]:
+def lab_calls(fn) -> list[str]:
     """Lab functions a hand-written test uses: ``lab.name(...)``, ``lab.call("name", ...)`` and
     ``lab.name`` passed on (``applied(lab.split_edge, ...)``), directly or through a helper defined
-    in the same test module."""
+    in the same test module.
+
+    Parameters
+    ----------
+    fn : function
+        The test function (its source is read; none readable: ``[]``).
+
+    Returns
+    -------
+    list of str
+        The function names, in order of first use.
+    """
     tree = _tree(fn)
     if tree is None:
         return []
-    out = _lab_calls_direct(fn, tree)
+    out = _direct_lab_calls(fn, tree)
     module = sys.modules.get(getattr(fn, "__module__", ""), None)
     for n in ast.walk(tree):
         if isinstance(n, ast.Call) and isinstance(n.func, ast.Name):
             g = getattr(module, n.func.id, None)
             if inspect.isfunction(g) and g.__module__ == fn.__module__ and g is not fn:
-                for name in _lab_calls_direct(g):
+                for name in _direct_lab_calls(g):
                     if name not in out:
                         out.append(name)
     return out
@@ -232,7 +244,7 @@ def _tree(fn):
 _TREES: dict = {}
 
 
-def _lab_calls_direct(fn, tree=None) -> list[str]:
+def _direct_lab_calls(fn, tree=None) -> list[str]:
     tree = _tree(fn) if tree is None else tree
     if tree is None:
         return []
@@ -256,8 +268,9 @@ def _lab_calls_direct(fn, tree=None) -> list[str]:
     return out
 
 
-def _named_functions(fn, tab: TaskTable) -> list[str]:
-    """Lab functions a test names in a string (``check_glsl_case(lab, case, "glsl_parallax_uv")``)."""
+def named_functions(fn, tab: TaskTable) -> list[str]:
+    """Lab functions a test names in a string (``check_glsl_case(lab, case, "glsl_parallax_uv")``):
+    the string constants of ``fn``'s source that are functions of the task table ``tab``, in order."""
     tree = _tree(fn)
     if tree is None:
         return []
@@ -269,6 +282,17 @@ def _named_functions(fn, tab: TaskTable) -> list[str]:
     return out
 
 
+def test_functions(item, tab: TaskTable) -> list[str]:
+    """The lab functions a collected graded pytest item calls, as the grader reads them: a reference
+    case's ``Case.function``, else :func:`lab_calls` and then :func:`named_functions` of the test."""
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    if case is not None and hasattr(case, "function"):
+        return [case.function]
+    names = lab_calls(item.function)
+    return names + [n for n in named_functions(item.function, tab) if n not in names]
+
+
 def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     """The tasks of a collected graded pytest item (see the module docstring)."""
     n = tab.of_part(part)
@@ -278,13 +302,8 @@ def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     case = callspec.params.get("case") if callspec is not None else None
     if case is not None and getattr(case, "task", None):
         return (int(case.task),)
-    if case is not None and hasattr(case, "function"):
-        names = [case.function]
-    else:
-        names = _lab_calls(item.function)
-        names += [n for n in _named_functions(item.function, tab) if n not in names]
     out: list[int] = []
-    for name in names:
+    for name in test_functions(item, tab):
         for t in tab.of_function(name):
             if t not in out:
                 out.append(t)
@@ -295,14 +314,9 @@ def test_runs(item, tab: TaskTable) -> tuple[int, ...]:
     """Every task a collected graded test runs (its functions and their building blocks): what
     ``--task N`` falls back to for a task that has no test of its own (remeshing's collapse pass,
     graded through the loop)."""
-    callspec = getattr(item, "callspec", None)
-    case = callspec.params.get("case") if callspec is not None else None
-    if case is not None and hasattr(case, "function"):
-        names = [case.function]
-    else:
-        names = _lab_calls(item.function) + _named_functions(item.function, tab)
-    return tuple(sorted({t for name in names for t in tab.runs(name)}))
+    return tuple(sorted({t for name in test_functions(item, tab) for t in tab.runs(name)}))
 
 
 test_tasks.__test__ = False  # not a pytest test, despite the name
 test_runs.__test__ = False
+test_functions.__test__ = False

@@ -10,8 +10,6 @@ then move by the mean of their offsets ``s`` (read back from the shader) along t
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from geomlib import gl
@@ -29,19 +27,15 @@ SHADERS = ("denoise.vert",)
 TASKS = {"denoise.vert": "Task 7: vertex denoising"}
 
 
-def shader_path(name: str) -> Path:
-    """``shaders/<name>`` next to this file."""
-    return Path(__file__).resolve().parent / "shaders" / name
+#: ``shader_path("denoise.vert")``: ``shaders/denoise.vert`` of this lab.
+shader_path = gl.shader_finder(__file__)
 
 
 def _run_points(name: str, n: int, attributes: dict, textures: dict, uniforms: dict) -> list[np.ndarray]:
-    source = shader_path(name).read_text()
-    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
-    if todo:
-        raise NotImplementedError(f"shaders/{name}: {todo[0]}")
+    source = gl.lab_shader_source(shader_path(name))
     width = int(min(n, 1024))
     size = (width, int(-(-n // width)))
-    try:
+    with gl.naming_task(f"shaders/{name}", TASKS[name]):  # the message leads with the file and task
         out = gl.render_points(
             source,
             gl.MOVED_OFFSET_FRAGMENT_SHADER,
@@ -52,9 +46,6 @@ def _run_points(name: str, n: int, attributes: dict, textures: dict, uniforms: d
             outputs=2,
             name=f"shaders/{name}",
         )
-    except gl.ShaderError as e:  # name the task with the file: the message leads with both
-        msg = str(e).replace(f"shaders/{name}", f"shaders/{name} ({TASKS[name]})", 1)
-        raise gl.ShaderError(msg, log=e.log, lines=e.lines) from None
     return [o[::-1].reshape(-1, 4)[:n] for o in out]  # read-back row 0 is the top: GL row size[1] - 1
 
 

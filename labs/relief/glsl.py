@@ -13,8 +13,6 @@ as the NumPy code (rounded to float32).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from geomlib import gl
@@ -40,22 +38,14 @@ SHADERS = ("parallax", "relief", "shadow")
 TASKS = {"parallax": "Task 2: parallax", "relief": "Task 3: march and refine", "shadow": "Task 4: shadow"}
 
 
-def shader_path(name: str) -> Path:
-    """``shaders/<name>.frag`` next to this file."""
-    return Path(__file__).resolve().parent / "shaders" / f"{name}.frag"
+#: ``shader_path("parallax")``: ``shaders/parallax.frag`` of this lab.
+shader_path = gl.shader_finder(__file__)
 
 
 def _run(name: str, size: tuple[int, int], textures: dict, uniforms: dict) -> np.ndarray:
-    path = shader_path(name)
-    source = path.read_text()
-    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
-    if todo:
-        raise NotImplementedError(f"shaders/{name}.frag: {todo[0]}")
-    try:
+    source = gl.lab_shader_source(shader_path(name))
+    with gl.naming_task(f"shaders/{name}.frag", TASKS[name]):  # the message leads with the file and task
         return gl.render_quad(source, size, textures=textures, uniforms=uniforms, name=f"shaders/{name}.frag")
-    except gl.ShaderError as e:  # name the task with the file: the message leads with both
-        msg = str(e).replace(f"shaders/{name}.frag", f"shaders/{name}.frag ({TASKS[name]})", 1)
-        raise gl.ShaderError(msg, log=e.log, lines=e.lines) from None
 
 
 def glsl_parallax_uv(height, uv, view, *, scale: float, bias: float | None = None, offset_limit: bool = False):

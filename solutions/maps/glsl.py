@@ -15,8 +15,6 @@ reference outputs.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from geomlib import gl
@@ -52,25 +50,8 @@ void main() { out_T = vec4(T_world, 1.0); out_B = vec4(B_world, 1.0); out_N = ve
 """
 
 
-def shader_path(name: str) -> Path:
-    """``shaders/<name>`` next to this file (``name`` with or without its suffix)."""
-    if "." not in name:
-        name = next(s for s in SHADERS if s.split(".")[0] == name)
-    return Path(__file__).resolve().parent / "shaders" / name
-
-
-def _source(name: str) -> str:
-    source = shader_path(name).read_text()
-    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
-    if todo:
-        raise NotImplementedError(f"shaders/{name}: {todo[0]}")
-    return source
-
-
-def _renamed(e: gl.ShaderError, name: str) -> gl.ShaderError:
-    """The harness's error with the task after the file name: the message leads with both."""
-    msg = str(e).replace(f"shaders/{name}", f"shaders/{name} ({TASKS[name]})", 1)
-    return gl.ShaderError(msg, log=e.log, lines=e.lines)
+#: ``shader_path("tbn.vert")`` (or ``"tbn"``): ``shaders/tbn.vert`` of this lab.
+shader_path = gl.shader_finder(__file__)
 
 
 def _grid(n: int) -> tuple[int, int]:
@@ -80,9 +61,9 @@ def _grid(n: int) -> tuple[int, int]:
 
 def _run_points(name: str, fragment: str, n: int, attributes: dict, textures: dict, uniforms: dict, outputs: int):
     """Run the vertex shader ``shaders/<name>`` on ``n`` vertices; ``outputs`` arrays ``(n, 4)``."""
-    source = _source(name)
+    source = gl.lab_shader_source(shader_path(name))
     size = _grid(n)
-    try:
+    with gl.naming_task(f"shaders/{name}", TASKS[name]):  # the message leads with the file and task
         out = gl.render_points(
             source,
             fragment,
@@ -93,8 +74,6 @@ def _run_points(name: str, fragment: str, n: int, attributes: dict, textures: di
             outputs=outputs,
             name=f"shaders/{name}",
         )
-    except gl.ShaderError as e:
-        raise _renamed(e, name) from None
     # Read-back row 0 is the top of the image: GL row size[1] - 1.
     return [o[::-1].reshape(-1, 4)[:n] for o in out]
 
@@ -193,11 +172,9 @@ def glsl_shade(
         uniforms[f"light_kind[{i}]"] = int(kind == "point")
         uniforms[f"light_vec[{i}]"] = vec
         uniforms[f"light_rgb[{i}]"] = rgb
-    source = _source("normalmap.frag")
-    try:
+    source = gl.lab_shader_source(shader_path("normalmap.frag"))
+    with gl.naming_task("shaders/normalmap.frag", TASKS["normalmap.frag"]):
         img = gl.render_quad(source, (w, h), textures=textures, uniforms=uniforms, name="shaders/normalmap.frag")
-    except gl.ShaderError as e:
-        raise _renamed(e, "normalmap.frag") from None
     out = np.empty((h, w, 3))
     out[...] = bg
     out[mask] = np.clip(img[..., :3][mask].astype(np.float64), 0.0, 1.0)

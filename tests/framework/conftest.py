@@ -56,13 +56,3 @@ def _quiet_worker_crashes(request):
         yield
     finally:
         faulthandler.enable(file=fd if fd is not None else sys.__stderr__)
-
-
-@pytest.fixture
-def generous_pictures(monkeypatch):
-    """Feedback pictures get :data:`tests.framework.hang_limits.PICTURE_S`: a limit for hangs, not speed."""
-    from geomlib.grading import tolerances
-
-    from .hang_limits import PICTURE_S
-
-    monkeypatch.setattr(tolerances, "PICTURE_TIME_S", PICTURE_S)

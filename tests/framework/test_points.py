@@ -7,10 +7,11 @@ from pathlib import Path
 
 import pytest
 
+from geomlib.grading.course import course
 from geomlib.grading.points import points_by_part
 
 ROOT = Path(__file__).resolve().parents[2]
-LABS = sorted(p.name for p in (ROOT / "solutions").iterdir() if (p / "__init__.py").is_file())
+LABS = course(ROOT).labs
 
 
 @pytest.fixture(scope="module")
@@ -37,13 +38,34 @@ def test_handout_grading_table_matches_the_tests(table, lab):
     assert rows.get("**total**") == f"{pub:g} + {hid:g} = {pub + hid:g}", f"labs/{lab}/README.md: total row"
 
 
-def test_readme_lab_table_gives_the_points_the_grader_computes(table):
-    """README.md's lab table: every lab, with "total (public + hidden)" as the grader counts them."""
+def test_readme_lab_table_is_the_one_geomlib_readme_build_writes(table):
+    """README.md's lab table (issue 26, item 8): every lab of the course in course order, with "total
+    (public + hidden)" as the grader counts them, exactly as `geomlib readme build` writes it."""
+    from geomlib.grading import readme
+
+    problems = readme.check(diff=True)
+    assert not problems, problems[0] + "\nrun `geomlib readme build`"
     text = (ROOT / "README.md").read_text()
-    rows = dict(re.findall(r"^\| \[([a-z]+)\]\(labs/[a-z]+/README\.md\) \|.*\| ([^|]+) \|$", text, flags=re.M))
-    assert sorted(rows) == sorted(LABS), f"README.md's lab table lists {sorted(rows)}"
-    for lab in LABS:
+    rows = re.findall(r"^\| \[([a-z]+)\]\(labs/[a-z]+/README\.md\) \|.*\| ([^|]+) \|$", text, flags=re.M)
+    assert [lab for lab, _ in rows] == LABS
+    for lab, points in rows:
         pub = sum(p for p, _ in table[lab].values())
         hid = sum(h for _, h in table[lab].values())
-        expected = f"{pub + hid:g} ({pub:g} + {hid:g})"
-        assert rows[lab].strip() == expected, f"README.md: the points of {lab} should say {expected}"
+        assert points.strip() == f"{pub + hid:g} ({pub:g} + {hid:g})", f"README.md: the points of {lab}"
+
+
+def test_a_stale_readme_table_is_reported_with_its_diff(tmp_path, monkeypatch):
+    """A hand edit of the table (remeshing's points said 42 while the grader gave 51) is found and shown."""
+    from geomlib.grading import readme
+
+    text = (ROOT / "README.md").read_text()
+    stale = re.sub(r"(\[remeshing\].*\| )[^|]+( \|)$", r"\g<1>42 (15 + 27)\2", text, count=1, flags=re.M)
+    assert stale != text
+    (tmp_path / "README.md").write_text(stale)
+    monkeypatch.setattr(readme, "_readme", lambda: tmp_path / "README.md")
+    [problem] = readme.check(diff=True)
+    assert "-| [remeshing]" in problem and "42 (15 + 27)" in problem
+    readme.build(log=lambda *_: None)
+    assert (tmp_path / "README.md").read_text() == text
+    (tmp_path / "README.md").write_text(text.replace(readme.BEGIN, ""))
+    assert "needs the lines" in readme.check()[0]

@@ -9,7 +9,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import zipfile
 from pathlib import Path
@@ -18,7 +17,7 @@ import pytest
 
 from geomlib.grading.results import validate_results
 
-from .course import run_geomlib, user_cli
+from .course import run_autograder, run_geomlib, user_cli
 
 
 @pytest.fixture(scope="module")
@@ -62,33 +61,7 @@ def test_student_bundle_grades_its_stubs_to_zero_without_errors(release):
 
 
 def _autograder(release: Path, submission_labs: Path | None) -> dict:
-    root = Path(tempfile.mkdtemp(prefix="geomlib-autograder-"))
-    root.chmod(0o755)
-    with zipfile.ZipFile(release / "autograder-sample.zip") as z:
-        z.extractall(root / "source")
-        names = z.namelist()
-    assert "setup.sh" in names and "run_autograder" in names
-    assert any("hidden" in n for n in names)  # the autograder does get the hidden tests
-    assert not any(n.startswith("solutions/") for n in names)
-    (root / "submission").mkdir()
-    if submission_labs is not None:
-        shutil.copytree(submission_labs, root / "submission" / "labs" / submission_labs.name)
-    hidden = root / "source" / "tests" / "reference" / "sample" / "hidden"
-    hidden.chmod(0o700)  # as setup.sh does
-    run = root / "source" / "run_autograder"
-    run.chmod(0o755)
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    # The sandbox user's drop is exercised on the real course (test_release_course.py): this
-    # interpreter may live where `nobody` cannot read it.
-    env.update(
-        GEOMLIB_AUTOGRADER_ROOT=str(root),
-        GEOMLIB_PYTHON=sys.executable,
-        PYTHONPATH=str(root / "source"),
-        GEOMLIB_SANDBOX_USER="",
-    )
-    p = subprocess.run(["bash", str(run)], env=env, capture_output=True, text=True, timeout=300)
-    assert p.returncode == 0, p.stdout + p.stderr
-    return json.loads((root / "results" / "results.json").read_text())
+    return run_autograder(release, "sample", submission_labs)
 
 
 def test_run_autograder_grades_a_correct_submission_with_hidden_tests(release, sample_course):

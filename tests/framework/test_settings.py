@@ -88,3 +88,28 @@ def test_every_variable_is_declared_and_documented_once():
     assert sorted(rows) == sorted(VARIABLES), (
         "docs/autograder.md: one table row per variable (settings.markdown_table())"
     )
+
+
+def test_the_picture_time_limit_is_one_run_setting(monkeypatch, tmp_path):
+    """``GEOMLIB_PICTURE_TIME_LIMIT`` (default ``tolerances.PICTURE_TIME_S``) is the limit a feedback
+    picture is drawn under; the suite raises it for its loaded machine the same way (root conftest.py)
+    instead of patching the module constant in every process."""
+    import time
+
+    from geomlib.grading import picture_run, tolerances
+
+    monkeypatch.delenv("GEOMLIB_PICTURE_TIME_LIMIT", raising=False)
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES", raising=False)
+    assert GradingSettings.build().picture_time_limit == tolerances.PICTURE_TIME_S
+    monkeypatch.setenv("GEOMLIB_PICTURE_TIME_LIMIT", "0.5")
+    assert GradingSettings.build().picture_time_limit == 0.5
+    path = tmp_path / "slow.png"
+
+    def slow_draw():
+        time.sleep(3)
+        path.write_bytes(b"drawn")
+
+    t = time.monotonic()
+    assert picture_run._drawn_in_time(str(path), slow_draw) is None  # given up after the run's limit
+    assert time.monotonic() - t < 2.5 and not path.exists()

@@ -34,7 +34,7 @@ class Points:
             m = it.get_closest_marker("graded")
             if m is not None:
                 points[it.nodeid] = m.kwargs.get("points", 1)
-                tab = tasks.table(plugin._lab_of(it.path))
+                tab = tasks.table(plugin.lab_of(it.path))
                 runs[it.nodeid] = list(tasks.test_runs(it, tab)) if hasattr(tasks, "test_runs") else []
 args = [str(I.tests_dir() / "graded" / lab) for lab in sys.argv[1:]]
 args += ["--impl=labs", "--collect-only", "-q", "-p", "no:cacheprovider", f"--rootdir={I.course_root()}"]
