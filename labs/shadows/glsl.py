@@ -16,8 +16,6 @@ through :mod:`geomlib.gl`); the graders compare them with the NumPy reference ou
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from geomlib import gl
@@ -50,17 +48,12 @@ MAX_DISK_SAMPLES = 64
 _CULL_CODE = {"none": 0, "front": 1, "back": 2}
 
 
-def shader_path(name: str) -> Path:
-    """``shaders/<name>`` next to this file."""
-    return Path(__file__).resolve().parent / "shaders" / name
+#: ``shader_path("depth.vert")`` (or ``"shadow"``): ``shaders/<name>`` of this lab.
+shader_path = gl.shader_finder(__file__)
 
 
 def _source(name: str) -> str:
-    source = shader_path(name).read_text()
-    todo = [line.strip()[len("#error") :].strip() for line in source.splitlines() if line.strip().startswith("#error")]
-    if todo:
-        raise NotImplementedError(f"shaders/{name}: {todo[0]}")
-    return source
+    return gl.lab_shader_source(shader_path(name))
 
 
 def _renamed(e: gl.ShaderError, fragment: str, vertex: str | None = None) -> gl.ShaderError:

@@ -32,7 +32,8 @@ def test_every_glsl_lab_finds_its_shaders_with_the_one_helper(lab, package):
     assert files
     for f in files:
         assert glsl.shader_path(f.name) == f
-        assert glsl.shader_path(f.stem) == f
+        if [g.stem for g in files].count(f.stem) == 1:  # shadows has depth.vert and depth.frag
+            assert glsl.shader_path(f.stem) == f
 
 
 def test_shader_finder_takes_the_folder_or_a_file_in_it_and_names_what_is_there(tmp_path):
