@@ -124,7 +124,7 @@ def _cmd_generated(a) -> int:
         files = tool.build(labs)
         print(report["built"].format(n=len(files), same=getattr(files, "unchanged", 0), seconds=time.time() - t))
         return 0
-    options = {"grade": not a.no_grade} if a.command == "refs" else {"diff": True}
+    options = {"grade": not a.no_grade, "outputs": not a.no_rerun} if a.command == "refs" else {"diff": True}
     problems = tool.check(labs, **options)
     for p in problems:
         print(report["problem"].format(p=p))
@@ -265,6 +265,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-grade",
         action="store_true",
         help="check: compare with the references only, without grading the solutions on every graded test",
+    )
+    rf.add_argument(
+        "--no-rerun",
+        action="store_true",
+        help="check: do not re-run the cases (their inputs, parameters, stored inputs and files are still "
+        "checked); for a run whose graded tests compare the solutions with every reference (the test suite)",
     )
     rf.set_defaults(func=_cmd_generated)
 

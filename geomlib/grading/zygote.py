@@ -60,6 +60,9 @@ PRELOAD = (
     "geomlib.camera",
     "geomlib.raster",
     "geomlib.datasets",
+    # The compiled kernels of sdf, simplification and remeshing: importing numba costs about a
+    # second of CPU, which every worker of those labs paid per call (their stubs too).
+    "numba",
 )
 
 #: Processes (threads) a worker may add to what its user already runs.

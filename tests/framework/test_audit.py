@@ -41,7 +41,7 @@ def test_every_mutant_changes_one_block_only_and_compiles(lab):
         if m.file not in stub_of:
             stub_of[m.file] = stubs.make_stub(original, m.file)
         glsl = not m.file.endswith(".py")
-        if not glsl:
+        if not glsl and m.kind != "operator":  # generate() compiles every operator mutant, and drops those that do not
             compile(m.source, m.file, "exec", dont_inherit=True)
         src = m.source
         if m.kind == "nothing" and not glsl:
@@ -53,6 +53,22 @@ def test_every_mutant_changes_one_block_only_and_compiles(lab):
         assert m.source != original and m.diff.startswith("- "), m.id
     kinds = {m.kind for m in mutants}
     assert "operator" in kinds and "nothing" in kinds, f"{lab}: mutant kinds {kinds}"
+
+
+def test_operator_mutants_that_do_not_compile_are_dropped(tmp_path, monkeypatch):
+    """The guard that lets the test above compile only the does-nothing mutants: generate() compiles
+    each operator mutant and keeps only those that compile."""
+    src = "def f(a, b):\n    # BEGIN SOLUTION: Task 1 (all): everything\n    return a + b\n    # END SOLUTION\n"
+    (tmp_path / "f.py").write_text(src)
+    plus = src.index("+")
+
+    def edits(text, tree, b):  # one edit that compiles, one that does not
+        yield plus, plus + 1, "-", "+ → -", 3, 13
+        yield plus, plus + 1, "+ +)", "+ → broken", 3, 13
+
+    monkeypatch.setattr(audit, "_operator_edits", edits)
+    mutants, _ = audit.generate("f", tmp_path)
+    assert [m.op for m in mutants if m.kind == "operator"] == ["+ → -"]
 
 
 def test_operator_mutants_cover_every_listed_operator():

@@ -211,6 +211,13 @@ def test_refs_check_detects_a_changed_solution(sample_course, tmp_path):
     )
     p = run_geomlib(copy, "refs", "check", "--no-grade", check=False)
     assert p.returncode == 1 and "tet-mid" in p.stdout and "no longer reproduces" in p.stdout
+    # --no-rerun leaves the outputs to the graded tests (the suite's run), but still checks each
+    # case's inputs and parameters against the manifest.
+    assert run_geomlib(copy, "refs", "check", "--no-grade", "--no-rerun").returncode == 0
+    cases = copy / "tests" / "graded" / "sample" / "cases.py"
+    cases.write_text(cases.read_text().replace('params={"s": 3.0}', 'params={"s": 2.0}'))
+    p = run_geomlib(copy, "refs", "check", "--no-grade", "--no-rerun", check=False)
+    assert p.returncode == 1 and "tet-scale" in p.stdout and "inputs or parameters changed" in p.stdout
 
 
 def test_a_broken_sandbox_is_reported_as_the_graders_problem(sample_course, tmp_path):

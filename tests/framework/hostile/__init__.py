@@ -102,13 +102,24 @@ def loop_weight(n, weights="warren"):
     raise ValueError("bad \\\\udc80 value".encode().decode("unicode_escape"))
 """
 
-#: loop_weight writes half a message header into every pipe it holds, then sleeps.
+#: loop_weight writes half a message header into every pipe it holds, then sleeps: in the run's
+#: first call only (it leaves a mark in the folder the run's workers share), so that one call, not
+#: each of the twenty that reach loop_weight, waits out the time limit; later calls answer. Where no
+#: mark can be left, every call hangs (slower, the same outcome).
 PARTIAL_HEADER = """
+_loop_weight_real = loop_weight
+
+
 def loop_weight(n, weights="warren"):
     import os
     import stat
     import time
 
+    try:
+        os.close(os.open(os.path.join(os.environ["NUMBA_CACHE_DIR"], "hostile-hung-once"), os.O_CREAT | os.O_EXCL))
+    except (KeyError, OSError) as e:
+        if isinstance(e, FileExistsError):
+            return _loop_weight_real(n, weights)
     for fd in range(3, 256):
         try:
             if stat.S_ISFIFO(os.fstat(fd).st_mode):
@@ -124,11 +135,20 @@ def loop_weight(n, weights="warren"):
     raise type("E" * 5_000_000, (Exception,), {})("x" * 5_000_000)
 """
 
-#: loop_odd_matrix returns an empty sparse matrix of shape (3e8, n).
+#: loop_odd_matrix returns an empty sparse matrix of shape (3e8, n) to the grader; called by the
+#: lab's own loop_subdivide it answers correctly (building on the forged matrix there only costs
+#: the worker seconds of work, which is not what this attack is about).
 SPARSE_BOMB = """
+_loop_odd_matrix_real = loop_odd_matrix
+
+
 def loop_odd_matrix(V, F, *, topo=None):
+    import sys
+
     import scipy.sparse as sp
 
+    if sys._getframe(1).f_globals.get("__name__") == __name__:
+        return _loop_odd_matrix_real(V, F, topo=topo)
     return sp.csr_matrix((300_000_000, len(V)))
 """
 
