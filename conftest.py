@@ -15,11 +15,11 @@ import pytest
 #: Seconds a module takes: the sum of its tests' durations in CI's run of 2026-11-26 (2 workers).
 #: Modules not listed are short and follow, in collection order.
 SECONDS: dict[str, float] = {
-    "tests/solutions/test_deterministic.py": 240,
+    "tests/solutions/test_deterministic.py": 215,
     "tests/framework/test_release_course.py": 140,
-    "tests/test_figures_reproduce.py": 115,
+    "tests/test_figures_reproduce.py": 125,
     "tests/framework/test_feedback_pictures.py": 105,
-    "tests/solutions/test_simplification.py": 90,
+    "tests/solutions/test_simplification.py": 70,
     "tests/framework/test_hostile.py": 80,
     "tests/test_course.py": 75,
     "tests/test_notebooks.py": 60,
