@@ -32,11 +32,11 @@ def pytest_configure(config: pytest.Config) -> None:
 #: --no-rerun and numba preloaded in the zygote, operator mutants compiled once; estimates from CPU
 #: time measured on a loaded machine). Modules not listed are short and follow, in collection order.
 SECONDS: dict[str, float] = {
-    "tests/solutions/test_deterministic.py": 240,
+    "tests/solutions/test_deterministic.py": 215,
     "tests/framework/test_release_course.py": 115,
-    "tests/test_figures_reproduce.py": 115,
+    "tests/test_figures_reproduce.py": 125,
     "tests/framework/test_feedback_pictures.py": 105,
-    "tests/solutions/test_simplification.py": 90,
+    "tests/solutions/test_simplification.py": 70,
     "tests/framework/test_hostile.py": 50,
     "tests/test_course.py": 55,
     "tests/test_notebooks.py": 60,

@@ -12,19 +12,26 @@ Every figure also keeps a white margin: nothing (a label, a legend) runs past th
 
 When it fails after an intended change, regenerate and commit the lab's figures:
 ``uv run geomlib figures --lab <lab> --out docs/figures``.
+
+The same build is checked for its captions (the rule and its waivers: ``tests/test_figure_captions.py``):
+each lab's figures are drawn once per run, not once per check.
 """
 
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
+from tests.test_figure_captions import NOT_YET, caption_problems
+
 ROOT = Path(__file__).resolve().parents[1]
 LABS = sorted(p.name for p in (ROOT / "docs" / "figures").iterdir() if p.is_dir() and p.name != "gallery")
+DRAWN = sorted(p.parent.name for p in (ROOT / "solutions").glob("*/figures.py"))
 LEVELS = 32
 MAX_FRACTION = 0.002
 
@@ -34,12 +41,25 @@ def differing_pixels(a: np.ndarray, b: np.ndarray) -> int:
     return int((np.abs(a.astype(np.int16) - b.astype(np.int16)).max(axis=2) > LEVELS).sum())
 
 
+@pytest.fixture(scope="module")
+def drawn(tmp_path_factory) -> Callable[[str], list]:
+    """``drawn(lab)``: the lab's ``make_figures`` records at full size, drawn on the first call only."""
+    made: dict[str, list] = {}
+
+    def draw(lab: str) -> list:
+        if lab not in made:
+            figures = importlib.import_module(f"solutions.{lab}.figures")
+            made[lab] = figures.make_figures(tmp_path_factory.mktemp(f"figures-{lab}"))
+        return made[lab]
+
+    return draw
+
+
 @pytest.mark.slow
 @pytest.mark.render
 @pytest.mark.parametrize("lab", LABS)
-def test_regenerated_figures_equal_the_committed_ones(lab, tmp_path):
-    figures = importlib.import_module(f"solutions.{lab}.figures")
-    made = {f.path.name: f.path for f in figures.make_figures(tmp_path) if f.path.suffix == ".png"}
+def test_regenerated_figures_equal_the_committed_ones(lab, drawn):
+    made = {f.path.name: f.path for f in drawn(lab) if f.path.suffix == ".png"}
     committed = {p.name: p for p in (ROOT / "docs" / "figures" / lab).glob("*.png")}
     assert set(made) == set(committed), (
         f"{lab}: make_figures writes {sorted(made)}, docs/figures/{lab}/ holds {sorted(committed)}"
@@ -61,4 +81,25 @@ def test_regenerated_figures_equal_the_committed_ones(lab, tmp_path):
     assert not stale, (
         f"docs/figures/{lab}/ is stale (regenerate: uv run geomlib figures --lab {lab} --out docs/figures):\n"
         + "\n".join(stale)
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.render
+@pytest.mark.parametrize("lab", DRAWN)
+def test_every_caption_states_measured_numbers(lab, drawn, tmp_path):
+    figures = importlib.import_module(f"solutions.{lab}.figures")
+    made = [*drawn(lab), figures.make_view(tmp_path, quick=True)]
+    waived = NOT_YET.get(lab, set())
+    wrong, converted = [], []
+    for fig in made:
+        problems = caption_problems(fig)
+        if fig.path.name in waived:
+            if not problems:
+                converted.append(fig.path.name)
+            continue
+        wrong += [f"{fig.path.name}: {p}" for p in problems]
+    assert not wrong, f"{lab}: captions with numbers not measured by their builder:\n" + "\n".join(wrong)
+    assert not converted, (
+        f"{lab}: remove {converted} from NOT_YET in tests/test_figure_captions.py: their captions are measured now"
     )

@@ -89,7 +89,9 @@ def test_kernels_run_without_numba():
         "V, F = datasets.icosphere(1); W, G = r(V, F, 0.5, iterations=2); print(len(W), len(G), float(np.abs(W).sum()))"
     )
     env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
-    out = subprocess.run([sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=1200
+    )  # hangs only
     assert out.returncode == 0, out.stderr
     V, F = datasets.icosphere(1)
     W, G = R.isotropic_remesh(V, F, 0.5, iterations=2)
