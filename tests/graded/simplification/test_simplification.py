@@ -242,6 +242,15 @@ def test_link_condition_on_a_boundary(lab):
     )
     # check_contractions also runs the flip test: moving 1 onto 0 keeps the flat faces (0, 4, 3), (1, 2, 5) and
     # (1, 5, 4) facing up; moving both onto vertex 2 squashes face (1, 2, 5) to a segment (degenerate: flipped).
+    # Non-edge pairs: (0, 2) share vertex 1, joined to both by boundary edges (zipping them is fine); (4, 2) share 1
+    # and 5, joined to 4 by interior edges (an edge would end up in three faces).
+    link, _ = lab.check_contractions(GRID_V, GRID_F, [[0, 2], [4, 2]], GRID_V[[0, 4]])
+    expect_true(
+        "link condition on the 3 x 3 grid, non-edge pairs (0, 2) and (4, 2)",
+        np.asarray(link).tolist() == [True, False],
+        f"got {np.asarray(link).tolist()}, expected [True, False]: a non-edge pair passes only when every common "
+        "neighbour is joined to both ends by boundary edges (one face each)",
+    )
     _, flips = lab.check_contractions(GRID_V, GRID_F, [[0, 1], [0, 1]], GRID_V[[0, 2]])
     expect_true(
         "flip test on the 3 x 3 grid, edge (0, 1) onto vertex 0 / onto vertex 2",
@@ -269,6 +278,17 @@ def test_flip_test_on_a_fan(lab):
         np.asarray(link).tolist() == [True, True, True, False],
         f"got {np.asarray(link).tolist()}, expected [True, True, True, False]: edge (0, 1) has exactly its 2 opposite "
         "vertices in common; the non-edge pair (1, 3) shares vertex 0 through interior edges",
+    )
+    # Flip and degeneracy tests are relative (|n'| against the face's squared edge lengths): the same fan shrunk
+    # by 1e-6 gives the same answers.
+    _, flips = lab.check_contractions(
+        FAN_V * 1e-6, FAN_F, [[0, 1]] * 3, np.array([[0.5, 0, 0], [-2.0, 2.0, 0], [-0.5, 0.5, 0]]) * 1e-6
+    )
+    expect_true(
+        "flip test on the fan shrunk by 1e-6",
+        np.asarray(flips).tolist() == [False, True, True],
+        f"got {np.asarray(flips).tolist()}, expected [False, True, True] as on the full-size fan: compare |n'| with "
+        "1e-10 x the sum of the face's squared edge lengths, not with an absolute number",
     )
 
 
