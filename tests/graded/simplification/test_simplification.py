@@ -279,6 +279,17 @@ def test_flip_test_on_a_fan(lab):
         f"got {np.asarray(link).tolist()}, expected [True, True, True, False]: edge (0, 1) has exactly its 2 opposite "
         "vertices in common; the non-edge pair (1, 3) shares vertex 0 through interior edges",
     )
+    # The degeneracy threshold, 1e-10 x the sum of the face's three squared edge lengths: two faces (0, 1, 2) and
+    # (2, 1, 3); contracting (2, 3) to (0.5, h, 0) leaves (0, 1, p) with base 1 and height h, |n'| = h, squared edges
+    # 1 + 0.25 + 0.25 = 1.5 (+ h^2): degenerate (flipped) for h = 1.1e-10 <= 1.5e-10, not for h = 3e-10.
+    V2 = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 2, 0]])
+    _, flips = lab.check_contractions(V2, [[0, 1, 2], [2, 1, 3]], [[2, 3]] * 2, [[0.5, 1.1e-10, 0], [0.5, 3e-10, 0]])
+    expect_true(
+        "flip test: a face squashed to height 1.1e-10 / 3e-10 over a base of length 1",
+        np.asarray(flips).tolist() == [True, False],
+        f"got {np.asarray(flips).tolist()}, expected [True, False]: degenerate means |n'| <= 1e-10 x (sum of the "
+        "face's three squared edge lengths)",
+    )
     # Flip and degeneracy tests are relative (|n'| against the face's squared edge lengths): the same fan shrunk
     # by 1e-6 gives the same answers.
     _, flips = lab.check_contractions(
