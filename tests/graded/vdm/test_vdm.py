@@ -147,7 +147,7 @@ def test_parameterization_rejects_non_disks(lab):
 
 @graded(points=1, part="sampling")
 def test_sampling_a_tilted_plane(lab):
-    """on a plane z = 0.3 x - 0.2 y with uv = xy, every sample is (u, v, 0.3 u - 0.2 v)"""
+    """on a plane z = 0.3 x - 0.2 y with uv = xy, every sample is (u, v, 0.3 u - 0.2 v), also among uneven triangles"""
     V, F = datasets.grid_patch(5)
     V = V.copy()
     V[:, 2] = 0.3 * V[:, 0] - 0.2 * V[:, 1]  # linear, so barycentric interpolation is exact
@@ -169,6 +169,24 @@ def test_sampling_a_tilted_plane(lab):
         atol=1e-12,
         hint="a vertex's uv must give the vertex",
         mesh=(V, F),
+    )
+    # Point location must find the containing triangle however the triangles are spread: a large triangle
+    # (0.5, 0), (1, 0), (1, 0.5), ten small ones just across its long side and one at the origin. The query
+    # (0.8, 0.28) is inside the large one (0.28 < 0.8 - 0.5), though the small ones' centres are nearer to it.
+    UV = [[0.5, 0], [1, 0], [1, 0.5], [0, 0], [0.01, 0], [0, 0.01]]
+    for k in range(10):
+        c = [0.74 + 0.02 * (k % 5), 0.33 + 0.03 * (k // 5)]
+        UV += [c, [c[0] + 0.01, c[1]], [c[0], c[1] + 0.01]]
+    UV = np.array(UV)
+    Fs = np.arange(len(UV)).reshape(-1, 3)
+    Vs = np.c_[UV, 0.3 * UV[:, 0] - 0.2 * UV[:, 1]]
+    expect_close(
+        "sample_surface at uv (0.8, 0.28), inside the large triangle (0.5, 0), (1, 0), (1, 0.5)",
+        lab.sample_surface(Vs, Fs, UV, [[0.8, 0.28]]),
+        [[0.8, 0.28, 0.3 * 0.8 - 0.2 * 0.28]],
+        atol=1e-12,
+        hint="a point inside a uv triangle must be found in that triangle, also when other triangles' centres are "
+        "nearer (check that every triangle is listed in every grid cell its bounding box touches)",
     )
 
 
