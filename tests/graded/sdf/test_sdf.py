@@ -73,9 +73,16 @@ def test_trace_straight_at_a_sphere(lab):
 
 @graded(points=1, part="soft shadows")
 def test_unoccluded_point_is_lit(lab):
-    """soft_shadow: a point with nothing between it and the light sees it fully (V = 1)"""
+    """soft_shadow: a point with nothing between it and the light sees it fully (V = 1); one whose line to the light
+    runs through a ball sees none of it (V = 0)"""
     v = lab.soft_shadow(scene("balls"), np.array([[-2.5, 1.5, 0.001]]), np.array([-2.5, 1.5, 3.0]), 0.3)
     expect_close("soft_shadow", v, [1.0], atol=1e-9, name="V")
+    # With the light at (0, 0, 3): (0.3, 0, 0.001) is in full shadow (at height 0.5 its line to the light is at
+    # x = 0.25, inside the ball of radius 0.5 centred at (0, 0, 0.5), so the march meets d < eps); (-2.5, 1.5, 0.001)
+    # is lit (its line passes 1.74 from that ball's centre, about 7 penumbra widths t tan(a) away).
+    P = np.array([[0.3, 0.0, 0.001], [-2.5, 1.5, 0.001]])
+    v = lab.soft_shadow(scene("balls"), P, np.array([0.0, 0.0, 3.0]), 0.3)
+    expect_close("soft_shadow of a point behind a ball and a lit one", v, [0.0, 1.0], atol=1e-9, name="V")
 
 
 # ------------------------------------------------------------------------------ bad input
