@@ -402,6 +402,13 @@ def test_transport_rejects_bad_fields(lab):
         "transport_grid of a field 3x denser on the right half: every interior grid point must move right "
         f"(u increases); moved by {np.round(moved, 3).tolist() if G.shape == (5, 5, 2) else G.shape}",
     )
+    # The field does not change under v -> 1 - v, so neither does the grid: rows i and 4 - i mirror each other.
+    mirror = np.abs(G[::-1, :, 1] - (1 - G[:, :, 1])).max()
+    expect(
+        mirror < 0.01,
+        f"transport_grid of a field that only varies with u: rows i and 4 - i must mirror in v (v -> 1 - v), "
+        f"off by {mirror:.3g}; the middle row has v = {np.round(G[2, :, 1], 3).tolist()}, expected 0.5",
+    )
     expect_rejected(lab, "transport_grid", np.zeros((8, 8)), 4, match="positive", label="a zero field")
     expect_rejected(lab, "transport_grid", np.ones((8, 6)), 4, match="square", label="a non-square field")
 
