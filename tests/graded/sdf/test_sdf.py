@@ -52,12 +52,20 @@ def test_bvh_is_valid_torus(lab):
 
 @graded(points=1, part="sign", timeout=KERNEL_TIMEOUT)
 def test_vote_on_an_open_mesh(lab):
-    """sign_vote still answers on a mesh with a hole: far-inside points stay inside"""
+    """sign_vote still answers on a mesh with a hole: far-inside points stay inside; the closed wedge's thin arm is inside"""
     V, F = wedge()
     F = F[1:]  # drop one side triangle: a hole
     P = np.array([[0.15, 0.15, 0.4], [1.8, 0.15, 0.4], [0.15, 1.3, 0.4], [3.0, 3.0, 3.0], [-1.0, 0.5, 0.4]])
     s = lab.sign_vote(V, F, P)
     expect_close("sign_vote on a wedge with a hole", s, [-1, -1, -1, 1, 1], atol=0, name="s")
+    # The closed wedge is the L-shaped prism 0 < z < 0.8 over [0, 2] x [0, 0.3] and [0, 0.3] x [0, 1.5]: points in
+    # its long thin arm are inside, points beside the arm (x > 0.3) or above it (z > 0.8) are outside.
+    V, F = wedge()
+    P = np.array(
+        [[0.1, 1.2, 0.15], [0.1, 1.1, 0.3], [0.08, 1.3, 0.4], [0.1, 1.0, 0.12], [0.5, 1.0, 0.3], [0.1, 1.2, 0.9]]
+    )
+    s = lab.sign_vote(V, F, P)
+    expect_close("sign_vote in and beside the arm of the closed wedge", s, [-1, -1, -1, -1, 1, 1], atol=0, name="s")
 
 
 @graded(points=1, part="sphere tracing")
