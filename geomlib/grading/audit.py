@@ -384,7 +384,14 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
     inputs = f"{_HELPER}_in"
     indent = re.match(r"\s*", lines[b.start - 1]).group(0)
     at_start = _offset(lines, b.start + 1, 0)
-    capture = (at_start, at_start, f"{indent}{inputs} = (" + "".join(f"{p}, " for p in params) + ")\n")
+    # Copies (of what has a .copy()): the block may change an input in place (push_out's P), and the "input"
+    # mutant must return the input as it was, not the block's work.
+    copies = "".join(f"{p}, " for p in params)
+    capture = (
+        at_start,
+        at_start,
+        f"{indent}{inputs} = tuple(getattr(a, 'copy', lambda a=a: a)() for a in ({copies}))\n",
+    )
     edits = []
     # Returns inside the block give trivial values.
     for s in stmts:
@@ -856,9 +863,13 @@ def audit(
 
         def probe_done(i, r, res):
             shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
-            if res.get("ok"):  # a test stopped by its time limit (a loaded machine) says nothing about the block
+            if res.get("ok"):
+                # A test the probe failed only by a time limit (a loaded machine) does not show that it runs the block.
                 covered[probes[i]["key"][:3]] = {
-                    t["name"] for t in res["tests"] if not t["passed"] and not _TIMED_OUT.search(t["output"])
+                    t["name"]
+                    for t in res["tests"]
+                    if not t["passed"]
+                    and ("geomlib audit: probe" in t.get("output", "") or not _TIMED_OUT.search(t.get("output", "")))
                 }
 
         if progress and probes:

@@ -52,12 +52,20 @@ def test_bvh_is_valid_torus(lab):
 
 @graded(points=1, part="sign", timeout=KERNEL_TIMEOUT)
 def test_vote_on_an_open_mesh(lab):
-    """sign_vote still answers on a mesh with a hole: far-inside points stay inside"""
+    """sign_vote still answers on a mesh with a hole: far-inside points stay inside; the closed wedge's thin arm is inside"""
     V, F = wedge()
     F = F[1:]  # drop one side triangle: a hole
     P = np.array([[0.15, 0.15, 0.4], [1.8, 0.15, 0.4], [0.15, 1.3, 0.4], [3.0, 3.0, 3.0], [-1.0, 0.5, 0.4]])
     s = lab.sign_vote(V, F, P)
     expect_close("sign_vote on a wedge with a hole", s, [-1, -1, -1, 1, 1], atol=0, name="s")
+    # The closed wedge is the L-shaped prism 0 < z < 0.8 over [0, 2] x [0, 0.3] and [0, 0.3] x [0, 1.5]: points in
+    # its long thin arm are inside, points beside the arm (x > 0.3) or above it (z > 0.8) are outside.
+    V, F = wedge()
+    P = np.array(
+        [[0.1, 1.2, 0.15], [0.1, 1.1, 0.3], [0.08, 1.3, 0.4], [0.1, 1.0, 0.12], [0.5, 1.0, 0.3], [0.1, 1.2, 0.9]]
+    )
+    s = lab.sign_vote(V, F, P)
+    expect_close("sign_vote in and beside the arm of the closed wedge", s, [-1, -1, -1, -1, 1, 1], atol=0, name="s")
 
 
 @graded(points=1, part="sphere tracing")
@@ -73,9 +81,16 @@ def test_trace_straight_at_a_sphere(lab):
 
 @graded(points=1, part="soft shadows")
 def test_unoccluded_point_is_lit(lab):
-    """soft_shadow: a point with nothing between it and the light sees it fully (V = 1)"""
+    """soft_shadow: a point with nothing between it and the light sees it fully (V = 1); one whose line to the light
+    runs through a ball sees none of it (V = 0)"""
     v = lab.soft_shadow(scene("balls"), np.array([[-2.5, 1.5, 0.001]]), np.array([-2.5, 1.5, 3.0]), 0.3)
     expect_close("soft_shadow", v, [1.0], atol=1e-9, name="V")
+    # With the light at (0, 0, 3): (0.3, 0, 0.001) is in full shadow (at height 0.5 its line to the light is at
+    # x = 0.25, inside the ball of radius 0.5 centred at (0, 0, 0.5), so the march meets d < eps); (-2.5, 1.5, 0.001)
+    # is lit (its line passes 1.74 from that ball's centre, about 7 penumbra widths t tan(a) away).
+    P = np.array([[0.3, 0.0, 0.001], [-2.5, 1.5, 0.001]])
+    v = lab.soft_shadow(scene("balls"), P, np.array([0.0, 0.0, 3.0]), 0.3)
+    expect_close("soft_shadow of a point behind a ball and a lit one", v, [0.0, 1.0], atol=1e-9, name="V")
 
 
 # ------------------------------------------------------------------------------ bad input

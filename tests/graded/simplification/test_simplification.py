@@ -209,6 +209,15 @@ def test_link_condition_tetrahedron_and_octahedron(lab):
         np.all(link),
         f"got {np.asarray(link).tolist()}, expected all True (each edge has exactly its 2 opposite vertices in common)",
     )
+    # check_contractions also runs the flip test. Contracting (0, 2) onto vertex 0 turns its two surviving faces by
+    # 55 degrees (normal (-1, 1, 1) of face (2, 1, 4) becomes (0, 1, 0)): no flip. Onto vertex 1 = (-1, 0, 0), face
+    # (2, 1, 4) becomes (1, 1, 4) with two equal corners: degenerate, which counts as flipped.
+    _, flips = lab.check_contractions(OCTA_V, OCTA_F, [[0, 2], [0, 2]], OCTA_V[[0, 1]])
+    expect_true(
+        "flip test on the octahedron, edge (0, 2) onto vertex 0 / onto vertex 1",
+        np.asarray(flips).tolist() == [False, True],
+        f"got {np.asarray(flips).tolist()}, expected [False, True] (a face with two equal corners is degenerate)",
+    )
 
 
 @graded(points=1, part="contraction")
@@ -231,17 +240,66 @@ def test_link_condition_on_a_boundary(lab):
         f"edges {bad} are wrong (expected {[x for e, x in zip(E.tolist(), expected) if tuple(e) in bad]}); "
         "count the outside of the boundary as one extra vertex next to every boundary vertex",
     )
+    # check_contractions also runs the flip test: moving 1 onto 0 keeps the flat faces (0, 4, 3), (1, 2, 5) and
+    # (1, 5, 4) facing up; moving both onto vertex 2 squashes face (1, 2, 5) to a segment (degenerate: flipped).
+    # Non-edge pairs: (0, 2) share vertex 1, joined to both by boundary edges (zipping them is fine); (4, 2) share 1
+    # and 5, joined to 4 by interior edges (an edge would end up in three faces).
+    link, _ = lab.check_contractions(GRID_V, GRID_F, [[0, 2], [4, 2]], GRID_V[[0, 4]])
+    expect_true(
+        "link condition on the 3 x 3 grid, non-edge pairs (0, 2) and (4, 2)",
+        np.asarray(link).tolist() == [True, False],
+        f"got {np.asarray(link).tolist()}, expected [True, False]: a non-edge pair passes only when every common "
+        "neighbour is joined to both ends by boundary edges (one face each)",
+    )
+    _, flips = lab.check_contractions(GRID_V, GRID_F, [[0, 1], [0, 1]], GRID_V[[0, 2]])
+    expect_true(
+        "flip test on the 3 x 3 grid, edge (0, 1) onto vertex 0 / onto vertex 2",
+        np.asarray(flips).tolist() == [False, True],
+        f"got {np.asarray(flips).tolist()}, expected [False, True] (a face with two equal corners is degenerate)",
+    )
 
 
 @graded(points=1, part="contraction")
 def test_flip_test_on_a_fan(lab):
     """fan around vertex 0: moving (0, 1) to (0.5, 0) is fine; (-2, 2) turns face (0, 2, 3) over; (-0.5, 0.5) flattens it"""
-    _, flips = lab.check_contractions(FAN_V, FAN_F, [[0, 1]] * 3, [[0.5, 0, 0], [-2.0, 2.0, 0], [-0.5, 0.5, 0]])
+    # A fourth pair, the non-edge pair (1, 3) moved onto vertex 0: face (0, 1, 2) gets two equal corners (flipped),
+    # and the pair fails the link condition (its common neighbour 0 is joined to 1 by an interior edge).
+    link, flips = lab.check_contractions(
+        FAN_V, FAN_F, [[0, 1]] * 3 + [[1, 3]], [[0.5, 0, 0], [-2.0, 2.0, 0], [-0.5, 0.5, 0], [0, 0, 0]]
+    )
     expect_true(
         "flip test on the fan",
+        np.asarray(flips).tolist() == [False, True, True, True],
+        f"got {np.asarray(flips).tolist()}, expected [False, True, True, True] (a face on the line through vertices 2 "
+        "and 3 is degenerate and counts as flipped, as is a face with two equal corners)",
+    )
+    expect_true(
+        "link condition on the fan",
+        np.asarray(link).tolist() == [True, True, True, False],
+        f"got {np.asarray(link).tolist()}, expected [True, True, True, False]: edge (0, 1) has exactly its 2 opposite "
+        "vertices in common; the non-edge pair (1, 3) shares vertex 0 through interior edges",
+    )
+    # The degeneracy threshold, 1e-10 x the sum of the face's three squared edge lengths: two faces (0, 1, 2) and
+    # (2, 1, 3); contracting (2, 3) to (0.5, h, 0) leaves (0, 1, p) with base 1 and height h, |n'| = h, squared edges
+    # 1 + 0.25 + 0.25 = 1.5 (+ h^2): degenerate (flipped) for h = 1.1e-10 <= 1.5e-10, not for h = 3e-10.
+    V2 = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 2, 0]])
+    _, flips = lab.check_contractions(V2, [[0, 1, 2], [2, 1, 3]], [[2, 3]] * 2, [[0.5, 1.1e-10, 0], [0.5, 3e-10, 0]])
+    expect_true(
+        "flip test: a face squashed to height 1.1e-10 / 3e-10 over a base of length 1",
+        np.asarray(flips).tolist() == [True, False],
+        f"got {np.asarray(flips).tolist()}, expected [True, False]: degenerate means |n'| <= 1e-10 x (sum of the "
+        "face's three squared edge lengths)",
+    )
+    # Flip and degeneracy tests are relative (|n'| against the face's squared edge lengths): the same fan shrunk
+    # by 1e-6 gives the same answers.
+    _, flips = lab.check_contractions(
+        FAN_V * 1e-6, FAN_F, [[0, 1]] * 3, np.array([[0.5, 0, 0], [-2.0, 2.0, 0], [-0.5, 0.5, 0]]) * 1e-6
+    )
+    expect_true(
+        "flip test on the fan shrunk by 1e-6",
         np.asarray(flips).tolist() == [False, True, True],
-        f"got {np.asarray(flips).tolist()}, expected [False, True, True] (a face on the line through vertices 2 and 3 "
-        "is degenerate and counts as flipped)",
+        f"got {np.asarray(flips).tolist()}, expected [False, True, True] as on the full-size fan: compare |n'| with "
+        "1e-10 x the sum of the face's squared edge lengths, not with an absolute number",
     )
 
 

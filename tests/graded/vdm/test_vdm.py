@@ -131,7 +131,8 @@ def test_parameterization_is_bijective(lab):
 def test_parameterization_rejects_non_disks(lab):
     """closed meshes, holes and handles are not disks"""
     V, F = datasets.grid_patch(4)
-    lab.parameterize_square(V, F)  # a valid call first
+    # A valid call first, and its answer: the identity (see the flat-square test).
+    expect_close("parameterize_square on a flat unit square", lab.parameterize_square(V, F), V[:, :2], atol=1e-10)
     Vs, Fs = datasets.icosphere(1)
     expect_rejected(lab, "parameterize_square", Vs, Fs, match="closed", label="parameterize_square on a sphere")
     Vt, Ft = datasets.torus()
@@ -146,7 +147,7 @@ def test_parameterization_rejects_non_disks(lab):
 
 @graded(points=1, part="sampling")
 def test_sampling_a_tilted_plane(lab):
-    """on a plane z = 0.3 x - 0.2 y with uv = xy, every sample is (u, v, 0.3 u - 0.2 v)"""
+    """on a plane z = 0.3 x - 0.2 y with uv = xy, every sample is (u, v, 0.3 u - 0.2 v), also among uneven triangles"""
     V, F = datasets.grid_patch(5)
     V = V.copy()
     V[:, 2] = 0.3 * V[:, 0] - 0.2 * V[:, 1]  # linear, so barycentric interpolation is exact
@@ -168,6 +169,24 @@ def test_sampling_a_tilted_plane(lab):
         atol=1e-12,
         hint="a vertex's uv must give the vertex",
         mesh=(V, F),
+    )
+    # Point location must find the containing triangle however the triangles are spread: a large triangle
+    # (0.5, 0), (1, 0), (1, 0.5), ten small ones just across its long side and one at the origin. The query
+    # (0.8, 0.28) is inside the large one (0.28 < 0.8 - 0.5), though the small ones' centres are nearer to it.
+    UV = [[0.5, 0], [1, 0], [1, 0.5], [0, 0], [0.01, 0], [0, 0.01]]
+    for k in range(10):
+        c = [0.74 + 0.02 * (k % 5), 0.33 + 0.03 * (k // 5)]
+        UV += [c, [c[0] + 0.01, c[1]], [c[0], c[1] + 0.01]]
+    UV = np.array(UV)
+    Fs = np.arange(len(UV)).reshape(-1, 3)
+    Vs = np.c_[UV, 0.3 * UV[:, 0] - 0.2 * UV[:, 1]]
+    expect_close(
+        "sample_surface at uv (0.8, 0.28), inside the large triangle (0.5, 0), (1, 0), (1, 0.5)",
+        lab.sample_surface(Vs, Fs, UV, [[0.8, 0.28]]),
+        [[0.8, 0.28, 0.3 * 0.8 - 0.2 * 0.28]],
+        atol=1e-12,
+        hint="a point inside a uv triangle must be found in that triangle, also when other triangles' centres are "
+        "nearer (check that every triangle is listed in every grid cell its bounding box touches)",
     )
 
 
@@ -206,7 +225,7 @@ def test_naive_vdm_recovers_the_rock_exactly(lab):
 
 @graded(points=1, part="naive VDM")
 def test_naive_vdm_of_a_flat_square_is_zero(lab):
-    """a flat unit square with uv = xy needs no displacement at all"""
+    """a flat unit square with uv = xy needs no displacement at all; tilted to z = 0.3 x - 0.2 y, exactly that height"""
     V, F = datasets.grid_patch(3)
     D = lab.naive_vdm(V, F, V[:, :2], 5)
     expect_texels_close(
@@ -215,6 +234,20 @@ def test_naive_vdm_of_a_flat_square_is_zero(lab):
         np.zeros((5, 5, 3)),
         atol=1e-12,
         hint="texel [i, j] samples u = j / (res - 1), v = i / (res - 1)",
+    )
+    # Tilt the square to z = 0.3 x - 0.2 y (uv still xy): now only the z component is displaced, by exactly that
+    # height (linear, so barycentric interpolation is exact), at texel [i, j] = (u, v) = (j, i) / 4.
+    Vt = V.copy()
+    Vt[:, 2] = 0.3 * V[:, 0] - 0.2 * V[:, 1]
+    t = np.linspace(0, 1, 5)
+    expected = np.zeros((5, 5, 3))
+    expected[..., 2] = 0.3 * t[None, :] - 0.2 * t[:, None]
+    expect_texels_close(
+        "naive_vdm of the square tilted to z = 0.3 x - 0.2 y",
+        lab.naive_vdm(Vt, F, V[:, :2], 5),
+        expected,
+        atol=1e-12,
+        hint="D = p(u, v) - (u, v, 0): the tilted square's height",
     )
     expect_rejected(lab, "naive_vdm", V, F, V[:, :2], 1, match="res", label="naive_vdm with res = 1")
 
@@ -359,8 +392,23 @@ def test_transport_grid_is_bijective_and_denser_where_important(lab):
 
 @graded(points=1, part="transport grid")
 def test_transport_rejects_bad_fields(lab):
-    """fields must be square and strictly positive"""
-    lab.transport_grid(np.ones((8, 8)), 4)  # a valid call first
+    """fields must be square and strictly positive (after a valid call: a field 3x denser on the right pulls the grid right)"""
+    field = np.ones((8, 8))
+    field[:, 4:] = 3.0  # columns are u: the right half u > 1/2 is three times denser
+    G = np.asarray(lab.transport_grid(field, 5))
+    moved = G[1:-1, 1:-1, 0] - uniform(5)[1:-1, 1:-1, 0]
+    expect(
+        G.shape == (5, 5, 2) and bool((moved > 0.01).all()),
+        "transport_grid of a field 3x denser on the right half: every interior grid point must move right "
+        f"(u increases); moved by {np.round(moved, 3).tolist() if G.shape == (5, 5, 2) else G.shape}",
+    )
+    # The field does not change under v -> 1 - v, so neither does the grid: rows i and 4 - i mirror each other.
+    mirror = np.abs(G[::-1, :, 1] - (1 - G[:, :, 1])).max()
+    expect(
+        mirror < 0.01,
+        f"transport_grid of a field that only varies with u: rows i and 4 - i must mirror in v (v -> 1 - v), "
+        f"off by {mirror:.3g}; the middle row has v = {np.round(G[2, :, 1], 3).tolist()}, expected 0.5",
+    )
     expect_rejected(lab, "transport_grid", np.zeros((8, 8)), 4, match="positive", label="a zero field")
     expect_rejected(lab, "transport_grid", np.ones((8, 6)), 4, match="square", label="a non-square field")
 
@@ -489,7 +537,7 @@ def test_diagonals_follow_a_crease_on_the_anti_diagonal(lab):
 
 @graded(points=1, part="diagonals")
 def test_diagonals_never_pick_a_flipped_split(lab):
-    """a non-convex cell: only its a-c split has two positive triangles, whatever the default"""
+    """a non-convex cell: only its a-c split has two positive triangles, whatever the default; and one where only b-d has"""
     G = uniform(3).copy()
     G[1, 1] = [0.2, 0.2]  # cell (0, 0) = (0,0), (.5,0), (.2,.2), (0,.5): triangle b, c, d is flipped
     V, F = roof(2)
@@ -499,4 +547,11 @@ def test_diagonals_never_pick_a_flipped_split(lab):
         expect(
             bool(diag[0, 0]),
             f"choose_diagonals(default={default}) split the non-convex cell (0, 0) along b-d, which flips triangle bcd",
+        )
+    G[1, 1] = [0.8, 0.2]  # cell (0, 1) = (.5,0), (1,0), (1,.5), (.8,.2): triangle a, c, d is flipped
+    for default in (True, False):
+        diag = np.asarray(lab.choose_diagonals(G, V, F, V[:, :2], E, default=default))
+        expect(
+            not bool(diag[0, 1]),
+            f"choose_diagonals(default={default}) split the non-convex cell (0, 1) along a-c, which flips triangle acd",
         )
