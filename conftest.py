@@ -11,6 +11,8 @@ changes nothing.
 from __future__ import annotations
 
 import os
+import sys
+import traceback
 
 import pytest
 
@@ -24,6 +26,25 @@ PICTURE_TIME_LIMIT_S = "300"
 
 def pytest_configure(config: pytest.Config) -> None:
     os.environ.setdefault("GEOMLIB_PICTURE_TIME_LIMIT", PICTURE_TIME_LIMIT_S)
+    sys.meta_path.insert(0, _OpenGLOnlyOnAHeadlessPlatform())
+
+
+class _OpenGLOnlyOnAHeadlessPlatform:
+    """PyOpenGL binds its platform once, at its first import: imported while ``PYOPENGL_PLATFORM`` is
+    unset, it takes GLX and every later render in that process fails ("PyOpenGL was imported before a
+    headless platform was chosen"). Two loaded CI runs lost 8 and 19 tests of one xdist worker that
+    way without showing who imported it. This guard makes that import fail where it happens, with its
+    stack, so the test that does it is the one that fails (geomlib.render.backend() sets the variable
+    before it imports OpenGL, so the library's own path is never refused)."""
+
+    def find_spec(self, name, path=None, target=None):
+        if name == "OpenGL" and not os.environ.get("PYOPENGL_PLATFORM"):
+            where = "".join(traceback.format_stack(limit=12)[:-1])
+            raise ImportError(
+                "OpenGL imported before a headless platform was chosen (PYOPENGL_PLATFORM is unset); "
+                f"go through geomlib.render.backend()/import_pyrender(). Imported from:\n{where}"
+            )
+        return None
 
 
 #: Seconds a module takes: the sum of its tests' durations in CI's run of 2026-11-26 (2 workers);

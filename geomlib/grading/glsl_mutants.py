@@ -112,6 +112,10 @@ def _input_for(typ: str, params: list[tuple[str, str, str]], used: set[str]) -> 
     return None
 
 
+#: GLSL's built-in outputs a block may leave as its result.
+_BUILTIN_OUTPUTS = {"gl_Position": "vec4", "gl_PointSize": "float", "gl_FragDepth": "float"}
+
+
 class Shape:
     """Where a block sits: its function, the function's parameters and the block's results."""
 
@@ -157,6 +161,7 @@ class Shape:
         globals_out = {
             n: t for t, n in re.findall(rf"^\s*(?:flat\s+|smooth\s+)?out\s+({_TYPES})\s+(\w+)\s*;", self.code, re.M)
         }
+        globals_out.update(_BUILTIN_OUTPUTS)  # a vertex stage's result is gl_Position (shadows' depth.vert)
         inside = set(re.findall(rf"\b{_TYPES}\s+([A-Za-z_]\w*)", block))
         for name in dict.fromkeys(_ASSIGN.findall(block)):
             if name in inside:

@@ -71,7 +71,7 @@ class _Selection:
             for item in drop:  # the task has no test of its own: which tests run it (parsed only now)
                 if item.nodeid in self.tasks:
                     try:
-                        runs[item.nodeid] = self.task in _tasks.test_runs(item, self.titles[plugin._lab_of(item.path)])
+                        runs[item.nodeid] = self.task in _tasks.test_runs(item, self.titles[plugin.lab_of(item.path)])
                     except Exception:
                         runs[item.nodeid] = False
         if self.task is not None and not [i for i in keep if i.nodeid in self.tasks] and any(runs.values()):
