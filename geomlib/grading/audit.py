@@ -449,6 +449,16 @@ def _apply(text: str, edits: list[tuple[int, int, str]]) -> str:
 # ---------------------------------------------------------------------------------- generation
 
 
+def _unique_id(out: list[Mutant], base: str) -> str:
+    """``base``, or ``base#2``, ``base#3``, ... when a mutant of ``out`` already has that id (two
+    edits of the same kind at one place)."""
+    ids = {m.id for m in out}
+    mid, k = base, 2
+    while mid in ids:
+        mid, k = f"{base}#{k}", k + 1
+    return mid
+
+
 def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) -> tuple[list[Mutant], list[str]]:
     """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated.
 
@@ -493,10 +503,7 @@ def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) 
             except SyntaxError:
                 continue
             seen.add(src)
-            mid = f"{b.file}:{line}:{col}:{label}"
-            k = 2
-            while any(m.id == mid for m in out):
-                mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
+            mid = _unique_id(out, f"{b.file}:{line}:{col}:{label}")
             out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), fname, src))
     ok = (
         glsl_mutants.compiles([(Path(m.file).suffix, m.source) for m in glsl if m.kind == "operator"])
@@ -538,10 +545,7 @@ def _glsl_mutants(lab: str, lab_dir: Path, b: _Block, notes: list[str]) -> list[
         if src in seen:
             continue
         seen.add(src)
-        mid = f"{b.file}:{line}:{col}:{label}"
-        k = 2
-        while any(m.id == mid for m in out):
-            mid, k = f"{b.file}:{line}:{col}:{label}#{k}", k + 1
+        mid = _unique_id(out, f"{b.file}:{line}:{col}:{label}")
         out.append(Mutant(mid, lab, b.file, line, b.task, b.title, "operator", label, _diff(text, src), shape.fn, src))
     return out
 
