@@ -13,10 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib import gl
-from geomlib.textures import WRAP_MODES
-from geomlib.validate import check_choice, check_float, check_mesh
 
-from .inputs import as_offset_image, as_unit_normals, check_uv, check_weld, normalize_rows
+from .inputs import checked_map_inputs, normalize_rows
 from .seams import seam_mean, weld_seams
 
 __all__ = ["SHADERS", "shader_path", "glsl_denoise_with_map"]
@@ -54,15 +52,7 @@ def glsl_denoise_with_map(
 ) -> np.ndarray:
     """:func:`denoise_with_map` computed by ``shaders/denoise.vert``: ``p' = p - lam (bias + scale h(uv)) n``."""
     where = "glsl_denoise_with_map"
-    V, F = check_mesh(V, F, where=where)
-    UV = check_uv(UV, len(V), where, in_range=True)
-    N = as_unit_normals(N, len(V), where)
-    H = as_offset_image(image, where)
-    bias = check_float(bias, "bias", where=where)
-    scale = check_float(scale, "scale", where=where)
-    lam = check_float(lam, "lam", minimum=0.0, maximum=1.0, where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    weld = check_weld(weld, where)
+    V, F, UV, N, H, bias, scale, lam, weld = checked_map_inputs(V, F, UV, N, image, bias, scale, lam, weld, wrap, where)
     P, s = _run_points(
         "denoise.vert",
         len(V),

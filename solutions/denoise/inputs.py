@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.tangent_space import as_height_map
-from geomlib.validate import MeshError, as_array, check_choice, check_uv
+from geomlib.textures import WRAP_MODES
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_mesh, check_uv
 from geomlib.vectors import as_unit_vectors as as_unit_normals
 from geomlib.vectors import normalize_rows
 
@@ -81,3 +82,18 @@ def as_offset_image(image, where: str, name: str = "image") -> np.ndarray:
     (:func:`geomlib.tangent_space.as_height_map`, shared with the maps and relief labs).
     """
     return as_height_map(image, where, name, unit_range=True, what="offset map")
+
+
+def checked_map_inputs(V, F, UV, N, image, bias, scale, lam, weld, wrap, where: str):
+    """The arguments of denoising through the offset map, checked once for both routes (NumPy
+    :func:`denoise_with_map` and GLSL :func:`glsl_denoise_with_map`): ``(V, F, UV, N, H, bias, scale,
+    lam, weld)`` with ``N`` unit rows and ``H`` the map as floats; ``wrap`` is only checked."""
+    V, F = check_mesh(V, F, where=where)
+    UV = check_uv(UV, len(V), where, in_range=True)
+    N = as_unit_normals(N, len(V), where)
+    H = as_offset_image(image, where)
+    bias = check_float(bias, "bias", where=where)
+    scale = check_float(scale, "scale", where=where)
+    lam = check_float(lam, "lam", minimum=0.0, maximum=1.0, where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    return V, F, UV, N, H, bias, scale, lam, check_weld(weld, where)

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib.textures import WRAP_MODES, dilate, rasterize_uv, sample_bilinear
-from geomlib.validate import check_choice, check_float, check_int, check_mesh
+from geomlib.textures import dilate, rasterize_uv, sample_bilinear
+from geomlib.validate import check_int, check_mesh
 
-from .inputs import as_offset_image, as_scalars, as_unit_normals, check_bits, check_uv, check_weld, normalize_rows
+from .inputs import as_scalars, check_bits, check_uv, checked_map_inputs, normalize_rows
 from .seams import seam_mean, weld_seams
 
 __all__ = ["bake_offset_map", "denoise_with_map", "quantisation_step"]
@@ -146,15 +146,7 @@ def denoise_with_map(
         ``lam``, ``bias``, ``scale`` or ``wrap``.
     """
     where = "denoise_with_map"
-    V, F = check_mesh(V, F, where=where)
-    UV = check_uv(UV, len(V), where, in_range=True)
-    N = as_unit_normals(N, len(V), where)
-    H = as_offset_image(image, where)
-    bias = check_float(bias, "bias", where=where)
-    scale = check_float(scale, "scale", where=where)
-    lam = check_float(lam, "lam", minimum=0.0, maximum=1.0, where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    weld = check_weld(weld, where)
+    V, F, UV, N, H, bias, scale, lam, weld = checked_map_inputs(V, F, UV, N, image, bias, scale, lam, weld, wrap, where)
     # BEGIN PROMPT
     # s = ...  # (n,) offsets read from the map
     # END PROMPT
