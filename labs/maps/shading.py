@@ -73,6 +73,52 @@ def _check_gbuffer(g, need: tuple[str, ...], where: str) -> None:
             )
 
 
+def checked_shade_inputs(
+    gbuffer, lights, eye, albedo, normal_map, ambient, specular, shininess, wrap, background, where: str
+):
+    """Given: the arguments of :func:`shade`, checked once for both routes (NumPy :func:`shade` and
+    GLSL :func:`~solutions.maps.glsl.glsl_shade`).
+
+    Returns
+    -------
+    need : tuple of str
+        The G-buffer attributes the call reads (checked present).
+    L : list of (kind, (3,), (3,))
+        The lights (:func:`~solutions.maps.inputs.check_lights`).
+    eye : (3,) float64
+    ambient, specular, shininess : float
+    bg : (3,) float64
+    tex : (s, s, 3) float64 in [0, 1] or None
+        The albedo texture, when ``albedo`` is an image.
+    alb : (3,) float64 or None
+        The constant albedo, when it is not.
+    nmap : (s, s, 3) float64 or None
+        The decoded normal map's vectors (not normalised).
+    """
+    need = ("position", "normal")
+    texture_albedo = np.ndim(albedo) == 3
+    if normal_map is not None or texture_albedo:
+        need += ("uv",)
+    if normal_map is not None:
+        need += ("tangent",)
+    _check_gbuffer(gbuffer, need, where)
+    L = check_lights(lights, where)
+    eye = as_array(eye, "eye", shape=(3,), where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    ambient = check_float(ambient, "ambient", minimum=0.0, where=where)
+    specular = check_float(specular, "specular", minimum=0.0, where=where)
+    shininess = check_float(shininess, "shininess", minimum=0.0, where=where)
+    bg = as_array(background, "background", shape=(3,), where=where)
+    tex = alb = None
+    if texture_albedo:
+        tex = as_image(albedo, "albedo", channels=3, where=where)
+        tex = tex.astype(np.float64) / 255.0 if tex.dtype == np.uint8 else as_array(tex, "albedo", where=where)
+    else:
+        alb = as_array(albedo, "albedo", shape=(3,), where=where)
+    nmap = as_normal_map(normal_map, where) if normal_map is not None else None
+    return need, L, eye, ambient, specular, shininess, bg, tex, alb, nmap
+
+
 def shade(
     gbuffer,
     lights,
@@ -134,28 +180,9 @@ def shade(
     MeshError
         Missing attributes, bad lights, maps or parameters.
     """
-    where = "shade"
-    need = ("position", "normal")
-    texture_albedo = np.ndim(albedo) == 3
-    if normal_map is not None or texture_albedo:
-        need += ("uv",)
-    if normal_map is not None:
-        need += ("tangent",)
-    _check_gbuffer(gbuffer, need, where)
-    L = check_lights(lights, where)
-    eye = as_array(eye, "eye", shape=(3,), where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    ambient = check_float(ambient, "ambient", minimum=0.0, where=where)
-    specular = check_float(specular, "specular", minimum=0.0, where=where)
-    shininess = check_float(shininess, "shininess", minimum=0.0, where=where)
-    bg = as_array(background, "background", shape=(3,), where=where)
-    if texture_albedo:
-        tex = as_image(albedo, "albedo", channels=3, where=where)
-        tex = tex.astype(np.float64) / 255.0 if tex.dtype == np.uint8 else as_array(tex, "albedo", where=where)
-    else:
-        tex = None
-        alb = as_array(albedo, "albedo", shape=(3,), where=where)
-    nmap = as_normal_map(normal_map, where) if normal_map is not None else None
+    need, L, eye, ambient, specular, shininess, bg, tex, alb, nmap = checked_shade_inputs(
+        gbuffer, lights, eye, albedo, normal_map, ambient, specular, shininess, wrap, background, "shade"
+    )
 
     mask = np.asarray(gbuffer.mask)
     h, w = mask.shape

@@ -47,6 +47,31 @@ def welded_vertex_normals(V, F, group: np.ndarray | None = None) -> np.ndarray:
     return normalize_rows(Nw[group], fallback=(0.0, 0.0, 1.0))
 
 
+def checked_displace_inputs(V, F, UV, N, height, lam, bias, scale, weld_seams, wrap, where: str):
+    """Given: the arguments of displacement mapping, checked once for both routes (NumPy
+    :func:`displace` and GLSL :func:`~solutions.maps.glsl.glsl_displace`).
+
+    Returns
+    -------
+    V, F, UV, n, Hm, lam, bias, scale, group, k
+        ``n`` the unit displacement directions ((n, 3), welded normals when ``N`` is None),
+        ``Hm`` the map as floats in [0, 1], ``group``/``k`` the seam groups
+        (:func:`geomlib.textures.weld_by_position`; every vertex its own group without ``weld_seams``).
+    """
+    V, F = check_mesh(V, F, where=where)
+    check_choice(wrap, "wrap", WRAP_MODES, where=where)
+    UV = check_uv(UV, len(V), where, in_range=(wrap == "clamp"))
+    Hm = as_height_map(height, where, name="height", unit_range=True, what="displacement map")
+    lam = check_float(lam, "lam", where=where)
+    bias = check_float(bias, "bias", where=where)
+    scale = check_float(scale, "scale", where=where)
+    if not isinstance(weld_seams, bool | np.bool_):
+        raise MeshError(f"{where}: weld_seams must be True or False, got {weld_seams!r}")
+    group, k = weld_by_position(V) if weld_seams else (np.arange(len(V)), len(V))
+    n = welded_vertex_normals(V, F, group) if N is None else as_unit_vectors(N, len(V), where)
+    return V, F, UV, n, Hm, lam, bias, scale, group, k
+
+
 def displace(
     V,
     F,
@@ -106,18 +131,9 @@ def displace(
     MeshError
         Invalid mesh, missing or out-of-range UVs, bad map, zero normals, bad parameters.
     """
-    where = "displace"
-    V, F = check_mesh(V, F, where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    UV = check_uv(UV, len(V), where, in_range=(wrap == "clamp"))
-    Hm = as_height_map(height, where, name="height", unit_range=True, what="displacement map")
-    lam = check_float(lam, "lam", where=where)
-    bias = check_float(bias, "bias", where=where)
-    scale = check_float(scale, "scale", where=where)
-    if not isinstance(weld_seams, bool | np.bool_):
-        raise MeshError(f"{where}: weld_seams must be True or False, got {weld_seams!r}")
-    group, k = weld_by_position(V) if weld_seams else (np.arange(len(V)), len(V))
-    n = welded_vertex_normals(V, F, group) if N is None else as_unit_vectors(N, len(V), where)
+    V, F, UV, n, Hm, lam, bias, scale, group, k = checked_displace_inputs(
+        V, F, UV, N, height, lam, bias, scale, weld_seams, wrap, "displace"
+    )
     h = sample_bilinear(Hm, UV, wrap=wrap)
     # BEGIN PROMPT
     # V_new = ...  # (n, 3) displaced positions

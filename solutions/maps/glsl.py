@@ -18,12 +18,11 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib import gl
-from geomlib.textures import WRAP_MODES, weld_by_position
-from geomlib.validate import MeshError, as_array, as_image, check_choice, check_float, check_mesh
+from geomlib.validate import MeshError, as_array
 
-from .displacement import group_mean, welded_vertex_normals
-from .inputs import as_height_map, as_normal_map, as_tangents, as_unit_vectors, check_lights, check_uv, normalize_rows
-from .shading import _check_gbuffer
+from .displacement import checked_displace_inputs, group_mean
+from .inputs import as_tangents, normalize_rows
+from .shading import checked_shade_inputs
 
 __all__ = ["SHADERS", "shader_path", "glsl_tbn", "glsl_shade", "glsl_displace"]
 
@@ -121,18 +120,11 @@ def glsl_shade(
 ) -> np.ndarray:
     """:func:`shade` computed by ``shaders/normalmap.frag`` (same arguments, same result)."""
     where = "glsl_shade"
-    need = ("position", "normal", "uv", "tangent")
-    texture_albedo = np.ndim(albedo) == 3
-    _check_gbuffer(gbuffer, need[: 2 + (normal_map is not None or texture_albedo) + (normal_map is not None)], where)
-    L = check_lights(lights, where)
+    need, L, eye, ambient, specular, shininess, bg, tex, alb, nmap = checked_shade_inputs(
+        gbuffer, lights, eye, albedo, normal_map, ambient, specular, shininess, wrap, background, where
+    )
     if len(L) > MAX_LIGHTS:
         raise MeshError(f"{where}: at most {MAX_LIGHTS} lights (normalmap.frag's uniform arrays), got {len(L)}")
-    eye = as_array(eye, "eye", shape=(3,), where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    ambient = check_float(ambient, "ambient", minimum=0.0, where=where)
-    specular = check_float(specular, "specular", minimum=0.0, where=where)
-    shininess = check_float(shininess, "shininess", minimum=0.0, where=where)
-    bg = as_array(background, "background", shape=(3,), where=where)
     mask = np.asarray(gbuffer.mask)
     h, w = mask.shape
     attrs = gbuffer.attributes
@@ -149,17 +141,15 @@ def glsl_shade(
         "normal_map": np.zeros((1, 1, 3)),
         "albedo_map": np.zeros((1, 1, 3)),
     }
-    uniforms = {"use_normal_map": 0, "use_albedo_map": int(texture_albedo), "albedo": np.zeros(3)}
-    if normal_map is not None:
-        nmap = as_normal_map(normal_map, where)  # decoded vectors; the shader decodes 2 rgb - 1 again
-        raw = np.asarray(normal_map)
+    uniforms = {"use_normal_map": 0, "use_albedo_map": int(tex is not None), "albedo": np.zeros(3)}
+    if nmap is not None:
+        raw = np.asarray(normal_map)  # the shader decodes 2 rgb - 1 itself
         textures["normal_map"] = raw / 255.0 if raw.dtype == np.uint8 else (nmap + 1.0) / 2.0
         uniforms["use_normal_map"] = 1
-    if texture_albedo:
-        tex = as_image(albedo, "albedo", channels=3, where=where)
-        textures["albedo_map"] = tex / 255.0 if tex.dtype == np.uint8 else as_array(tex, "albedo", where=where)
+    if tex is not None:
+        textures["albedo_map"] = tex
     else:
-        uniforms["albedo"] = as_array(albedo, "albedo", shape=(3,), where=where)
+        uniforms["albedo"] = alb
     uniforms.update(
         eye=eye,
         ambient=ambient,
@@ -190,18 +180,9 @@ def glsl_displace(
     with ``weld_seams`` the copies of a seam vertex (:func:`geomlib.textures.weld_by_position`) are
     then moved by the mean of their offsets ``d`` (read back from the shader) along their mean normal.
     """
-    where = "glsl_displace"
-    V, F = check_mesh(V, F, where=where)
-    check_choice(wrap, "wrap", WRAP_MODES, where=where)
-    UV = check_uv(UV, len(V), where, in_range=(wrap == "clamp"))
-    Hm = as_height_map(height, where, name="height", unit_range=True, what="displacement map")
-    lam = check_float(lam, "lam", where=where)
-    bias = check_float(bias, "bias", where=where)
-    scale = check_float(scale, "scale", where=where)
-    if not isinstance(weld_seams, bool | np.bool_):
-        raise MeshError(f"{where}: weld_seams must be True or False, got {weld_seams!r}")
-    group, k = weld_by_position(V) if weld_seams else (np.arange(len(V)), len(V))
-    n = welded_vertex_normals(V, F, group) if N is None else as_unit_vectors(N, len(V), where)
+    V, F, UV, n, Hm, lam, bias, scale, group, k = checked_displace_inputs(
+        V, F, UV, N, height, lam, bias, scale, weld_seams, wrap, "glsl_displace"
+    )
     P, d = _run_points(
         "displace.vert",
         gl.MOVED_OFFSET_FRAGMENT_SHADER,
