@@ -88,6 +88,7 @@ RESULTS="$OUT/results.json"
 LOG="$OUT/grader-output.txt"
 PY="${GEOMLIB_PYTHON:-$SRC/.venv/bin/python}"
 export GEOMLIB_ROOT="$SRC"
+export PATH="$PATH:/usr/sbin:/sbin"  # runuser lives in sbin, which a minimal PATH leaves out
 export GEOMLIB_SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
 # Feedback pictures (inlined into results.json): the first few failures get one each.
 export GEOMLIB_MAX_FEEDBACK_PICTURES="${GEOMLIB_MAX_FEEDBACK_PICTURES-8}"

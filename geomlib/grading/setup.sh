@@ -14,6 +14,8 @@ SRC="$ROOT/source"
 SANDBOX_USER="${GEOMLIB_SANDBOX_USER-nobody}"
 cd "$SRC"
 export DEBIAN_FRONTEND=noninteractive
+# runuser and ldconfig live in sbin, which a minimal PATH (env -i, cron, some images) leaves out.
+export PATH="$PATH:/usr/sbin:/sbin"
 
 # System packages, only the missing ones: headless OpenGL (OSMesa for pyrender and the GLSL
 # harness; EGL with Mesa's software driver as the fallback platform), a Python 3 (for uv's bootstrap).
