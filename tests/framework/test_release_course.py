@@ -94,6 +94,8 @@ def _run(root: Path, fill, **extra_env) -> tuple[dict, str]:
     fill(root / "submission")
     subprocess.run(["chmod", "-R", "a+rX", str(root / "submission")], check=True)
     env = _env(GEOMLIB_AUTOGRADER_ROOT=str(root), **extra_env)
+    # A minimal PATH without sbin, as cron or `env -i` give: run_autograder must still find runuser.
+    env["PATH"] = "/usr/bin:/bin"
     if not IS_ROOT:
         env["GEOMLIB_SANDBOX_USER"] = ""
     p = subprocess.run(
