@@ -83,7 +83,7 @@ STORED = [
     linear_maps_entry("b-short", 48, "front"),
     cube_visibility_entry("glsl-cube-eye-defaults", "glsl-cube-linear-a-64-front", "a"),
     cube_visibility_entry("glsl-cube-eye-small-bias", "glsl-cube-linear-a-64-front", "a", bias=0.004),
-    cube_visibility_entry("glsl-cube-eye-pcf3", "glsl-cube-linear-b-48-none", "b", bias=0.005, pcf=3),
+    cube_visibility_entry("glsl-cube-eye-pcf3", "glsl-cube-linear-b-48-none", "b", bias=0.02, pcf=3),
     cube_visibility_entry("glsl-cube-eye-short-far", "glsl-cube-linear-b-short-48-front", "b-short"),
 ]
 #: Hidden: two other lights, sizes and culling modes; PCF 5, the default bias, PCF 3 on a back-culled map.
