@@ -7,10 +7,12 @@ computed here. The face matrices are stored too, so Task 11 does not need Task 8
 Tolerances, from the measured agreement of the solution's shaders with the NumPy route on llvmpipe
 (the handout's section 1.9 gives the numbers):
 
-* linear cube maps: covered texels agree exactly (0 of 1.9 M texels: 9 light set-ups x sizes 48, 64,
-  256 x the 3 culling modes); depths (distance / far) differ by at most 8.5e-5. So
-  ``CUBE_DEPTH_ATOL = 5e-4`` (6 times that, a thirtieth of the default bias of a 64² face) and at most
-  ``CUBE_COVERAGE_BAD = 0.1%`` of texels covered on one side only, as for Task 9;
+* linear cube maps: 72 set-ups (4 lights x 2 far planes x sizes 48, 64, 256 x the 3 culling modes,
+  10.4 M texels): 63 texels differ, 53 covered on one side only and 10 holding another surface, all
+  texel centres on an edge where the two rasterizers' tie rules differ (at most 4 in one set-up, 0.02%
+  of a 48² cube); the other depths (distance / far) differ by at most 4.2e-4 (p99.9 1.0e-4), the GPU's
+  vertex snapping. So ``CUBE_DEPTH_ATOL = 1e-3`` (a sixteenth of the default bias of a 64² face) and at
+  most ``CUBE_TEXELS_BAD = 0.1%`` of the texels may differ (other coverage, or depth beyond the tolerance);
 * visibilities: 11 of 688,920 point lookups differed (4 lights x 3 sizes x 2 far planes x 2 point sets x
   5 option sets), all of them points on a plane through the light, which sit exactly on a texel border
   of their face (the NumPy route's matrix product rounds to one side, the cube-map table to the other);
@@ -31,8 +33,8 @@ from geomlib.grading.feedback import failure_picture
 from .cases_cube_glsl import STORED, STORED_HIDDEN
 from .cases_glsl import eye_points
 
-CUBE_DEPTH_ATOL = 5e-4
-CUBE_COVERAGE_BAD = 1e-3
+CUBE_DEPTH_ATOL = 1e-3
+CUBE_TEXELS_BAD = 1e-3
 CUBE_VISIBILITY_ATOL = 1e-6
 CUBE_VISIBILITY_BAD = 1e-3
 CUBE_DEPTH_LABEL = "glsl_cube_depth_maps (shaders/cube_depth.vert + shaders/cube_depth.frag, the cube pass from the light)"
@@ -51,8 +53,9 @@ def _empty(size: int) -> np.ndarray:
 
 
 def expect_cube_maps(label: str, got, expected) -> None:
-    """Six GPU linear-depth maps against the NumPy ones: the same covered texels (up to CUBE_COVERAGE_BAD),
-    depths within CUBE_DEPTH_ATOL there. The message names the face and the stage that is likely wrong."""
+    """Six GPU linear-depth maps against the NumPy ones: the same covered texels and depths within
+    CUBE_DEPTH_ATOL there, except on at most CUBE_TEXELS_BAD of the texels. The message names the face and
+    the stage that is likely wrong."""
     e = np.asarray(expected, float)
     try:
         g = np.asarray(got, float)
@@ -65,7 +68,7 @@ def expect_cube_maps(label: str, got, expected) -> None:
     coverage = cov_e != cov_g
     depth_bad = cov_e & cov_g & ~(np.abs(g - e) <= CUBE_DEPTH_ATOL)
     nan = np.isnan(g)
-    if coverage.mean() <= CUBE_COVERAGE_BAD and not depth_bad.any() and not nan.any():
+    if (coverage | depth_bad).mean() <= CUBE_TEXELS_BAD and not nan.any():
         return
 
     def where(mask):
@@ -76,7 +79,7 @@ def expect_cube_maps(label: str, got, expected) -> None:
     if nan.any():
         f, r, c, at, picture = where(nan)
         raise Mismatch(f"{label}: {at} (NaN: the fragment stage, cube_depth.frag, wrote NaN)", picture)
-    if coverage.mean() > CUBE_COVERAGE_BAD:
+    if coverage.mean() > CUBE_TEXELS_BAD or depth_bad.sum() <= coverage.sum():
         f, r, c, at, picture = where(coverage)
         raise Mismatch(
             f"{label}: {at}; {int(coverage.sum())} of {coverage.size} texels are covered in one map and empty in "
