@@ -222,9 +222,8 @@ def glsl_cube_depth_maps(
     Ms = cube_light_matrices(pos, near, far) if matrices is None else as_array(matrices, "matrices", where=where)
     if Ms.shape != (6, 4, 4):
         raise MeshError(f"{where}: matrices has shape {Ms.shape}, expected (6, 4, 4): one per cube face")
-    vertex, fragment = gl.lab_shader_source(_shader_path("cube_depth.vert")), gl.lab_shader_source(
-        _shader_path("cube_depth.frag")
-    )
+    vertex = gl.lab_shader_source(_shader_path("cube_depth.vert"))
+    fragment = gl.lab_shader_source(_shader_path("cube_depth.frag"))
     empty = _texel_rays(size)
     out = np.empty((6, size, size))
     for i in range(6):

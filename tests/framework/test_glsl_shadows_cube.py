@@ -134,23 +134,25 @@ def test_a_wrong_world_position_from_the_vertex_stage_is_caught():
 
 def test_missing_culling_is_caught():
     old = "if ((cull == 1 && gl_FrontFacing) || (cull == 2 && !gl_FrontFacing)) {"
-    msg = _fail_of(_edit("cube_depth.frag", old, "if (false) {"), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")
+    msg = _fail_of(
+        _edit("cube_depth.frag", old, "if (false) {"), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front"
+    )
     assert 'cull="front"' in msg and "cube_depth.frag" in msg, msg
 
 
 @pytest.mark.parametrize(
-    ("old", "new"),
+    ("old", "new", "case"),
     [
-        ("sctc = vec2(-d.x, -d.y);", "sctc = vec2(d.x, -d.y);"),  # -z face mirrored
-        ("sctc = vec2(d.x, d.z);", "sctc = vec2(d.x, -d.z);"),  # +y face upside down
-        ("int row = int(size) - 1 - int(floor(st.y * size));", "int row = int(floor(st.y * size));"),  # no row flip
-        ("return 2 * a + (d[a] < 0.0 ? 1 : 0);", "return 2 * a;"),  # the sign of the axis ignored
-        ("if (ma > far) {", "if (false) {"),  # beyond the far plane read as shadowed
+        ("sctc = vec2(-d.x, -d.y);", "sctc = vec2(d.x, -d.y);", "glsl-cube-eye-defaults"),  # -z face mirrored
+        ("sctc = vec2(d.x, d.z);", "sctc = vec2(d.x, -d.z);", "glsl-cube-eye-pcf3"),  # +y face upside down
+        ("int row = int(size) - 1 - int(floor(st.y * size));", "int row = int(floor(st.y * size));",
+         "glsl-cube-eye-defaults"),  # no row flip
+        ("return 2 * a + (d[a] < 0.0 ? 1 : 0);", "return 2 * a;", "glsl-cube-eye-defaults"),  # the axis' sign ignored
+        ("if (ma > far) {", "if (false) {", "glsl-cube-eye-short-far"),  # beyond the far plane read as shadowed
     ],
     ids=["mirrored-face", "flipped-face", "no-row-flip", "no-sign", "no-far-fix"],
-)
-def test_a_wrong_lookup_is_caught(old, new):
-    case = "glsl-cube-eye-short-far" if "far" in old else "glsl-cube-eye-defaults"
+)  # fmt: skip
+def test_a_wrong_lookup_is_caught(old, new, case):
     msg = _fail_of(_edit("cube_shadow.frag", old, new), "check_glsl_cube_shadow", case)
     assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "pixels differ" in msg, msg
 

@@ -37,7 +37,9 @@ CUBE_DEPTH_ATOL = 1e-3
 CUBE_TEXELS_BAD = 1e-3
 CUBE_VISIBILITY_ATOL = 1e-6
 CUBE_VISIBILITY_BAD = 1e-3
-CUBE_DEPTH_LABEL = "glsl_cube_depth_maps (shaders/cube_depth.vert + shaders/cube_depth.frag, the cube pass from the light)"
+CUBE_DEPTH_LABEL = (
+    "glsl_cube_depth_maps (shaders/cube_depth.vert + shaders/cube_depth.frag, the cube pass from the light)"
+)
 CUBE_SHADOW_LABEL = "glsl_point_shadow_visibility (shaders/cube_shadow.frag, the cube lookup's fragment stage)"
 FACES = ("+x", "-x", "+y", "-y", "+z", "-z")
 
@@ -72,22 +74,23 @@ def expect_cube_maps(label: str, got, expected) -> None:
         return
 
     def where(mask):
+        """The first bad texel, as text, and the picture of its face."""
         f, r, c = (int(i) for i in np.argwhere(mask)[0])
-        picture = failure_picture(f"{label}, face {f} ({FACES[f]})", g[f], e[f], name="D", atol=CUBE_DEPTH_ATOL)
-        return f, r, c, f"face {f} ({FACES[f]}) D[{r}, {c}] expected {format_vec(e[f, r, c])}, got {format_vec(g[f, r, c])}", picture
+        at = f"face {f} ({FACES[f]}) D[{r}, {c}] expected {format_vec(e[f, r, c])}, got {format_vec(g[f, r, c])}"
+        return at, failure_picture(f"{label}, face {f} ({FACES[f]})", g[f], e[f], name="D", atol=CUBE_DEPTH_ATOL)
 
     if nan.any():
-        f, r, c, at, picture = where(nan)
+        at, picture = where(nan)
         raise Mismatch(f"{label}: {at} (NaN: the fragment stage, cube_depth.frag, wrote NaN)", picture)
     if coverage.mean() > CUBE_TEXELS_BAD or depth_bad.sum() <= coverage.sum():
-        f, r, c, at, picture = where(coverage)
+        at, picture = where(coverage)
         raise Mismatch(
             f"{label}: {at}; {int(coverage.sum())} of {coverage.size} texels are covered in one map and empty in "
             f"the other: the vertex stage (cube_depth.vert: gl_Position = lightSpaceMatrix (position, 1)) places "
             f"the scene wrongly, or cube_depth.frag culls the wrong faces (cull 1 = front: gl_FrontFacing, 2 = back)",
             picture,
         )
-    f, r, c, at, picture = where(depth_bad)
+    at, picture = where(depth_bad)
     raise Mismatch(
         f"{label}: {at}; the covered texels are right but {int(depth_bad.sum())} depths differ by more than "
         f"{CUBE_DEPTH_ATOL:g}: the fragment stage (cube_depth.frag) must write the linear depth "
