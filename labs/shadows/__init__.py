@@ -1,7 +1,8 @@
 """Lab "shadows": shadow mapping for directional, spot and point lights, with bias, culling, frustum handling and PCF."""
 
 # ruff: noqa: F403 (the package re-exports what its modules export)
-from . import cubemap, depth, glsl, lights, lookup, options, scene, shading, truth
+from . import cube_glsl, cubemap, depth, glsl, lights, lookup, options, scene, shading, truth
+from .cube_glsl import *
 from .cubemap import *
 from .depth import *
 from .glsl import *
@@ -16,7 +17,7 @@ from .truth import *
 _MODULE_ONLY = {"check_shadow_map", "as_camera", "as_light", "LightSetup"}
 __all__ = [
     name
-    for module in (lights, depth, lookup, options, cubemap, scene, shading, truth, glsl)
+    for module in (lights, depth, lookup, options, cubemap, scene, shading, truth, glsl, cube_glsl)
     for name in module.__all__
     if name not in _MODULE_ONLY
 ]

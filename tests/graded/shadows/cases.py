@@ -436,3 +436,8 @@ def _point_inputs(size, seed, n=400, near=0.2, far=12.0, prefix=""):
 from .cases_glsl import STORED as _GLSL_STORED  # noqa: E402
 
 STORED += _GLSL_STORED
+
+# The point light's GLSL route (tasks 11-12): cases_cube_glsl.py.
+from .cases_cube_glsl import STORED as _CUBE_GLSL_STORED  # noqa: E402
+
+STORED += _CUBE_GLSL_STORED

@@ -160,3 +160,8 @@ CASES = [
 from .cases_glsl import STORED_HIDDEN as _GLSL_STORED  # noqa: E402
 
 STORED += _GLSL_STORED
+
+# The point light's GLSL route, hidden (tasks 11-12): cases_cube_glsl.py.
+from .cases_cube_glsl import STORED_HIDDEN as _CUBE_GLSL_STORED  # noqa: E402
+
+STORED += _CUBE_GLSL_STORED

@@ -18,6 +18,8 @@ TASKS = {
     "pcf_visibility": (7,),
     "glsl_depth_map": (9,),
     "glsl_shadow_visibility": (10,),
+    "glsl_cube_depth_maps": (11,),
+    "glsl_point_shadow_visibility": (12,),
 }
 TITLES = {
     1: "light matrix",
@@ -30,6 +32,8 @@ TITLES = {
     8: "cube map",
     9: "light pass",
     10: "fragment shadow test",
+    11: "cube light pass",
+    12: "cube shadow lookup",
 }
 #: The shadow test of one receiver point, in task order.
 _VISIBILITY = (
@@ -61,4 +65,13 @@ COMPOSITES = {
     "light_visibility": _ALL,
     "render_with_shadows": _ALL,
     "shadow_report": _ALL,
+    "cube_distance_maps": ("depth_map", "cull_faces", "cube_light_matrices"),
+    "linear_point_shadow_visibility": (
+        "compare_depth",
+        "light_uvz",
+        "pcf_visibility",
+        "cube_face_index",
+        "cube_light_matrices",
+    ),
+    "glsl_cube_depth_maps": ("cube_light_matrices",),
 }

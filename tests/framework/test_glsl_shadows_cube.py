@@ -1,0 +1,187 @@
+"""The point light's cube shaders (tasks 11-12: cube_depth.vert, cube_depth.frag, cube_shadow.frag) keep the
+relief route's guarantees (issue 27): a shader that does not compile names its file, line and task; NaN and a
+wrong stage fail the shader's own check with the pass and stage named; a broken shader costs only its own
+task's tests; a hang is named with its task; the stubs are the solutions with ``#error`` directives."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from geomlib.grading import shader_watch
+from geomlib.grading.errors import GradingFailure, Mismatch
+from geomlib.grading.sandbox import LabProxy
+from geomlib.grading.stubs import make_stub
+from tests.graded.shadows.support import small_scene
+
+from .course import planted_solution
+
+COURSE = Path(__file__).resolve().parents[2]
+SHADERS = COURSE / "solutions" / "shadows" / "shaders"
+TASK = {"cube_depth.vert": 11, "cube_depth.frag": 11, "cube_shadow.frag": 12}
+LIGHT = {"position": np.array([0.2, -0.3, 2.6]), "near": 0.2, "far": 12.0}
+
+
+def _replace(path: Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
+    path.write_text(text.replace(old, new))
+
+
+def _edit(shader: str, old: str, new: str):
+    return lambda dest: _replace(dest / "shaders" / shader, old, new)
+
+
+def _line_of(shader: str, text: str) -> int:
+    return next(i for i, ln in enumerate((SHADERS / shader).read_text().splitlines(), start=1) if text in ln)
+
+
+def _depth_inputs():
+    V, F = small_scene()
+    return {"V": V, "F": F, **LIGHT, "size": 8, "cull": "front"}
+
+
+def _shadow_inputs():
+    P = np.array([[0.0, 0.0, 0.0], [1.0, -0.6, 1.0], [2.5, 2.5, 0.0]])
+    return {"P": P, "N": np.tile([0.0, 0.0, 1.0], (3, 1)), "maps": np.ones((6, 8, 8)), **LIGHT, "pcf": 3}
+
+
+@pytest.mark.parametrize(
+    ("shader", "function", "inputs", "needle", "typo", "stage"),
+    [
+        ("cube_depth.vert", "glsl_cube_depth_maps", _depth_inputs, "gl_Position = lightSpaceMatrix * vec4(position, 1.0);",
+         "lightSpaceMatrix", " \\(vertex shader\\)"),
+        ("cube_depth.frag", "glsl_cube_depth_maps", _depth_inputs,
+         "result = vec4(length(world - lightPos) / far, 1.0, 0.0, 1.0);", "lightPos", ""),
+        ("cube_shadow.frag", "glsl_point_shadow_visibility", _shadow_inputs, "float depth = length(d) / far - bias;",
+         "bias", ""),
+    ],
+)  # fmt: skip
+def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, stage):
+    line = _line_of(shader, needle)
+    dest = planted_solution("shadows", _edit(shader, needle, needle.replace(typo, typo + "_misspelt", 1)))
+    try:
+        with pytest.raises(GradingFailure) as e:
+            LabProxy("shadows", dest, timeout=180).call(function, **inputs())
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    first = str(e.value).splitlines()[0]
+    m = re.match(
+        rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage} did not compile, line (\d+)",
+        first,
+    )
+    assert m, first
+    assert int(m.group(1)) == line, (first, line)
+    assert "_misspelt" in first and "cube_glsl.py" not in first, first
+
+
+def _fail_of(edit, check: str, *args) -> str:
+    """The Mismatch message of the graded check ``check`` (test_shadows_cube_glsl) on a planted copy."""
+    from tests.graded.shadows import test_shadows_cube_glsl
+
+    dest = planted_solution("shadows", edit)
+    try:
+        with pytest.raises(Mismatch) as e:
+            getattr(test_shadows_cube_glsl, check)(LabProxy("shadows", dest, timeout=180), *args)
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    return str(e.value)
+
+
+def test_nan_from_the_cube_lookup_is_named():
+    old = "return lit / float(pcf * pcf);"
+    msg = _fail_of(_edit("cube_shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));"), "check_glsl_cube_shadow",
+                   "glsl-cube-eye-pcf3")  # fmt: skip
+    assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "NaN" in msg, msg
+
+
+def test_nan_from_the_cube_pass_is_named():
+    old = "result = vec4(length(world - lightPos) / far, 1.0, 0.0, 1.0);"
+    new = "result = vec4(sqrt(-1.0 - length(world)), 1.0, 0.0, 1.0);"
+    msg = _fail_of(_edit("cube_depth.frag", old, new), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")
+    assert "the cube pass from the light" in msg and "NaN" in msg and "cube_depth.frag" in msg, msg
+
+
+def test_a_wrong_vertex_stage_is_named():
+    old = "gl_Position = lightSpaceMatrix * vec4(position, 1.0);"
+    msg = _fail_of(_edit("cube_depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
+                   "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
+    assert "the vertex stage (cube_depth.vert" in msg and "covered in one map and empty" in msg, msg
+
+
+@pytest.mark.parametrize(
+    "wrong",
+    ["gl_FragCoord.z", "length(world - lightPos)", "length(world) / far"],
+    ids=["window-depth", "not-over-far", "distance-to-origin"],
+)
+def test_a_wrong_fragment_stage_is_named(wrong):
+    """Window depth instead of linear depth, the distance not divided by far, the distance to the origin."""
+    old = "result = vec4(length(world - lightPos) / far, 1.0, 0.0, 1.0);"
+    msg = _fail_of(_edit("cube_depth.frag", old, f"result = vec4({wrong}, 1.0, 0.0, 1.0);"),
+                   "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
+    assert "the fragment stage (cube_depth.frag) must write the linear depth" in msg, msg
+
+
+def test_a_wrong_world_position_from_the_vertex_stage_is_caught():
+    msg = _fail_of(_edit("cube_depth.vert", "world = position;", "world = gl_Position.xyz;"),
+                   "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
+    assert "cube_depth.frag) must write the linear depth" in msg and "`world`" in msg, msg
+
+
+def test_missing_culling_is_caught():
+    old = "if ((cull == 1 && gl_FrontFacing) || (cull == 2 && !gl_FrontFacing)) {"
+    msg = _fail_of(
+        _edit("cube_depth.frag", old, "if (false) {"), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front"
+    )
+    assert 'cull="front"' in msg and "cube_depth.frag" in msg, msg
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "case"),
+    [
+        ("sctc = vec2(-d.x, -d.y);", "sctc = vec2(d.x, -d.y);", "glsl-cube-eye-defaults"),  # -z face mirrored
+        ("sctc = vec2(d.x, d.z);", "sctc = vec2(d.x, -d.z);", "glsl-cube-eye-pcf3"),  # +y face upside down
+        ("int row = int(size) - 1 - int(floor(st.y * size));", "int row = int(floor(st.y * size));",
+         "glsl-cube-eye-defaults"),  # no row flip
+        ("return 2 * a + (d[a] < 0.0 ? 1 : 0);", "return 2 * a;", "glsl-cube-eye-defaults"),  # the axis' sign ignored
+        ("if (ma > far) {", "if (false) {", "glsl-cube-eye-short-far"),  # beyond the far plane read as shadowed
+    ],
+    ids=["mirrored-face", "flipped-face", "no-row-flip", "no-sign", "no-far-fix"],
+)  # fmt: skip
+def test_a_wrong_lookup_is_caught(old, new, case):
+    msg = _fail_of(_edit("cube_shadow.frag", old, new), "check_glsl_cube_shadow", case)
+    assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "pixels differ" in msg, msg
+
+
+def test_a_broken_cube_lookup_costs_only_its_own_tests():
+    """cube_shadow.frag that does not compile: the cube pass's check, and Task 10's, still pass on the same copy."""
+    from tests.graded.shadows import test_shadows_cube_glsl, test_shadows_glsl
+
+    dest = planted_solution("shadows", _edit("cube_shadow.frag", "ma = ad[a];", "ma = ad[a]"))
+    try:
+        lab = LabProxy("shadows", dest, timeout=180)
+        test_shadows_cube_glsl.check_glsl_cube_depth(lab, "glsl-cube-linear-b-48-none")
+        test_shadows_glsl.check_glsl_shadow(lab, "glsl-eye-ortho-defaults")
+        with pytest.raises(GradingFailure, match=r"shaders/cube_shadow.frag \(Task 12"):
+            test_shadows_cube_glsl.check_glsl_cube_shadow(lab, "glsl-cube-eye-defaults")
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+
+
+@pytest.mark.parametrize("shader", ["cube_depth.frag", "cube_shadow.frag"])
+def test_a_hanging_shader_is_named_with_its_task(shader):
+    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / "shadows"])
+    assert f"shaders/{shader} (Task {TASK[shader]} (" in msg and "a loop that does not end" in msg, msg
+
+
+@pytest.mark.parametrize("shader", list(TASK))
+def test_the_stubs_are_the_solutions_with_error_directives(shader):
+    solution = (SHADERS / shader).read_text()
+    stub = (COURSE / "labs" / "shadows" / "shaders" / shader).read_text()
+    assert stub == make_stub(solution, f"shaders/{shader}")
+    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
+    assert errors and all(e.startswith(f"#error Task {TASK[shader]} (") for e in errors), errors
