@@ -193,6 +193,15 @@ def _draw(s: Surface, o: RenderOptions, where: str) -> np.ndarray:
         )
     else:
         img = col.astype(np.float32)
+    if o.highlight_lines is not None:
+        segs = as_array(o.highlight_lines, "highlight_lines", shape=(None, 2, 3), where=where)
+        if len(segs):
+            X = (segs.reshape(-1, 3) - fr.c0) / fr.s0
+            img = overlay(
+                img, np.asarray(depth), fr.pose, chk.fov, fr.znear, fr.diag, V=X,
+                edges=np.arange(len(X)).reshape(-1, 2), wire_color=_as_rgb(o.line_color, "line_color", where),
+                line_px=float(o.line_width) * ss, wire_opacity=1.0, points=None, point_color=chk.point_rgb, point_px=0.0,
+            )  # fmt: skip
     if ss > 1:  # box filter: sum the ss*ss sub-pixel grids
         acc = np.zeros((h, w, 3), dtype=np.float32)
         for i in range(ss):
