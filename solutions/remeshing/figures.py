@@ -38,6 +38,8 @@ LAB = "remeshing"
 #: valence colours: blue below the target, grey at it, red above (target 6 inside, 4 on the boundary)
 LOW, SIX, HIGH = np.array([0.25, 0.45, 0.95]), np.array([0.82, 0.82, 0.82]), np.array([0.95, 0.3, 0.25])
 VALENCE_TITLE = "vertices coloured by valence: blue below 6, grey 6, red above"
+#: the target valences: inside and on the boundary
+TARGET_INSIDE, TARGET_BOUNDARY = 6, 4
 #: boundary vertices (black, apart from the valence colours) and feature lines (green)
 BOUNDARY, FEATURE = (0.05, 0.05, 0.05), (0.05, 0.6, 0.2)
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error vanishes
@@ -163,7 +165,7 @@ def _summary(q: dict) -> str:
 def valence_colors(V, F) -> np.ndarray:
     """Per-vertex colours: :data:`LOW` below the target valence, :data:`SIX` at it, :data:`HIGH` above."""
     H = topology.halfedge_mesh(np.asarray(F), len(V))
-    d = H.valence - np.where(H.boundary_vertex, 4, 6)
+    d = H.valence - np.where(H.boundary_vertex, TARGET_BOUNDARY, TARGET_INSIDE)
     return np.where(d[:, None] < 0, LOW, np.where(d[:, None] > 0, HIGH, SIX))
 
 
@@ -367,13 +369,14 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
         "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
         "jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
         "iterations) with preserve_boundary True and False. Boundary vertices are black dots, every vertex "
-        "coloured by valence against its target (6 inside, 4 on the boundary: blue below, grey at, red above). "
+        "coloured by valence against its target ({inside} inside, {boundary} on the boundary: blue below, grey at, red "
+        "above). "
         "Preserved, the boundary stays on the input's boundary line (its vertices at most {off_kept:.2g} from it, "
         "the model being {diag:.2f} across) and is only respaced (length {len_kept:.2f} against {length:.2f}); not "
         "preserved, it is relaxed like the interior and leaves the line (up to {off_free:.2g}), and the opening "
         "shrinks (length {len_free:.2f}).",
         L=L, its=its, off_kept=offsets[True][0], off_free=offsets[False][0], diag=diag, len_kept=offsets[True][1],
-        len_free=offsets[False][1], length=length,
+        len_free=offsets[False][1], length=length, inside=TARGET_INSIDE, boundary=TARGET_BOUNDARY,
     )  # fmt: skip
 
 
