@@ -266,7 +266,7 @@ def fig_bricks(out: Path, quick: bool) -> Drawn:
         line = np.c_[x, np.full(m, g.origin[1] + k * g.spacing), np.full(m, zc)]
         dense = g.sample(line) / g.spacing
         bricked = B.sample(line) / g.spacing
-        w = occ_img.shape[0] + 120
+        w = max(occ_img.shape[0] + 120, 360)  # the quick figure's plots stay readable
         prof = line_plot(
             [x, x, x], [dense, np.clip(dense, -band, band), bricked],
             ["float grid (trilinear)", "clamped to the band +-r", "8-bit bricks"],
