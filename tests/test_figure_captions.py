@@ -17,9 +17,7 @@ from geomlib.labfigures import Claims
 
 #: Figures whose captions are still typed text with numbers in it, per lab (file names).
 NOT_YET: dict[str, set[str]] = {
-    "simplification": {"series.png", "error_vs_faces.png", "pairs.png", "boundary.png", "simplification_3d.html"},
-    "remeshing": {"before_after.png", "operations.png", "iterations.png", "features.png", "boundary.png",
-                  "remeshing_3d.html"},
+    "remeshing": {"before_after.png", "iterations.png", "remeshing_3d.html"},
     "denoise": {"lambda_sequence.png", "error_vs_iterations.png", "offset_map.png"},
 }  # fmt: skip
 

@@ -103,3 +103,43 @@ def test_every_caption_states_measured_numbers(lab, drawn, tmp_path):
     assert not converted, (
         f"{lab}: remove {converted} from NOT_YET in tests/test_figure_captions.py: their captions are measured now"
     )
+
+
+#: What a caption's words say about its measured numbers, per lab and figure: the words are typed,
+#: so each claim in them is checked here against the numbers the builder measured (Claims.numbers).
+PROSE: dict[str, dict[str, Callable[[dict], bool]]] = {
+    "sdf": {
+        # the legend's three brick states all occur on this mesh
+        "sdf_bricks.png": lambda n: n["inside"] > 0 and n["outside"] > 0 and n["kept"] > 0 and n["max_err"] <= 0.5,
+        # "the improved variant cuts that overestimate", "the streaks are small next to the error against the truth"
+        "sdf_soft_shadows.png": lambda n: n["ib_mean"] < n["pb_mean"] and n["ib_max"] < n["pb_max"]
+        and n["prof_err"] > 2 * n["pb_max"] and n["better"] == sum(n[f"i{i}"] < n[f"e{i}"] for i in range(3)),
+        "sdf_normals.png": lambda n: n["mean4"] > 10 * n["mean6"],  # "first- against second-order"
+    },
+    "simplification": {
+        "error_vs_faces.png": lambda n: n["b_lo"] > 1.0,  # the shortest-edge baseline is worse everywhere
+        "boundary.png": lambda n: n["off_kept"] < 0.1 * n["off_free"],  # the outline is kept, not cut
+        "series.png": lambda n: n["m0"] < n["m1"] < n["m2"] and n["s0"] < n["s1"] < n["s2"],
+    },
+    "remeshing": {
+        "operations.png": lambda n: (n["split"], n["collapse"], n["flip"]) == (n["faces"] + 2, n["faces"] - 2, n["faces"]),
+        "features.png": lambda n: n["kept"] < n["free"],  # keeping the features keeps the surface closer
+        # preserved: on the line and respaced; not preserved: off the line and the opening shrinks
+        "boundary.png": lambda n: n["off_kept"] < 1e-6 * n["diag"] < n["off_free"] and n["len_free"] < n["length"],
+    },
+}  # fmt: skip
+
+
+@pytest.mark.slow
+@pytest.mark.render
+@pytest.mark.parametrize("lab", sorted(PROSE))
+def test_caption_words_agree_with_the_measured_numbers(lab, drawn):
+    made = {f.path.name: f for f in drawn(lab)}
+    wrong = []
+    for name, holds in PROSE[lab].items():
+        claims = made[name].claims
+        if claims is None:
+            wrong.append(f"{name}: the caption has no measured numbers")
+        elif not holds(claims.numbers):
+            wrong.append(f"{name}: the caption's words do not hold for its numbers {claims.numbers}")
+    assert not wrong, f"{lab}:\n" + "\n".join(wrong)

@@ -20,7 +20,7 @@ from geomlib.render.options import RenderOptions, _as_rgb, _as_texture, check_op
 from geomlib.render.overlay import auto_wire_opacity, overlay
 from geomlib.render.scene import Surface, add_floor, add_surface, normalised_frame
 from geomlib.render.shading import vertex_normals
-from geomlib.validate import MeshError, as_array, check_choice, check_mesh, check_polygon_mesh
+from geomlib.validate import MeshError, as_array, check_choice, check_float, check_mesh, check_polygon_mesh
 
 __all__ = ["render", "render_polygons"]
 
@@ -132,6 +132,11 @@ render_polygons.__doc__ += _RETURNS
 
 def _draw(s: Surface, o: RenderOptions, where: str) -> np.ndarray:
     chk = check_options(o, where)
+    lines = None
+    if o.highlight_lines is not None:
+        lines = as_array(o.highlight_lines, "highlight_lines", shape=(None, 2, 3), where=where)
+        line_rgb = _as_rgb(o.line_color, "line_color", where)
+        line_px = check_float(o.line_width, "line_width", positive=True, where=where)
     if isinstance(o.light, str):
         check_choice(o.light, "light", ("directional", "spot"), where=where)
         specs = None
@@ -193,6 +198,13 @@ def _draw(s: Surface, o: RenderOptions, where: str) -> np.ndarray:
         )
     else:
         img = col.astype(np.float32)
+    if lines is not None and len(lines):
+        X = (lines.reshape(-1, 3) - fr.c0) / fr.s0  # into the normalised frame, as the mesh
+        img = overlay(
+            img, np.asarray(depth), fr.pose, chk.fov, fr.znear, fr.diag, V=X,
+            edges=np.arange(len(X)).reshape(-1, 2), wire_color=line_rgb, line_px=line_px * ss, wire_opacity=1.0,
+            points=None, point_color=chk.point_rgb, point_px=0.0,
+        )  # fmt: skip
     if ss > 1:  # box filter: sum the ss*ss sub-pixel grids
         acc = np.zeros((h, w, 3), dtype=np.float32)
         for i in range(ss):

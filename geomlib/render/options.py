@@ -69,6 +69,13 @@ class RenderOptions:
         Colour of the dots.
     point_radius : float
         Dot radius in output pixels.
+    highlight_lines : (k, 2, 3) array_like, optional
+        Line segments (world positions of their two ends, need not be mesh edges) drawn
+        depth-tested on top, e.g. an outline or the sharp edges of another mesh.
+    line_color : RGB in [0, 1]
+        Colour of ``highlight_lines``.
+    line_width : float
+        Width of ``highlight_lines`` in pixels.
     camera : str or (eye, target, up) or (4, 4) array
         A view of :data:`geomlib.camera.VIEWS` framing the mesh (see
         :func:`geomlib.render.camera_pose`), a look-at triple, or a camera-to-world pose (camera
@@ -131,6 +138,9 @@ class RenderOptions:
     highlight_points: object = None
     point_color: object = (0.90, 0.12, 0.10)
     point_radius: float = 3.5
+    highlight_lines: object = None
+    line_color: object = (0.05, 0.55, 0.25)
+    line_width: float = 2.5
     camera: object = "three_quarter"
     fov_deg: float = 35.0
     size: tuple[int, int] = (640, 480)

@@ -38,6 +38,10 @@ LAB = "remeshing"
 #: valence colours: blue below the target, grey at it, red above (target 6 inside, 4 on the boundary)
 LOW, SIX, HIGH = np.array([0.25, 0.45, 0.95]), np.array([0.82, 0.82, 0.82]), np.array([0.95, 0.3, 0.25])
 VALENCE_TITLE = "vertices coloured by valence: blue below 6, grey 6, red above"
+#: the target valences: inside and on the boundary
+TARGET_INSIDE, TARGET_BOUNDARY = 6, 4
+#: boundary vertices (black, apart from the valence colours) and feature lines (green)
+BOUNDARY, FEATURE = (0.05, 0.05, 0.05), (0.05, 0.6, 0.2)
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error vanishes
 
 
@@ -161,7 +165,7 @@ def _summary(q: dict) -> str:
 def valence_colors(V, F) -> np.ndarray:
     """Per-vertex colours: :data:`LOW` below the target valence, :data:`SIX` at it, :data:`HIGH` above."""
     H = topology.halfedge_mesh(np.asarray(F), len(V))
-    d = H.valence - np.where(H.boundary_vertex, 4, 6)
+    d = H.valence - np.where(H.boundary_vertex, TARGET_BOUNDARY, TARGET_INSIDE)
     return np.where(d[:, None] < 0, LOW, np.where(d[:, None] > 0, HIGH, SIX))
 
 
@@ -280,14 +284,16 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
         imgs, caps = [render(V, F, **kw)], [f"input: {len(F)} faces; sharp_edges: not implemented yet"]
     else:
         sharp = np.asarray(sharp)
-        imgs = [render(V, F, highlight_points=np.unique(sharp), **kw)]
-        caps = [f"input: {len(F)} faces; the {len(sharp)} edges sharper than {angle:.0f}° marked at their ends"]
+        imgs = [render(V, F, highlight_lines=V[sharp], line_color=FEATURE, **kw)]
+        caps = [f"input: {len(F)} faces; the {len(sharp)} edges sharper than {angle:.0f}° in green"]
+    lines = None if sharp is None else V[sharp]  # the input's sharp edges, over both results
     for r, e, what in zip(results, errs, (f"feature_angle={angle:.0f}", "feature_angle=None"), strict=True):
         if r is None:
             imgs.append(_blank(size))
             caps.append(f"{what}: not implemented yet")
             continue
-        imgs.append(render(*r, face_colors=heat_colors(e, 0, vmax, CMAP), **kw))
+        imgs.append(render(*r, face_colors=heat_colors(e, 0, vmax, CMAP), highlight_lines=lines, line_color=FEATURE,
+                           line_width=1.5, **kw))  # fmt: skip
         caps.append(
             f"{what}: {len(r[1])} faces, min angle {quality(*r)['min_angle']:.1f}°; "
             f"faces off the input by up to {e.max():.2f}%"
@@ -296,17 +302,20 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
     if any(e is not None for e in errs):  # the bar of the heat maps, when there are any
         bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
         grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
-    return Drawn(
+    if missing.caption_head() or sharp is None:
+        return Drawn(grid, missing.caption_head() + "A block with sharp edges remeshed with and without them kept.")
+    return Drawn.claimed(
         grid,
-        missing.caption_head()
-        + "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its edges "
-        f"sharper than {angle:.0f}° (sharp_edges) have their ends marked. Then isotropic_remesh to L = {L} "
-        f"({its} iterations) with feature_angle = {angle:.0f} and without: each face is coloured by the distance of "
-        "its centroid from the input surface, in % of the bounding-box diagonal (one scale for both, the bar on "
-        "the right). With the features kept, the corners stay put and the vertices of the sharp edges on the "
-        "input's edges, so what is left is the sag of flat faces under the curved top; without, the faces cut "
-        "across the sharp edges and round the corners.",
-    )
+        "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its {n_sharp} "
+        "edges sharper than {angle:.0f} degrees (sharp_edges) drawn in green, on the input and over both results. "
+        "Then isotropic_remesh to L = {L} ({its} iterations) with feature_angle = {angle:.0f} and without: each face "
+        "is coloured by the distance of its centroid from the input surface, in % of the bounding-box diagonal "
+        "(one scale for both, the bar on the right; at most {kept:.2f}% and {free:.2f}%). With the features kept, "
+        "the corners stay put and the vertices of the sharp edges on the input's edges, so what is left is the "
+        "sag of flat faces under the curved top; without, the faces cut across the green lines and round the "
+        "corners.",
+        n_sharp=len(sharp), angle=angle, L=L, its=its, kept=float(errs[0].max()), free=float(errs[1].max()),
+    )  # fmt: skip
 
 
 def _boundary_offset(U, G, A, B) -> tuple[int, float, float]:
@@ -332,8 +341,10 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
     E = topology.boundary_edges(F)
     A, B = V[E[:, 0]], V[E[:, 1]]
     length = float(np.linalg.norm(B - A, axis=1).sum())
+    kw["point_color"] = BOUNDARY  # not the valence red
     imgs = [render(V, F, colors=valence_colors(V, F), highlight_points=np.unique(E), **kw)]
-    caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (dots), boundary length {length:.2f}"]
+    caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (black dots), boundary length {length:.2f}"]
+    offsets = {}
     missing = MissingTasks()  # tasks whose panels are left blank
     for keep in (True, False):
         r = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
@@ -342,31 +353,66 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
             caps.append(f"preserve_boundary={keep}: not implemented yet")
             continue
         nb, off, ln = _boundary_offset(*r, A, B)
+        offsets[keep] = (off, ln)
         dots = np.unique(topology.boundary_edges(r[1]))
         imgs.append(render(*r, colors=valence_colors(*r), highlight_points=dots, **kw))
         caps.append(
-            f"preserve_boundary={keep}: {len(r[1])} faces, {nb} boundary vertices, at most {100 * off / diag:.2f}% "
-            f"of the diagonal from the input boundary; length {ln:.2f}"
+            f"preserve_boundary={keep}: {len(r[1])} faces, {nb} boundary vertices, at most {off:.2g} "
+            f"({100 * off / diag:.2g}% of the diagonal) from the input boundary; length {ln:.2f}"
         )
     title = f"An open surface remeshed to L = {L}; valence: blue below the target (6, on the boundary 4), grey at it, red above"
     img = panels(imgs, caps, ncols=3, title=title)
-    return Drawn(
+    if missing.caption_head():
+        return Drawn(img, missing.caption_head() + "An open surface remeshed with its boundary preserved or not.")
+    return Drawn.claimed(
         img,
-        missing.caption_head()
-        + "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
-        f"jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
-        "iterations) with preserve_boundary True and False. Boundary vertices are dotted, every vertex coloured "
-        "by valence against its target (6 inside, 4 on the boundary). The captions give how far the boundary "
-        "vertices are from the input's boundary line and the boundary's length: preserved, the boundary stays on "
-        "that line and is only respaced; not preserved, it is relaxed like the interior, leaves the line and "
-        "the opening shrinks.",
-    )
+        "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
+        "jagged boundary loop), seen from behind into the opening, and isotropic_remesh to L = {L} ({its} "
+        "iterations) with preserve_boundary True and False. Boundary vertices are black dots, every vertex "
+        "coloured by valence against its target ({inside} inside, {boundary} on the boundary: blue below, grey at, red "
+        "above). "
+        "Preserved, the boundary stays on the input's boundary line (its vertices at most {off_kept:.2g} from it, "
+        "the model being {diag:.2f} across) and is only respaced (length {len_kept:.2f} against {length:.2f}); not "
+        "preserved, it is relaxed like the interior and leaves the line (up to {off_free:.2g}), and the opening "
+        "shrinks (length {len_free:.2f}).",
+        L=L, its=its, off_kept=offsets[True][0], off_free=offsets[False][0], diag=diag, len_kept=offsets[True][1],
+        len_free=offsets[False][1], length=length, inside=TARGET_INSIDE, boundary=TARGET_BOUNDARY,
+    )  # fmt: skip
 
 
-def _new_edge_ends(G, F) -> np.ndarray:
-    """Vertices of the edges of ``G`` that ``F`` does not have (the flipped edge)."""
-    old = {tuple(e) for e in topology.unique_edges(F).tolist()}
-    return np.unique([e for e in topology.unique_edges(G).tolist() if tuple(e) not in old])
+def _patch_drawing(U, G, size, *, thick=(), labels=(), dots=()) -> np.ndarray:
+    """A flat patch drawn from above with matplotlib: its edges, ``thick`` edges in red, named points.
+
+    ``thick`` is a list of ``(p, q)`` position pairs, ``labels`` of ``(name, position)``, ``dots`` of
+    positions (drawn as red dots). The patches of the operations figure are planar, so a 2-D drawing
+    shows the letters of the handout's formulas exactly where the vertices are.
+    """
+    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure as MplFigure
+
+    dpi = 100
+    with matplotlib.rc_context({"font.family": "DejaVu Sans", "svg.hashsalt": "geomlib", "path.simplify": False}):
+        fig = MplFigure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi, facecolor="white")
+        canvas = FigureCanvasAgg(fig)
+        ax = fig.add_axes((0.04, 0.04, 0.92, 0.92))
+        ax.triplot(U[:, 0], U[:, 1], G, color=(0.25, 0.3, 0.45), linewidth=0.9)
+        ax.fill(*U[np.unique(G)][:, :2].T, alpha=0)  # keeps the axes limits on the patch
+        for p, q in thick:
+            ax.plot([p[0], q[0]], [p[1], q[1]], color=(0.85, 0.15, 0.1), linewidth=3.2, zorder=3)
+        for p in dots:
+            ax.plot([p[0]], [p[1]], "o", color=(0.85, 0.15, 0.1), markersize=7, zorder=4)
+        for name, p in labels:
+            ax.annotate(name, (p[0], p[1]), xytext=(6, 5), textcoords="offset points", fontsize=15,
+                        fontweight="bold", color=(0.1, 0.1, 0.1), zorder=5)  # fmt: skip
+        lo, hi = U[:, :2].min(axis=0), U[:, :2].max(axis=0)
+        pad = 0.06 * float((hi - lo).max())
+        ax.set_xlim(lo[0] - pad, hi[0] + pad)
+        ax.set_ylim(lo[1] - pad, hi[1] + pad)
+        ax.set_aspect("equal")
+        ax.axis("off")
+        canvas.draw()
+        return np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
 
 
 @figure_name("operations")
@@ -378,42 +424,60 @@ def fig_operations(out: Path, R, quick: bool) -> Drawn:
     diagonal = (V[H.E[:, 0], :2] != V[H.E[:, 1], :2]).all(axis=1)
     e = int(np.flatnonzero(inside & diagonal)[0])
     a, b = (int(i) for i in H.E[e])
-    mid = 0.5 * (V[a] + V[b])
-    size = (200, 200) if quick else (260, 260)
-    kw = dict(camera="top", size=size, supersample=_ss(quick), wireframe=True, flat=True)
+    # c: opposite the edge in the face (a, b, c), d: in the face (b, a, d), as in the flip's docstring
+    c = d = None
+    for f in F[(F == a).any(axis=1) & (F == b).any(axis=1)]:
+        k = int(np.flatnonzero(f == a)[0])
+        if f[(k + 1) % 3] == b:
+            c = int(f[(k + 2) % 3])
+        else:
+            d = int(f[(k + 1) % 3])
+    pa, pb, pc, pd = V[a], V[b], V[c], V[d]
+    mid = 0.5 * (pa + pb)
+    size = (240, 240) if quick else (300, 300)
     missing = MissingTasks()  # tasks whose panels are left blank
-    imgs, caps = [render(V, F, highlight_points=[a, b], **kw)], [f"patch, edge ({a}, {b}) marked"]
-    for name, op, mark in (
-        ("split_edge", R.split_edge, "new vertex marked"),
-        ("collapse_edge", R.collapse_edge, "merged vertex marked"),
-        ("flip_edge", R.flip_edge, "new edge marked"),
-    ):
+    names = [("a", pa), ("b", pb), ("c", pc), ("d", pd)]
+    imgs = [_patch_drawing(V, F, size, thick=[(pa, pb)], labels=names)]
+    caps = [f"{len(F)} faces; the edge a-b in red, c and d opposite it"]
+    faces = {}
+    for name, op in (("split_edge", R.split_edge), ("collapse_edge", R.collapse_edge), ("flip_edge", R.flip_edge)):
         r = missing.attempt(op, V, H, e)
         if r is None:
             imgs.append(_blank(size))
             caps.append(f"{name}: not implemented yet")
             continue
         U, G = np.asarray(r[0], dtype=np.float64), np.asarray(r[1].idx).reshape(-1, 3)
-        if name == "flip_edge":
-            dots = _new_edge_ends(G, F)
+        faces[name] = len(G)
+        if name == "split_edge":
+            draw = dict(thick=[(mid, p) for p in (pa, pb, pc, pd)], dots=[mid], labels=[*names, ("m", mid)])
+            caps.append(f"split_edge: {len(G)} faces; m, the midpoint of a-b, joined to a, b, c, d")
+        elif name == "collapse_edge":
+            draw = dict(dots=[mid], labels=[("m", mid), ("c", pc), ("d", pd)])
+            caps.append(f"collapse_edge: {len(G)} faces; a and b merged at m, faces a-b-c and b-a-d gone")
         else:
-            dots = [int(np.argmin(np.linalg.norm(U - mid, axis=1)))]
-        imgs.append(render(U, G, highlight_points=dots, **kw))
-        caps.append(f"{name}: {len(G)} faces, {mark}")
+            draw = dict(thick=[(pc, pd)], labels=names)
+            caps.append(f"flip_edge: {len(G)} faces; a-b replaced by c-d")
+        imgs.append(_patch_drawing(U, G, size, **draw))
     J = V + 0.08 * np.random.default_rng(1).normal(size=V.shape) * [1, 1, 0] * ~H.boundary_vertex[:, None]
-    imgs.append(render(J, F, **kw))
+    imgs.append(_patch_drawing(J, F, size))
     caps.append("interior vertices jittered")
-    W = missing.attempt(R.tangential_relaxation, J, F)
-    imgs.append(_blank(size) if W is None else render(np.asarray(W), F, **kw))
+    damping = 0.5
+    W = missing.attempt(R.tangential_relaxation, J, F, damping=damping)
+    imgs.append(_blank(size) if W is None else _patch_drawing(np.asarray(W, dtype=np.float64), F, size))
     caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
-    return Drawn(
+    if missing.caption_head():
+        return Drawn(img, missing.caption_head() + "The local operations on the diagonal a-b of a grid patch.")
+    return Drawn.claimed(
         img,
-        missing.caption_head()
-        + "The diagonal of the middle cell of a grid patch (its ends marked) split at its midpoint, collapsed "
-        "(both ends meet at the midpoint) and flipped to the other diagonal; a patch with jittered interior "
-        "vertices before and after one tangential relaxation step (damping 0.5).",
-    )
+        "The diagonal a-b of the middle cell of a grid patch ({faces} faces; c and d are the vertices opposite "
+        "it, in the faces (a, b, c) and (b, a, d), as in the Task 1-3 docstrings) split at its midpoint m "
+        "({split} faces: m joins a, b, c and d), collapsed (a and b meet at m, the two faces of the edge go: "
+        "{collapse} faces) and flipped to the other diagonal c-d ({flip} faces); a patch with jittered interior "
+        "vertices before and after one tangential relaxation step (damping {damping}).",
+        faces=len(F), split=faces["split_edge"], collapse=faces["collapse_edge"], flip=faces["flip_edge"],
+        damping=damping,
+    )  # fmt: skip
 
 
 @figure_name("remeshing_3d")

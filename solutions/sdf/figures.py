@@ -25,10 +25,10 @@ from geomlib.labfigures import (
     missing_panel,
     partial_figure,
 )
-from geomlib.plot import colorbar, heatmap_image, panels
+from geomlib.plot import colorbar, heatmap_image, line_plot, panels
 
 from .analytic import op_difference, op_union, sd_box, sd_capsule, sd_plane, sd_sphere, sd_torus, smooth_union
-from .bricks import EMPTY_INSIDE, compress_bricks
+from .bricks import EMPTY_INSIDE, EMPTY_OUTSIDE, compress_bricks
 from .field import SDFGrid, grid_points
 from .gradient import gradient_central, gradient_tetra
 from .mesh_sdf import sdf_grid
@@ -209,53 +209,105 @@ def fig_slices(out: Path, quick: bool) -> Drawn:
     )
 
 
+def _sphere_grid(quick):
+    """An icosphere of radius 1 on a grid: thick enough for bricks that lie entirely inside the band."""
+    key = ("sphere", quick)
+    if key not in _CACHE:
+        V, F = datasets.icosphere(3, radius=1.0)
+        _CACHE[key] = (V, F, sdf_grid(V, F, 36 if quick else 64))
+    return _CACHE[key]
+
+
+def _brick_lines(img, n, up, colour=(110, 110, 110)):
+    """Draw the brick boundaries (every 7 samples) on a plane image of ``n`` samples drawn ``up`` x ``up``."""
+    for s in range(0, n, 7):
+        p = min(s * up + up // 2, img.shape[0] - 1)
+        img[p, :] = colour
+        img[:, p] = colour
+    return img
+
+
 @figure_name("sdf_bricks")
 def fig_bricks(out: Path, quick: bool) -> Drawn:
     try:
-        V, F, g = _torus_grid(quick)
-        B = compress_bricks(g, band_voxels=4)
+        V, F, g = _sphere_grid(quick)
+        band = 4
+        B = compress_bricks(g, band_voxels=band)
         n = g.shape[0]
-        j = B.table.shape[1] // 2  # the vertical brick layer through the ring's centre (x-z)
-        T = B.table[:, j, :]
-        occ = np.where(T >= 0, 2, np.where(T == EMPTY_INSIDE, 1, 0)).astype(float)
-        cell = 24
-        occ_img = np.repeat(np.repeat(heatmap_image(occ.T[::-1], "viridis", 0, 2), cell, 0), cell, 1)
-        occ_img[::cell] = occ_img[:, ::cell] = 255  # the brick grid
+        # one x-z plane of grid samples for both maps: the middle sample row (y) of the middle brick layer
+        j = B.table.shape[1] // 2
+        k = min(7 * j + 3, n - 1)
+        up = 4
+        # per sample of the plane: the state of the brick that owns it (sample s belongs to brick s // 7)
+        owner = np.minimum(np.arange(n) // 7, B.table.shape[0] - 1)
+        T = B.table[owner][:, j][:, owner]  # (x, z)
+        state = np.where(T >= 0, 2, np.where(T == EMPTY_INSIDE, 1, 0)).astype(float)
+        zero = np.zeros((n, n), bool)
+        s = g.values[:, k, :] < 0
+        zero[:-1] |= s[:-1] != s[1:]
+        zero[:, :-1] |= s[:, :-1] != s[:, 1:]
+
+        def plane(rgb):  # x to the right, z up, drawn up x up, brick lines and the surface on top
+            img = _up(rgb[:, ::-1].transpose(1, 0, 2).copy(), up)
+            img = _brick_lines(img[::-1], n, up)[::-1]
+            img[_up(zero[:, ::-1].T, up)] = (20, 20, 20)
+            return img
+
+        occ_img = plane(heatmap_image(state, "viridis", 0, 2))
         X = grid_points(g.origin, g.spacing, g.shape)
-        err = (B.sample(X) - g.values.ravel()).reshape(g.shape) / B.step
-        band = np.abs(g.values) < B.r
-        # the same x-z plane: the grid samples at the brick layer's middle row of y
-        k = min(int(round((B.table.shape[1] // 2 + 0.5) * (n - 1) / B.table.shape[1])), n - 1)
-        e2 = np.where(band[:, k, :], err[:, k, :], np.nan).T[::-1]
-        up = max(1, (occ_img.shape[0]) // e2.shape[0])
-        err_img = np.repeat(np.repeat(heatmap_image(e2, "RdBu", -0.5, 0.5, nan_color=(255, 255, 255)), up, 0), up, 1)
-        zero = np.abs(g.values[:, k, :].T[::-1]) < 0.5 * g.spacing
-        err_img[np.repeat(np.repeat(zero, up, 0), up, 1)] = (40, 40, 40)
-        dense = g.values.astype(np.float32).nbytes
+        err = (B.sample(X) - np.clip(g.values.ravel(), -B.r, B.r)).reshape(g.shape) / B.step
+        inband = np.abs(g.values) < B.r
+        e2 = np.where(inband[:, k, :], err[:, k, :], np.nan)
+        err_img = plane(heatmap_image(e2, "RdBu", -0.5, 0.5, nan_color=(245, 245, 245)))
+        # a 1-D profile along x through the centre of the plane: the float grid, clamped, and the bricks
+        m = 8 * n
+        x = np.linspace(g.origin[0], g.origin[0] + (n - 1) * g.spacing, m)
+        zc = g.origin[2] + (n // 2) * g.spacing
+        line = np.c_[x, np.full(m, g.origin[1] + k * g.spacing), np.full(m, zc)]
+        dense = g.sample(line) / g.spacing
+        bricked = B.sample(line) / g.spacing
+        w = max(occ_img.shape[0] + 120, 360)  # the quick figure's plots stay readable
+        prof = line_plot(
+            [x, x, x], [dense, np.clip(dense, -band, band), bricked],
+            ["float grid (trilinear)", "clamped to the band +-r", "8-bit bricks"],
+            xlabel="x", ylabel="distance (voxels)", title="along x through the centre", size=(w + 60, w), markers=False,
+        )  # fmt: skip
+        xs = g.origin[0] + np.arange(n) * g.spacing
+        prof_e = line_plot(
+            [xs], [err[:, k, n // 2]], ["bricks - clamped grid"], xlabel="x (grid samples)",
+            ylabel="error (quantisation steps 2r/255)", title="the same line: quantisation error", size=(w + 60, w),
+        )  # fmt: skip
+        dense_bytes = g.values.astype(np.float32).nbytes
         inside = int((B.table == EMPTY_INSIDE).sum())
-        legend = "teal dropped inside (-r), " if inside else ""
+        outside = int((B.table == EMPTY_OUTSIDE).sum())
         caps = [
-            f"bricks of the x-z layer through the centre (white: brick grid): yellow kept, {legend}purple dropped outside (+r)",
-            "quantisation error in steps at the samples of the same plane, inside the band; dark: the surface; white: outside",
+            "bricks owning the samples of one x-z plane (grey lines: brick grid; black: the surface): "
+            "yellow kept, teal dropped inside (-r), purple dropped outside (+r)",
+            "quantisation error in steps at the same samples, inside the band (grey: outside the band)",
+            "distance along the line z = centre of the same plane",
+            "error at the grid samples on that line",
         ]
-        imgs = [occ_img, _with_bar(err_img, -0.5, 0.5, "RdBu", "error / step")]
+        imgs = [occ_img, _with_bar(err_img, -0.5, 0.5, "RdBu", "error / step"), prof, prof_e]
         title = (
-            f"8^3 bricks (7 cells + apron), r = 4 voxels, uint8: {B.nbytes / 1024:.0f} KiB vs dense float32 "
-            f"{dense / 1024:.0f} KiB ({dense / B.nbytes:.1f}x smaller)"
+            f"8^3 bricks (7 cells + apron), r = {band} voxels, uint8: {B.nbytes / 1024:.0f} KiB vs dense float32 "
+            f"{dense_bytes / 1024:.0f} KiB ({dense_bytes / B.nbytes:.1f}x smaller)"
         )
     except NotImplementedError as e:
         imgs, caps, title = [_missing((200, 200), f"Tasks 2-6 ({str(e)[:50]})", e)], [""], "Bricks"
         return Drawn(panels(imgs, caps, title=title), "Which bricks are stored, and the bricked field's error.")
     return Drawn.claimed(
-        panels(imgs, caps, title=title),
-        "Left: which bricks of one brick layer are stored (yellow) and which are dropped because they lie entirely "
-        "more than r outside the surface (purple). Of the {total} bricks, {kept} are kept and {inside} are "
-        "dropped inside: the tube is too thin (radius {tube_vox:.1f} voxels) for a brick to lie entirely more "
-        "than r = {band} voxels inside it. Right: on the same plane, the error of the bricked, 8-bit field at the "
-        "grid samples inside the band, in quantisation steps 2r/255: at most {max_err:.3f} steps over the whole "
-        "grid, within half a step. The title gives the memory against a dense float32 grid.",
-        total=int(B.table.size), kept=len(B.codes), inside=inside, tube_vox=TUBE / float(g.spacing), band=4,
-        max_err=float(np.nanmax(np.abs(err[band]))),
+        panels(imgs, caps, ncols=2, title=title),
+        "A sphere mesh (radius {radius} units, {radius_vox:.1f} voxels) on a {n}^3 grid, cut into bricks of 8^3 "
+        "samples. Top left: the bricks that own the samples of one x-z plane, with the brick grid and the surface: "
+        "of the {total} bricks, {kept} are kept, {inside} are dropped because every sample is at least r = {band} "
+        "voxels inside (read back as -r) and {outside} because every sample is at least r outside (read as +r). "
+        "Top right: on the same plane, the error of the bricked 8-bit field against the float grid clamped to the "
+        "band, in quantisation steps 2r/255: at most {max_err:.3f} steps over the whole grid, within half a step. "
+        "Bottom: one line through the centre of that plane: the float grid's distance, clamped to +-r, and what "
+        "the bricks return (the clamp flattens the field beyond the band, inside and out); the quantisation error "
+        "on that line stays within half a step.",
+        radius=1.0, radius_vox=1.0 / float(g.spacing), n=n, total=int(B.table.size), kept=len(B.codes),
+        inside=inside, outside=outside, band=band, max_err=float(np.nanmax(np.abs(err[inband]))),
     )  # fmt: skip
 
 
@@ -286,18 +338,31 @@ def fig_normals(out: Path, quick: bool) -> Drawn:
             im[hit] = e
             imgs.append(im)
             caps.append(f"{name} ({taps} lookups): mean {e.mean():.2f}°, p99 {np.percentile(e, 99):.2f}°")
-        hi = float(max(np.percentile(e, 99) for e in errs))
-        pics = [heatmap_image(im, "inferno", 0, hi, nan_color=(255, 255, 255)) for im in imgs]
-        pics[-1] = _with_bar(pics[-1], 0, hi, "inferno", "angle error (°)")
+        # one log scale for both: on a linear one the second-order stencil's map is uniformly black
+        lo = float(np.floor(np.log10(max(np.percentile(errs[0], 1), 1e-6))))
+        hi = float(np.ceil(np.log10(max(np.percentile(e, 99) for e in errs))))
+        pics = [
+            heatmap_image(np.log10(np.maximum(im, 10**lo)), "inferno", lo, hi, nan_color=(255, 255, 255)) for im in imgs
+        ]
+        pics[-1] = _with_bar(pics[-1], lo, hi, "inferno", "log10 angle error (°)")
         title = f"Normals from a {n}^3 grid of a torus: angle to the true normal at the sphere-traced hits, h = half a voxel"
     except NotImplementedError as e:
         pics, caps, title = [_missing(size, f"Tasks 6-8 ({str(e)[:50]})", e)], [""], "Gradients"
-    return Drawn(
+        return Drawn(panels(pics, caps, title=title), "Normals of a sampled torus field: 6-tap and 4-tap stencils.")
+    return Drawn.claimed(
         panels(pics, caps, title=title),
         "The angle between the finite-difference normal of a sampled torus field and the exact normal, at every "
-        "sphere-traced hit, same step h for both. The 4-tap tetrahedral stencil needs two thirds of the lookups "
-        "but is only first-order accurate: its error is h times the mixed second derivatives of the field "
-        "(largest where the torus curves diagonally to the grid axes), while central differences are second order.",
+        "sphere-traced hit, same step h for both, on one logarithmic colour scale (10^{lo:.0f} to 10^{hi:.0f} "
+        "degrees). The 4-tap tetrahedral stencil needs two thirds of the lookups but is only first-order accurate "
+        "(mean {mean4:.2f} degrees against {mean6:.2f} for central differences, {ratio:.0f} times larger): its error "
+        "is h times the mixed second derivatives of the field, largest where the torus curves diagonally to the "
+        "grid axes. Central differences are second order: what is left of their error, visible only on the log "
+        "scale, is the grid itself, stripes along the sample planes where the trilinear lookup's slope jumps.",
+        lo=lo,
+        hi=hi,
+        mean4=float(errs[1].mean()),
+        mean6=float(errs[0].mean()),
+        ratio=float(errs[1].mean() / errs[0].mean()),
     )
 
 
@@ -388,6 +453,8 @@ def fig_soft_shadows(out: Path, quick: bool) -> Drawn:
     except NotImplementedError as e:
         page = panels([_missing((200, 200), f"Tasks 2-9 ({str(e)[:50]})", e)], [""], title="Soft shadows")
         return Drawn(page, "Soft shadows of a sphere mesh: the course formula, the improved variant, the truth.")
+    box = _banding_panels(quick, light, up)
+    page = _stack([page, box["page"]])
     worse = sum(numbers[f"i{i}"] > numbers[f"e{i}"] for i in range(len(radii)))
     return Drawn.claimed(
         page,
@@ -397,12 +464,97 @@ def fig_soft_shadows(out: Path, quick: bool) -> Drawn:
         "rays, and the per-pixel error of the formula. The formula drops to zero wherever the ray to the light's "
         "centre is blocked, so its umbra is the hard shadow of the centre and only the outer half of the true "
         "penumbra survives: the error is a ring on the inner penumbra that widens with R (mean {e0:.3f}, {e1:.3f}, "
-        "{e2:.3f}). The improved variant only tightens the estimate (it changes V by at most {dmax:.2f}) and so "
-        "darkens the penumbra a little more: it is closer to the truth in {better} of {rows} rows (mean {i0:.3f}, "
-        "{i1:.3f}, {i2:.3f}). What it is meant to fix (banding when large steps jump past the closest approach, "
-        "see the handout) does not show in this smooth scene.",
-        r0=radii[0], r1=radii[1], r2=radii[2], better=len(radii) - worse, rows=len(radii), **numbers,
+        "{e2:.3f}). The improved variant only tightens the estimate (it changes V by at most {dmax:.2f}), so it "
+        "is closer to the truth in {better} of {rows} rows (mean {i0:.3f}, {i1:.3f}, {i2:.3f}): neither recovers the "
+        "inner penumbra. What it does fix shows on a box, whose sharp edges a march with steps as long as the "
+        "distance skips past (bottom, R = {rb}): the formula's sampled minimum lies above the minimum along the "
+        "whole ray (marched in {fine} small steps), in streaks that follow the march's sample positions (blue, mean "
+        "{pb_mean:.4f}, up to {pb_max:.3f}); the improved variant's estimate of the closest approach between two "
+        "samples cuts that overestimate (mean {ib_mean:.4f}, up to {ib_max:.3f}), undershooting by at most "
+        "{ib_under:.3f} (red). The profile across the box's shadow puts the two errors side by side: the streaks "
+        "are small next to the error of all three estimates against the area-light truth on that line (the "
+        "formula's up to {prof_err:.2f}), which no way of marching recovers.",
+        r0=radii[0], r1=radii[1], r2=radii[2], better=len(radii) - worse, rows=len(radii),
+        **numbers, **box["numbers"],
     )  # fmt: skip
+
+
+#: The box of the banding demonstration: centre and half size (it stands on the ground)
+SHADOW_BOX_C, SHADOW_BOX_H = (0.0, 0.0, 0.8), (0.5, 0.5, 0.5)
+
+
+def _stack(pages):
+    """Stack pictures vertically, centred, on white."""
+    w = max(p.shape[1] for p in pages)
+    out = []
+    for p in pages:
+        left = (w - p.shape[1]) // 2
+        out.append(np.pad(p, ((0, 0), (left, w - p.shape[1] - left), (0, 0)), constant_values=255))
+    return np.concatenate(out, axis=0)
+
+
+def _ray_minimum(field, P, light, R, k):
+    """The course formula's limit: ``min phi(x(t)) / (t tan alpha)`` over ``k`` evenly spaced ``t``, clamped."""
+    L = light - P
+    D = np.linalg.norm(L, axis=1)
+    ldir = L / D[:, None]
+    tan_a = R / np.sqrt(D**2 - R**2)
+    V = np.ones(len(P))
+    for s in np.linspace(0.0, 1.0, k)[1:]:
+        t = 1e-3 * D + s * (D - R - 1e-3 * D)
+        V = np.minimum(V, field(P + t[:, None] * ldir) / (t * tan_a))
+    return np.clip(V, 0.0, 1.0)
+
+
+def _banding_panels(quick, light, up):
+    """The box scene: formula and improved variant against the minimum along the whole ray, and a profile."""
+    c, h = np.array(SHADOW_BOX_C), np.array(SHADOW_BOX_H)
+
+    def field(Q):
+        return np.minimum(sd_box(Q, c, h), Q[:, 2])
+
+    n = 40 if quick else 96
+    xs = np.linspace(-2.0, 2.0, n)
+    X, Y = np.meshgrid(xs, xs, indexing="xy")
+    P = np.c_[X.ravel(), Y.ravel(), np.full(X.size, 1e-3)]
+    R = 1.0
+    fine = 300 if quick else 1500
+    est = soft_shadow(field, P, light, R, max_steps=48)
+    imp = soft_shadow(field, P, light, R, max_steps=48, improved=True)
+    lim = _ray_minimum(field, P, light, R, fine)
+    pics, caps = [], []
+    for v, what in ((est, "course formula"), (imp, "improved"), (lim, f"minimum along the ray\n({fine} small steps)")):
+        im = _up(heatmap_image(v.reshape(n, n)[::-1], "gray", 0, 1), up)
+        im[[0, -1]] = im[:, [0, -1]] = (120, 120, 120)
+        pics.append(im)
+        caps.append(f"box, R = {R}: {what}")
+    s = 0.1
+    for v, what in ((est, "formula"), (imp, "improved")):
+        im = _up(heatmap_image((v - lim).reshape(n, n)[::-1], "RdBu", -s, s), up)
+        pics.append(im)
+        caps.append(f"{what} - minimum along the ray\n(blue: above it, red: below)")
+    pics[-1] = _with_bar(pics[-1], -s, s, "RdBu", "V difference")
+    grid = panels(pics, caps, ncols=5, title="A box: the banding the improved variant removes")
+    # the profile across the box's shadow, with the area-light truth of the same box as a mesh
+    row = int(np.argmin(np.abs(xs - 0.1)))
+    Pr = P[row * n : (row + 1) * n]
+    BV, BF = datasets.sharp_box(tuple(2 * h), 8)
+    truth = mesh_visibility(BV + c, BF, Pr, light, R, n=64 if quick else 512)
+    sel = slice(row * n, (row + 1) * n)
+    prof = line_plot(
+        [xs] * 4, [est[sel], imp[sel], lim[sel], truth],
+        ["course formula", "improved", "minimum along the ray", "Monte-Carlo truth"],
+        xlabel=f"x along y = {xs[row]:.2f}", ylabel="visible fraction V", title="Across the box's shadow",
+        size=(900, 340) if not quick else (600, 300), markers=False,
+    )  # fmt: skip
+    under = np.maximum(lim - imp, 0.0)
+    numbers = {
+        "rb": R, "fine": fine,
+        "pb_mean": float(np.mean(np.abs(est - lim))), "pb_max": float(np.max(np.abs(est - lim))),
+        "ib_mean": float(np.mean(np.abs(imp - lim))), "ib_max": float(np.max(np.abs(imp - lim))),
+        "ib_under": float(under.max()), "prof_err": float(np.max(np.abs(est[sel] - truth))),
+    }  # fmt: skip
+    return {"page": _stack([grid, prof]), "numbers": numbers}
 
 
 def _segment_pixels(a, b, shape, k=24):

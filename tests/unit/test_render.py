@@ -245,6 +245,8 @@ def test_egl_fallback_renders_like_osmesa(tmp_path):
         (dict(uv=np.zeros((3, 2)), texture=np.zeros((8, 8, 3))), r"uv has 3 rows, expected 4"),
         (dict(normals=np.zeros((4, 3))), r"normals: row 0 is the zero vector"),
         (dict(highlight_points=[7]), r"highlight_points has vertex index 7"),
+        (dict(highlight_lines=np.zeros((2, 3))), r"highlight_lines has shape \(2, 3\), expected \(n, 2, 3\)"),
+        (dict(highlight_lines=np.zeros((1, 2, 3)), line_width=0), r"line_width must be > 0"),
         (dict(camera="isometric"), r"camera must be one of"),
         (dict(camera=np.eye(4) * 2), r"rigid camera-to-world"),
         (dict(size=(0, 10)), r"size\[0\] \(width\) must be >= 1"),
@@ -265,6 +267,19 @@ def test_bad_input_raises_mesh_error(change, match):
     V_, F_ = args.pop("V"), args.pop("F")
     with pytest.raises(MeshError, match=match):
         R.render(V_, F_, **args)
+
+
+@pytest.mark.render
+def test_highlight_lines_are_drawn_where_visible(sphere, plain):
+    V, F = sphere
+    green = lambda img: int(((img[..., 1] > 120) & (img[..., 0] < 80) & (img[..., 2] < 120)).sum())  # noqa: E731
+    # a segment over the top of the sphere (the three_quarter view sees it) and one under it (hidden)
+    over = np.array([[[-0.7, 0.0, 1.01], [0.7, 0.0, 1.01]]])
+    under = np.array([[[-0.2, 0.0, -1.01], [0.2, 0.0, -1.01]]])  # behind the sphere from every point of view above
+    img = R.render(V, F, size=SIZE, highlight_lines=over, line_color=(0.0, 0.8, 0.1), line_width=3)
+    hidden = R.render(V, F, size=SIZE, highlight_lines=under, line_color=(0.0, 0.8, 0.1), line_width=3)
+    assert green(plain[0]) == 0 and green(img) >= 40, "a visible highlight line should be drawn in its colour"
+    assert green(hidden) == 0, "a line behind the surface should be hidden by the depth test"
 
 
 @pytest.mark.render
