@@ -29,7 +29,7 @@ VARIABLES: dict[str, str] = {
     "GEOMLIB_ROOT": "the course folder (holding `tests/`, `solutions/`, `labs/`); default: the checkout geomlib is imported from",
     "GEOMLIB_IMPL": "the implementation a notebook's `open_lab` loads (`solutions`, `labs` or a folder); default: the solutions where present, else `labs`",
     "GEOMLIB_TIME_BUDGET": "seconds for a whole grading run (`--time-budget`); later tests fail at once with a message",
-    "GEOMLIB_TIME_LIMIT": "seconds allowed per call into the implementation (`--time-limit`); default each test's own",
+    "GEOMLIB_TIME_LIMIT": "seconds allowed per call into the implementation (`--time-limit`); default each test's own (the test suite, run without `--impl`, sets 300: a limit for hangs)",
     "GEOMLIB_NO_FEEDBACK_PICTURES": "set (non-empty): draw no feedback pictures",
     "GEOMLIB_MAX_FEEDBACK_PICTURES": "at most this many feedback pictures per run (the autograder sets 8)",
     "GEOMLIB_PICTURE_TIME_LIMIT": "seconds one feedback picture may take before it is given up (a limit for hangs; default 20; the test suite sets 300)",
