@@ -75,7 +75,7 @@ __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
 _HELPER = "_geomlib_audit_nothing"
 NOTHING_MODES = ("zeros", "input", "constant")
 #: How many mutants per lab ``--quick`` grades (a fixed, seeded sample).
-QUICK_PER_LAB = 4
+QUICK_PER_LAB = 3
 
 
 class AuditError(ValueError):
@@ -551,11 +551,11 @@ def _glsl_mutants(lab: str, lab_dir: Path, b: _Block, notes: list[str]) -> list[
 
 
 def quick_sample(mutants: list[Mutant], lab: str, n: int = QUICK_PER_LAB) -> list[Mutant]:
-    """A fixed sample (seeded by the lab's name): one does-nothing mutant first, then operators."""
+    """A fixed sample (seeded by the lab's name): does-nothing mutants (half, rounded up), then operators."""
     rng = random.Random(zlib.crc32(lab.encode()))
     nothing = [m for m in mutants if m.kind == "nothing" and m.op == "zeros"]
     ops = [m for m in mutants if m.kind == "operator"]
-    pick = rng.sample(nothing, min(len(nothing), max(1, n // 2)))
+    pick = rng.sample(nothing, min(len(nothing), max(1, (n + 1) // 2)))
     pick += rng.sample(ops, min(len(ops), n - len(pick)))
     order = {m.id: i for i, m in enumerate(mutants)}
     return sorted(pick, key=lambda m: order[m.id])
