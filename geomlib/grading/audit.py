@@ -1180,6 +1180,12 @@ def markdown(report: dict) -> str:
                 out.append(f"- Task {r['task']} `{r['id']}`{what}: `{d}`")
                 if r.get("kept_points"):
                     out.append(f"  kept by: {'; '.join(r['kept_points'][:4])}")
+        elsewhere = [r for r in lr["mutants"] if r.get("killed_by")]
+        if elsewhere:
+            out += ["", f"## {lab}: killed only by the tests of another task that runs the block", ""]
+            out += [
+                f"- Task {r['task']} `{r['id']}`: by {r['killed_by']}'s tests ({r['why'][:120]})" for r in elsewhere
+            ]
         if lr["notes"]:
             out += ["", f"## {lab}: not mutated", ""]
             out += [f"- {n}" for n in lr["notes"]]
