@@ -1043,7 +1043,10 @@ def _grade_elsewhere(pool, reqs, rows, report, tabs, jit, work, quick, progress)
 
         again.append({"prepare": prepare, "row": i, "task": t})
     if progress and again:
-        sys.stderr.write(f"grading {len(again)} surviving operator mutant(s) on other tasks that run their block...\n")
+        n = len({a["row"] for a in again})
+        sys.stderr.write(
+            f"grading {n} surviving operator mutant(s) on the other tasks that run their block ({len(again)} runs)...\n"
+        )
 
     def again_done(k, r, res):
         shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
