@@ -75,7 +75,7 @@ __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
 _HELPER = "_geomlib_audit_nothing"
 NOTHING_MODES = ("zeros", "input", "constant")
 #: How many mutants per lab ``--quick`` grades (a fixed, seeded sample).
-QUICK_PER_LAB = 4
+QUICK_PER_LAB = 3
 
 
 class AuditError(ValueError):
@@ -551,11 +551,11 @@ def _glsl_mutants(lab: str, lab_dir: Path, b: _Block, notes: list[str]) -> list[
 
 
 def quick_sample(mutants: list[Mutant], lab: str, n: int = QUICK_PER_LAB) -> list[Mutant]:
-    """A fixed sample (seeded by the lab's name): one does-nothing mutant first, then operators."""
+    """A fixed sample (seeded by the lab's name): does-nothing mutants (half, rounded up), then operators."""
     rng = random.Random(zlib.crc32(lab.encode()))
     nothing = [m for m in mutants if m.kind == "nothing" and m.op == "zeros"]
     ops = [m for m in mutants if m.kind == "operator"]
-    pick = rng.sample(nothing, min(len(nothing), max(1, n // 2)))
+    pick = rng.sample(nothing, min(len(nothing), max(1, (n + 1) // 2)))
     pick += rng.sample(ops, min(len(ops), n - len(pick)))
     order = {m.id: i for i, m in enumerate(mutants)}
     return sorted(pick, key=lambda m: order[m.id])
@@ -624,12 +624,16 @@ def _worker_main() -> int:
     reply = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # anything else written to stdout goes to the log, not into the replies
     from geomlib.grading import audit as registered  # the module pytest loads with -p (this one is __main__)
+    from geomlib.grading import sandbox
     from geomlib.grading.grade import grade
 
+    user_limit = os.environ.get("GEOMLIB_TIME_LIMIT")
     for line in sys.stdin:
         req = json.loads(line)
         t = time.time()
         os.environ["GEOMLIB_TIME_BUDGET"] = str(req.get("budget") or "")
+        if not user_limit:  # GEOMLIB_TIME_LIMIT set by the user wins
+            os.environ["GEOMLIB_TIME_LIMIT"] = str(req.get("time_limit") or "")
         try:
             registered._CALLS.clear()
             records: list = []
@@ -648,6 +652,11 @@ def _worker_main() -> int:
         except BaseException as e:  # noqa: BLE001  (the audit keeps going; the mutant's row says what happened)
             out = {"ok": False, "error": f"{type(e).__name__}: {e}"}
         out["seconds"] = time.time() - t
+        if req.get("fresh"):
+            # A new zygote, so a new numba cache: a given kernel (cached under the stub's path) that
+            # calls a task kernel keeps the task kernel it was compiled with, which would be the
+            # previous mutant's (numba does not check the functions a cached function calls).
+            sandbox.shutdown()
         reply.write(json.dumps(out) + "\n")
     return 0
 
@@ -734,6 +743,18 @@ class _Progress:
         self.stream.flush()
 
 
+#: Seconds per call for a lab with numba kernels (unless GEOMLIB_TIME_LIMIT is set): each mutant is
+#: a new folder, so its first call compiles every kernel again (remeshing: 20 s of CPU, over 150 s
+#: of wall time at load 20), which the grader's own limit (a warm cache) does not allow for.
+COMPILED_CALL_LIMIT = 600.0
+
+
+def _jit_request(solution: Path) -> dict:
+    """For a lab with ``@njit`` kernels: a fresh zygote per request and :data:`COMPILED_CALL_LIMIT`."""
+    compiled = any("@njit" in p.read_text(encoding="utf-8") for p in sorted(solution.rglob("*.py")))
+    return {"fresh": True, "time_limit": COMPILED_CALL_LIMIT} if compiled else {}
+
+
 def _copy_lab(src: Path, dest: Path) -> None:
     shutil.copytree(src, dest, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
 
@@ -780,6 +801,8 @@ def audit(
     if kind not in (None, "nothing", "operator"):
         raise AuditError(f"unknown mutant kind {kind!r}: 'nothing' or 'operator'")
     runs_of: dict[str, dict] = {}  # lab -> {function: every lab function a call of it runs}
+    jit: dict[str, dict] = {}  # lab -> what its requests add when it has compiled kernels (_jit_request)
+    tabs: dict = {}  # lab -> its TaskTable
     pool = _Pool(max(1, jobs), work)
     try:
         plan = []  # (lab, mutant)
@@ -797,6 +820,7 @@ def audit(
                 muts = sample_mutants(muts, lab, sample)
             tab = _tasks.derive(course().lab(lab).solution)
             runs_of[lab] = {f: {f, *tab.composites.get(f, ())} for f in {*tab.tasks, *tab.composites}}
+            tabs[lab] = tab
             tasks = sorted({m.task for m in muts})
             report["labs"][lab] = {
                 "notes": notes,
@@ -809,6 +833,7 @@ def audit(
                 "generated": total,
             }
             plan.append((lab, muts, tasks))
+            jit[lab] = _jit_request(course().lab(lab).solution)
         # Baseline: the unchanged solution, graded task by task the same way. --quick skips it (the
         # test suite already checks that the solutions score full marks): a mutant is killed when it
         # scores less than the maximum.
@@ -817,7 +842,7 @@ def audit(
             d = work / "baseline"
             if not (d / lab).exists():
                 _copy_lab(course().lab(lab).solution, d / lab)
-            base_reqs += [{"impl": str(d), "lab": lab, "task": t, "budget": None} for t in tasks]
+            base_reqs += [{"impl": str(d), "lab": lab, "task": t, "budget": None, **jit[lab]} for t in tasks]
         base: dict = {}
 
         def base_done(i, r, res):
@@ -847,7 +872,14 @@ def audit(
                 def prepare(m=m, d=d, budget=budget):
                     _copy_lab(course().lab(m.lab).solution, d / m.lab)
                     (d / m.lab / m.file).write_text(m.source)
-                    return {"impl": str(d), "lab": m.lab, "task": m.task, "budget": budget, "mutant": m.id}
+                    return {
+                        "impl": str(d),
+                        "lab": m.lab,
+                        "task": m.task,
+                        "budget": budget,
+                        "mutant": m.id,
+                        **jit[m.lab],
+                    }
 
                 reqs.append({"prepare": prepare, "mutant": m})
         # Which tests run each block: a probe copy raises at the block's first line; the tests it
@@ -861,7 +893,7 @@ def audit(
                 lab, file, line, task = key
                 _copy_lab(course().lab(lab).solution, d / lab)
                 (d / lab / file).write_text(_probe_source((course().lab(lab).solution / file).read_text(), line, file))
-                return {"impl": str(d), "lab": lab, "task": task, "budget": 120.0}
+                return {"impl": str(d), "lab": lab, "task": task, "budget": None if jit[lab] else 120.0, **jit[lab]}
 
             probes.append({"prepare": prepare_probe, "key": key})
 
@@ -937,6 +969,7 @@ def audit(
         pool.run(reqs, done)
         if prog:
             prog.end()
+        _grade_elsewhere(pool, reqs, rows, report, tabs, jit, work, quick, progress)
         for i in sorted(rows):
             report["labs"][rows[i]["lab"]]["mutants"].append(rows[i])
         for lr in report["labs"].values():
@@ -953,6 +986,84 @@ def audit(
         shutil.rmtree(work, ignore_errors=True)
     report["seconds"] = round(time.time() - t_start, 1)
     return report
+
+
+def _grade_elsewhere(pool, reqs, rows, report, tabs, jit, work, quick, progress) -> None:
+    """An operator mutant its own task's tests do not catch is graded on the tests of the other tasks
+    whose functions run its block (remeshing's ``split`` kernel, Task 1, is graded through
+    ``split_long_edges`` and the loop, Tasks 4 and 10): a student with that bug loses points there.
+    It is killed when it scores less than the solution on one of them (``killed_by``)."""
+    todo = []  # (row index, task)
+    for i, row in rows.items():
+        if row["kind"] != "operator" or row["status"] not in ("survived", "equivalent"):
+            continue
+        tab = tabs[row["lab"]]
+        others = sorted(
+            {t[0] for f, t in tab.tasks.items() if row["function"] in tab.composites.get(f, ()) and t[0] != row["task"]}
+        )
+        todo += [(i, t) for t in others]
+    if not todo:
+        return
+    need = sorted({(rows[i]["lab"], t) for i, t in todo if t not in report["labs"][rows[i]["lab"]]["baseline"]})
+    base: dict = {}
+    if not quick:
+        for lab, _t in need:
+            if not (work / "baseline" / lab).exists():
+                _copy_lab(course().lab(lab).solution, work / "baseline" / lab)
+        pool.run(
+            [{"impl": str(work / "baseline"), "lab": lab, "task": t, "budget": None, **jit[lab]} for lab, t in need],
+            lambda k, r, res: base.__setitem__((r["lab"], r["task"]), res),
+        )
+        for (lab, t), res in base.items():
+            got, top = _score(res)
+            full = res.get("ok") and got >= top
+            report["labs"][lab]["baseline"][t] = {
+                "score": got,
+                "max": top,
+                "seconds": round(res.get("seconds", 0.0), 2),
+            }
+            if not full:
+                report["labs"][lab]["errors"].append(
+                    f"Task {t}: the solution itself scores {got:g}/{top:g} ({_first_failure(res)}); "
+                    "mutants of other tasks are not graded on it"
+                )
+    again = []
+    for i, t in todo:
+        row = rows[i]
+        b = report["labs"][row["lab"]]["baseline"].get(t)
+        if not quick and (not b or b["score"] < b["max"]):
+            continue
+        m: Mutant = reqs[i]["mutant"]
+        d = work / f"{m.lab}-again-{len(again)}"
+
+        def prepare(m=m, d=d, t=t):
+            _copy_lab(course().lab(m.lab).solution, d / m.lab)
+            (d / m.lab / m.file).write_text(m.source)
+            return {"impl": str(d), "lab": m.lab, "task": t, "budget": None, "mutant": m.id, **jit[m.lab]}
+
+        again.append({"prepare": prepare, "row": i, "task": t})
+    if progress and again:
+        n = len({a["row"] for a in again})
+        sys.stderr.write(
+            f"grading {n} surviving operator mutant(s) on the other tasks that run their block ({len(again)} runs)...\n"
+        )
+
+    def again_done(k, r, res):
+        shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
+        row, t = rows[again[k]["row"]], again[k]["task"]
+        got, top = _score(res)
+        full = report["labs"][row["lab"]]["baseline"].get(t, {}).get("score", top)
+        if not res.get("ok") or got >= full or row["status"] not in ("survived", "equivalent"):
+            return
+        why = _first_failure(res)
+        row["status"] = (
+            "killed" if row["status"] == "survived" else f"ERROR: declared equivalent but killed by Task {t}'s tests"
+        )
+        row["killed_by"] = f"Task {t}"
+        row["why"] = why
+        row["by_time"] = bool(_TIMED_OUT.search(why))
+
+    pool.run(again, again_done)
 
 
 _TIMED_OUT = re.compile(r"time budget|timed out|took longer|time limit", re.I)
@@ -1072,6 +1183,12 @@ def markdown(report: dict) -> str:
                 out.append(f"- Task {r['task']} `{r['id']}`{what}: `{d}`")
                 if r.get("kept_points"):
                     out.append(f"  kept by: {'; '.join(r['kept_points'][:4])}")
+        elsewhere = [r for r in lr["mutants"] if r.get("killed_by")]
+        if elsewhere:
+            out += ["", f"## {lab}: killed only by the tests of another task that runs the block", ""]
+            out += [
+                f"- Task {r['task']} `{r['id']}`: by {r['killed_by']}'s tests ({r['why'][:120]})" for r in elsewhere
+            ]
         if lr["notes"]:
             out += ["", f"## {lab}: not mutated", ""]
             out += [f"- {n}" for n in lr["notes"]]

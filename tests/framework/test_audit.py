@@ -115,8 +115,9 @@ def two_lab_course(sample_course, tmp_path) -> Path:
         '[[equivalent]]\nid = "ops.py:22:nothing-zeros"\nreason = "planted: wrongly declared"\n\n'
         '[[equivalent]]\nid = "ops.py:99:0:gone"\nreason = "planted: names no mutant"\n'
     )
-    run_geomlib(root, "refs", "build")
-    run_geomlib(root, "stubs", "build")
+    # The sample lab is built already; the weak lab's stubs are the sample's (the same solution).
+    shutil.copytree(root / "labs" / "sample", root / "labs" / "weak")
+    run_geomlib(root, "refs", "build", "--lab", "weak")
     for dirpath, _dirs, files in os.walk(base):
         os.chmod(dirpath, 0o755)
         for f in files:
@@ -178,3 +179,48 @@ def test_does_nothing_is_judged_by_the_tests_that_run_the_block():
     assert [t["name"] for t in audit._own_tests(res, "f", runs)] == ["a", "c"]
     assert [t["name"] for t in audit._own_tests(res, "f", runs, covered={"a", "d"})] == ["a"]
     assert audit._own_tests(res, "f", runs, covered=set()) == []
+
+
+def test_a_survivor_is_graded_on_the_other_tasks_that_run_its_block(tmp_path, monkeypatch):
+    """remeshing's ``split`` kernel (Task 1) is only observable through the passes and the loop
+    (Tasks 4 and 10): an operator mutant its own task misses is graded there, killed when it loses
+    points; a declared-equivalent one that loses points there is an error."""
+    from geomlib.grading.tasks import TaskTable
+
+    tab = TaskTable(
+        tasks={"split": (1,), "split_pass": (4,), "remesh": (10,), "other": (2,)},
+        composites={"split_pass": ("split",), "remesh": ("split", "split_pass"), "other": ()},
+    )
+    monkeypatch.setattr(audit, "_copy_lab", lambda src, dest: dest.mkdir(parents=True))
+    m = audit.Mutant("k.py:1:1:+ → -", "lab", "k.py", 1, 1, "split", "operator", "+ → -", "- a\n+ b", "split", "x")
+    rows = {0: {**{k: v for k, v in vars(m).items() if k != "source"}, "status": "survived", "why": ""}}
+    rows[1] = {**rows[0], "id": "k.py:2:1:+ → -", "status": "equivalent"}
+    report = {"labs": {"lab": {"baseline": {1: {"score": 5, "max": 5}}, "errors": []}}}
+    graded = []
+
+    class Pool:
+        def run(self, requests, on_done):
+            for i, r in enumerate(requests):
+                r = r["prepare"]() if "prepare" in r else r
+                graded.append((r.get("mutant"), r["task"]))
+                lost = r.get("mutant") is not None and r["task"] == 10
+                on_done(i, r, {"ok": True, "tests": [{"name": "t", "score": 0 if lost else 3, "max": 3,
+                                                      "passed": not lost, "output": "min_angle = 0"}]})  # fmt: skip
+
+    reqs = [{"mutant": m}, {"mutant": m}]
+    audit._grade_elsewhere(Pool(), reqs, rows, report, {"lab": tab}, {"lab": {}}, tmp_path, False, False)
+    assert sorted(t for mid, t in graded if mid is None) == [4, 10], "the solution is graded on Tasks 4 and 10 first"
+    assert sorted(t for mid, t in graded if mid) == [4, 4, 10, 10]
+    assert rows[0]["status"] == "killed" and rows[0]["killed_by"] == "Task 10", rows[0]
+    assert rows[1]["status"].startswith("ERROR: declared equivalent but killed by Task 10"), rows[1]
+    assert "killed only by the tests of another task" in audit.markdown(
+        {"labs": {"lab": {"tasks": {}, "mutants": list(rows.values()), "errors": [], "notes": []}}}
+    )
+
+
+def test_labs_with_compiled_kernels_get_a_fresh_zygote_per_request():
+    """A given kernel cached under the stub's path keeps the task kernel it was compiled with
+    (numba does not check callees): every request of a numba lab gets a new zygote and cache."""
+    root = _impl.course_root() / "solutions"
+    assert audit._jit_request(root / "remeshing") == {"fresh": True, "time_limit": audit.COMPILED_CALL_LIMIT}
+    assert audit._jit_request(root / "subdivision") == {}

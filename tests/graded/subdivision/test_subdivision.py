@@ -115,9 +115,27 @@ def test_weights_by_hand(lab):
     expect_close("loop_weight([3, 4, 6], 'loop')", lab.loop_weight([3, 4, 6], "loop"), loop_beta([3, 4, 6]))
 
 
+def _face_split(V, F, point):
+    """``(V, F)`` with face 0 split at a new last vertex ``point``: mixed valences (3 at the new vertex)."""
+    V = np.r_[np.asarray(V, float), [point]]
+    n, (a, b, c) = len(V) - 1, F[0]
+    return V, np.r_[[[a, b, n], [b, c, n], [c, a, n]], F[1:]]
+
+
+def _even_rows(F, n, rule):
+    """The even rows by the handout's rule: 1 - k u(k) on v, u(k) on each of its k neighbours."""
+    A = np.zeros((n, n))
+    for i, j in topology.unique_edges(F):
+        A[i, j] = A[j, i] = 1
+    k = A.sum(axis=1)
+    u = rule(k)
+    return A * u[:, None] + np.diag(1 - k * u)
+
+
 @graded(points=2, part="even vertices")
 def test_octahedron_even_rows(lab):
-    """octahedron, valence 4: row v = (1 - 4u) on v and u on its 4 neighbours (every vertex but its antipode)"""
+    """octahedron, valence 4: row v = (1 - 4u) on v and u on its 4 neighbours (every vertex but its antipode);
+    with face 0 split at its centre (valences 3, 4, 5), each row takes the weight of its own valence"""
     for weights, u in (("warren", warren_weight(4)), ("loop", loop_beta(4))):
         expected = np.full((6, 6), u)
         np.fill_diagonal(expected, 1 - 4 * u)
@@ -127,20 +145,38 @@ def test_octahedron_even_rows(lab):
         expect_matrix(
             f"loop_even_matrix(octahedron, weights={weights!r})", S, expected, "S_even", mesh=(OCTA_V, OCTA_F)
         )
+    V, F = _face_split(OCTA_V, OCTA_F, [0.4, 0.4, 0.4])
+    for weights, rule in (("warren", warren_weight), ("loop", loop_beta)):
+        expect_matrix(
+            f"loop_even_matrix(octahedron with face 0 split, weights={weights!r})",
+            lab.loop_even_matrix(V, F, weights),
+            _even_rows(F, len(V), rule),
+            "S_even",
+            mesh=(V, F),
+        )
 
 
 @graded(points=1, part="even vertices")
 def test_tetrahedron_even_rows(lab):
-    """tetrahedron, valence 3: both rules give u = 3/16, so each row is 7/16 on v and 3/16 on the others"""
+    """tetrahedron, valence 3: both rules give u = 3/16, so each row is 7/16 on v and 3/16 on the others;
+    with face 0 split at its centre (valences 3 and 4), the rules differ on the rows of valence 4"""
     expected = np.full((4, 4), 3 / 16)
     np.fill_diagonal(expected, 7 / 16)
-    for weights in ("warren", "loop"):
+    V, F = _face_split(TET_V, TET_F, np.mean(TET_V[TET_F[0]], axis=0) * 1.2)
+    for weights, rule in (("warren", warren_weight), ("loop", loop_beta)):
         expect_matrix(
             f"loop_even_matrix(tetrahedron, {weights!r})",
             lab.loop_even_matrix(TET_V, TET_F, weights),
             expected,
             "S_even",
             mesh=(TET_V, TET_F),
+        )
+        expect_matrix(
+            f"loop_even_matrix(tetrahedron with face 0 split, {weights!r})",
+            lab.loop_even_matrix(V, F, weights),
+            _even_rows(F, len(V), rule),
+            "S_even",
+            mesh=(V, F),
         )
 
 
@@ -235,11 +271,18 @@ def test_one_quad_boundary_points(lab):
 
 @graded(points=1, part="several levels")
 def test_levels_zero_is_identity(lab):
-    """levels=0 returns the input mesh unchanged"""
+    """levels=0 returns the input mesh unchanged (and levels=1 does not: n + e vertices, 4m faces)"""
     V, F = datasets.icosphere(1)
     V0, F0 = lab.loop_subdivide(V, F, 0)
     expect_close("loop_subdivide(levels=0) vertices", V0, V, atol=0.0, name="V", mesh=(V, F))
     expect_close("loop_subdivide(levels=0) faces", F0, F, atol=0.0, name="F")
+    V1, F1 = lab.loop_subdivide(V, F, 1)
+    n1 = len(V) + len(topology.unique_edges(F))
+    if np.shape(V1) != (n1, 3) or np.shape(F1) != (4 * len(F), 3):
+        raise Mismatch(
+            f"loop_subdivide(icosphere(1), levels=1): got V {np.shape(V1)}, F {np.shape(F1)}; expected ({n1}, 3) and "
+            f"({4 * len(F)}, 3)"
+        )
 
 
 @graded(points=2, part="several levels")
