@@ -6,10 +6,12 @@ attributes) into float32 render targets, and returns the pixels as NumPy arrays,
 compare them with the NumPy reference.
 
 The context lives on the same headless platform as :mod:`geomlib.render` (pyrender):
-:func:`geomlib.render.backend` chooses ``PYOPENGL_PLATFORM`` (OSMesa here, Mesa EGL otherwise),
-and the context is created by pyrender's platform class for that choice. Never mix EGL and OSMesa
-in one process (PyOpenGL binds its platform once, at import). Every call makes this module's
-context current first, so it coexists with pyrender's own contexts.
+:func:`geomlib.render.backend` chooses ``PYOPENGL_PLATFORM`` (OSMesa here, Mesa EGL otherwise).
+An OSMesa context is created through PyOpenGL directly, with the attributes of pyrender's
+``OSMesaPlatform``, so that a process that only runs shaders (a grader's sandboxed worker) never
+imports pyrender; an EGL context by pyrender's ``EGLPlatform``. Never mix EGL and OSMesa in one
+process (PyOpenGL binds its platform once, at import). Every call makes this module's context
+current first, so it coexists with pyrender's own contexts.
 
 Conventions, those of every texture in geomlib: image row 0 is ``v = 1`` (the top); the
 full-screen quad passes ``uv`` in [0, 1]² with ``v`` up, and pixel ``(r, c)`` of a ``(h, w)``
@@ -152,6 +154,48 @@ def naming_task(label: str, task: str):
         raise ShaderError(msg, log=e.log, lines=e.lines) from None
 
 
+class _OSMesaContext:
+    """An OSMesa context with pyrender's ``OSMesaPlatform`` interface and attributes (OpenGL 3.3 core,
+    RGBA, 24-bit depth), made without importing pyrender: its import (trimesh, networkx, pyglet) costs
+    about 2 s of CPU, which every sandboxed worker running a student's shader paid per call, while
+    creating the context costs about 15 ms."""
+
+    def __init__(self, width: int, height: int):
+        self.width, self.height = width, height
+        self._context = self._buffer = None
+
+    def init_context(self) -> None:
+        from OpenGL import arrays, osmesa
+
+        attrs = arrays.GLintArray.asArray(
+            [
+                osmesa.OSMESA_FORMAT, osmesa.OSMESA_RGBA,
+                osmesa.OSMESA_DEPTH_BITS, 24,
+                osmesa.OSMESA_PROFILE, osmesa.OSMESA_CORE_PROFILE,
+                osmesa.OSMESA_CONTEXT_MAJOR_VERSION, 3,
+                osmesa.OSMESA_CONTEXT_MINOR_VERSION, 3,
+                0,
+            ]
+        )  # fmt: skip
+        self._context = osmesa.OSMesaCreateContextAttribs(attrs, None)
+        if not self._context:
+            raise RuntimeError("OSMesaCreateContextAttribs gave no OpenGL 3.3 core context")
+        self._buffer = arrays.GLubyteArray.zeros((self.height, self.width, 4))
+
+    def make_current(self) -> None:
+        from OpenGL import GL, osmesa
+
+        if not osmesa.OSMesaMakeCurrent(self._context, self._buffer, GL.GL_UNSIGNED_BYTE, self.width, self.height):
+            raise RuntimeError("OSMesaMakeCurrent failed")
+
+    def delete_context(self) -> None:
+        from OpenGL import osmesa
+
+        if self._context is not None:
+            osmesa.OSMesaDestroyContext(self._context)
+        self._context = self._buffer = None
+
+
 def _gl():
     """The OpenGL module, with this module's context current (created on first use)."""
     from geomlib.render.context import note_context_created, require_own_context
@@ -163,10 +207,10 @@ def _gl():
 
         try:
             chosen = backend()
-            import_pyrender()  # the platform choice and pyrender's NumPy shim, in one place
             if chosen == "osmesa":
-                from pyrender.platforms.osmesa import OSMesaPlatform as Platform
+                Platform = _OSMesaContext
             elif chosen == "egl":
+                import_pyrender()  # the platform choice and pyrender's NumPy shim, in one place
                 from pyrender.platforms.egl import EGLPlatform as Platform
             else:
                 raise RuntimeError(f"PYOPENGL_PLATFORM={chosen!r} is not a headless platform (osmesa or egl)")

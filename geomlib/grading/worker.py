@@ -121,6 +121,24 @@ def prepare_stubs(stubs_dir: str | None) -> None:
                 pass
 
 
+def prepare_gl(*lab_folders: str | None) -> None:
+    """Import PyOpenGL on the headless platform, in the zygote, when the lab runs shaders (it has a
+    ``shaders/`` folder): every worker of a GLSL call imported it (0.4 s of CPU) before this. No
+    OpenGL context is created here: Mesa's rasteriser threads do not survive a fork (see
+    :func:`geomlib.render.context.inherited_context`), so each worker creates its own (about 15 ms)."""
+    from geomlib.gl import SHADER_FOLDER
+
+    if "OpenGL.GL" in sys.modules or not any(f and os.path.isdir(os.path.join(f, SHADER_FOLDER)) for f in lab_folders):
+        return
+    from geomlib.render.context import backend
+
+    platform = backend()  # PYOPENGL_PLATFORM before PyOpenGL's import (inherited by the workers)
+    importlib.import_module("OpenGL.GL")
+    importlib.import_module("OpenGL.arrays")
+    if platform == "osmesa":
+        importlib.import_module("OpenGL.osmesa")
+
+
 def _is_plain_file(path: Path) -> bool:
     return path.is_file() and not path.is_symlink()
 

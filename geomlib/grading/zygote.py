@@ -373,6 +373,10 @@ def serve(sock: socket.socket) -> None:
             _worker.prepare_stubs(req.get("stubs_dir"))  # the course's stubs, parsed once for every worker
         except Exception:  # noqa: BLE001 - the worker parses them itself
             pass
+        try:
+            _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"))  # PyOpenGL, once, for a lab with shaders
+        except Exception:  # noqa: BLE001 - the worker imports it itself (and reports what fails)
+            pass
         pid = os.fork()
         if pid == 0:
             sock.close()
