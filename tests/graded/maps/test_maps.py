@@ -94,7 +94,7 @@ def test_mirrored_uvs_flip_w(lab):
 
 @graded(points=1, part="tangent frames")
 def test_frames_are_orthonormal_without_nan(lab):
-    """random and partly degenerate UVs: unit T, B, N, T . N = 0, B = w N x T, no NaN"""
+    """random and partly degenerate UVs: unit T, B, N, T . N = 0, B = w N x T, T along the faces' dP/du, no NaN"""
     V, F = datasets.icosphere(2)
     UV = np.random.default_rng(0).random((len(V), 2))
     UV[F[:6].ravel()] = 0.3
@@ -115,6 +115,31 @@ def test_frames_are_orthonormal_without_nan(lab):
     )
     expect_close(
         "tangent_frames B - w N x T", B - w[:, None] * np.cross(N, T), np.zeros_like(B), atol=1e-9, mesh=(V, F)
+    )
+    # Orthonormal is not enough (any frame built from N passes the checks above): T points where u grows.
+    # The handout's sum T_sum = sum over usable faces of area * unit(dP/du) (unit(dP/du) sign-adjusted by
+    # det, as dividing by det does), and T = normalize(T_sum - (N . T_sum) N), so T . T_sum = |T_sum - (N .
+    # T_sum) N| > 0 wherever a usable face gives a tangential T_sum.
+    E1, E2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    d1, d2 = UV[F[:, 1]] - UV[F[:, 0]], UV[F[:, 2]] - UV[F[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    dPdu = d2[:, 1:2] * E1 - d1[:, 1:2] * E2
+    area = 0.5 * np.linalg.norm(np.cross(E1, E2), axis=1)
+    usable = np.abs(det) > 1e-6
+    face_t = np.zeros_like(dPdu)
+    face_t[usable] = unit(dPdu[usable]) * (area * np.sign(det))[usable, None]
+    T_sum = np.zeros_like(V)
+    for k in range(3):
+        np.add.at(T_sum, F[:, k], face_t)
+    tangential = np.linalg.norm(T_sum - np.sum(N * T_sum, axis=1)[:, None] * N, axis=1)
+    has_u = tangential > 1e-3 * np.linalg.norm(T_sum, axis=1) + 1e-12
+    along = np.sum(T * T_sum, axis=1)
+    bad = np.flatnonzero(has_u & ~(along > 0.5 * tangential))
+    expect(
+        bad.size == 0,
+        f"tangent_frames: at vertex {bad[0] if bad.size else -1} T does not point where u grows "
+        f"(T . T_sum = {along[bad[0]] if bad.size else 0:.3g}, where T_sum is the area-weighted sum of the unit "
+        f"dP/du of its faces); {bad.size} of {int(has_u.sum())} vertices with a usable face",
     )
 
 
