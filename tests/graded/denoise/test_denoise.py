@@ -411,7 +411,7 @@ def test_map_route_matches_direct_route(lab):
 
 @graded(points=1, part="seam fix")
 def test_weld_by_hand(lab):
-    """two triangles cut apart in UV: vertices 3 and 4 copy 1 and 2, so 4 groups remain"""
+    """two triangles cut apart in UV: vertices 3 and 4 copy 1 and 2, so 4 groups remain (also with tol)"""
     out = lab.weld_seams(SPLIT_V, SPLIT_F)
     expected = {
         "Vw": SPLIT_V[[0, 1, 2, 5]],
@@ -422,6 +422,17 @@ def test_weld_by_hand(lab):
         raise Mismatch("weld_seams should return three values (Vw, Fw, group)")
     msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
     expect_true("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
+    # With tol: copies that an exporter wrote 1e-4 apart are joined the same way (each group keeps the
+    # position of its first member).
+    Vt = SPLIT_V.astype(float)
+    Vt[3] += [1e-4, 0.0, 0.0]
+    Vt[4] += [0.0, -1e-4, 0.0]
+    out = lab.weld_seams(Vt, SPLIT_F, tol=1e-3)
+    if not isinstance(out, tuple | list) or len(out) != 3:
+        raise Mismatch("weld_seams(tol=1e-3) should return three values (Vw, Fw, group)")
+    expected["Vw"] = Vt[[0, 1, 2, 5]]
+    msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
+    expect_true("weld_seams(tol=1e-3) with copies 1e-4 apart", msg is None, str(msg))
 
 
 @graded(points=1, part="seam fix")
