@@ -304,7 +304,7 @@ def test_constant_map_by_hand(lab):
 
 @graded(points=1, part="displacement")
 def test_seam_copies_move_together(lab):
-    """UV sphere with a random map: vertices that share a position still share it after displacement, each moved by at most lam"""
+    """UV sphere with a random map: vertices that share a position still share it after displacement, each moved by at most lam; copies whose normals cancel move along +z"""
     V, F, UV = datasets.uv_sphere(8, 16)
     H = np.random.default_rng(1).random((16, 16))
     Vd = np.asarray(lab.displace(V, F, UV, None, H, lam=0.2), float)
@@ -325,6 +325,18 @@ def test_seam_copies_move_together(lab):
             "offsets and normals when weld_seams=True",
             marked_picture("displace: seam copies", V, F, V[~(gaps < 1e-12)], "seam vertices whose copies split"),
         )
+    # Copies whose normals cancel move along (0, 0, 1), as the docstring says: two triangles cut apart, the
+    # copies 1 and 3 (at (1, 0, 0)) facing +z and -z, a constant map h = 1/2: P' = P + 0.5 (0, 0, 1).
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
+    F = np.array([[0, 1, 2], [3, 5, 4]])
+    UV = np.array([[0.0, 0.0], [0.45, 0.0], [0.0, 0.45], [0.55, 0.55], [0.55, 1.0], [1.0, 1.0]])
+    N = np.tile([0.0, 0.0, 1.0], (6, 1))
+    N[3] = [0.0, 0.0, -1.0]
+    Vd = np.asarray(lab.displace(V, F, UV, N, np.full((4, 4), 0.5)), float)
+    expect_close(
+        "displace of seam copies whose normals cancel (vertices 1 and 3)", Vd[[1, 3]], [[1, 0, 0.5], [1, 0, 0.5]],
+        atol=1e-12, hint="a zero mean normal falls back to (0, 0, 1)", mesh=(V, F),
+    )  # fmt: skip
 
 
 # ------------------------------------------------------------------------------ baking
