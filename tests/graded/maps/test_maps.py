@@ -234,7 +234,7 @@ def test_matches_the_analytic_gradient(lab):
 
 @graded(points=1, part="shading")
 def test_lambert_by_hand(lab):
-    """light at 60 degrees, no ambient, no specular: colour = albedo * cos 60 = albedo / 2"""
+    """light at 60 degrees, no ambient, no specular: colour = albedo * cos 60 = albedo / 2, also with zero normals"""
     g, eye = quad_gbuffer(8)
     d = (np.sin(np.pi / 3), 0.0, -np.cos(np.pi / 3))
     img = np.asarray(lab.shade(g, [{"direction": d}], eye, (0.8, 0.6, 0.4), ambient=0.0, specular=0.0), float)
@@ -246,6 +246,18 @@ def test_lambert_by_hand(lab):
         hint="diffuse = albedo max(n . l, 0) with l = -direction",
     )
     expect_close("shade: background pixels", img[~g.mask], np.ones((int((~g.mask).sum()), 3)), atol=0)
+    # A zero interpolated normal is shaded with n = (0, 0, 1) (the docstring): a light at 60 degrees from the
+    # vertical, towards (1, 1, 0), gives albedo / 2 again (a fallback tilted towards x or y gives another colour).
+    g.attributes["normal"] = np.zeros_like(np.asarray(g.attributes["normal"]))
+    d = (np.sin(np.pi / 3) / np.sqrt(2), np.sin(np.pi / 3) / np.sqrt(2), -np.cos(np.pi / 3))
+    img = np.asarray(lab.shade(g, [{"direction": d}], eye, (0.8, 0.6, 0.4), ambient=0.0, specular=0.0), float)
+    expect_close(
+        "shade with zero normals in the G-buffer",
+        img[g.mask],
+        np.tile([0.4, 0.3, 0.2], (int(g.mask.sum()), 1)),
+        atol=1e-5,
+        hint="a zero-length normal falls back to (0, 0, 1)",
+    )
 
 
 @graded(points=1, part="shading")
