@@ -262,10 +262,21 @@ def _operator_edits(text: str, tree: ast.AST, b: _Block) -> list[tuple[int, int,
 
 _HELPER_SOURCE = f'''
 
-def {_HELPER}(x, mode, inputs=(), inplace=False):
+def {_HELPER}_keep(objs):
+    """geomlib audit: copies of the objects (dataclass instances) a block changes, taken at its start."""
+    import copy as _copy
+    import dataclasses as _dc
+
+    return tuple((o, _copy.deepcopy(o)) for o in objs if _dc.is_dataclass(o) and not isinstance(o, type))
+
+
+def {_HELPER}(x, mode, inputs=(), inplace=False, restore=()):
     """geomlib audit: a does-nothing replacement for a task's result ``x`` (zeros, an input, a constant)."""
     import numpy as _np
     import scipy.sparse as _sp
+
+    for o, c in restore:  # the objects the block changed, back as the block found them
+        o.__dict__.update(c.__dict__)
 
     if isinstance(x, tuple | list):
         if mode == "input":
@@ -368,8 +379,41 @@ def _walk_no_defs(node):
         todo.extend(ast.iter_child_nodes(n))
 
 
-def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
-    """Text edits that make a block's results trivial, with ``{mode}`` left to fill in; or ([], why not)."""
+def _stored_bases(nodes) -> list[str]:
+    """Names whose attributes or items the nodes assign to (``state.V[i] = p`` gives ``state``)."""
+    out = []
+    for n in nodes:
+        if isinstance(n, ast.Subscript | ast.Attribute) and isinstance(n.ctx, ast.Store):
+            base = n.value
+            while isinstance(base, ast.Subscript | ast.Attribute):
+                base = base.value
+            if isinstance(base, ast.Name) and base.id not in out:
+                out.append(base.id)
+    return out
+
+
+def _changed_through_calls(stmts, params: list[str], defs: dict) -> list[str]:
+    """The parameters the block hands to one of the lab's functions that assigns into that argument
+    (``greedy_collapse`` calls ``contract_pair(state, ...)``, which sets ``state.V[i]``)."""
+    out = []
+    for s in stmts:
+        for n in [s, *_walk_no_defs(s)]:
+            if not (isinstance(n, ast.Call) and isinstance(n.func, ast.Name) and n.func.id in defs):
+                continue
+            g = defs[n.func.id]
+            names = [a.arg for a in (*g.args.posonlyargs, *g.args.args)]
+            stored = _stored_bases(ast.walk(g))
+            for k, arg in enumerate(n.args):
+                if isinstance(arg, ast.Name) and arg.id in params and k < len(names) and names[k] in stored:
+                    out.append(arg.id)
+    return out
+
+
+def _nothing_edits(text: str, tree: ast.Module, b: _Block, defs: dict | None = None) -> tuple[list, str]:
+    """Text edits that make a block's results trivial, with ``{mode}`` left to fill in; or ([], why not).
+
+    ``defs``: the lab's module-level functions by name, to find the objects the block changes through
+    them."""
     chain = _enclosing(tree, b)
     if not chain:
         return [], "the block is not inside a function"
@@ -393,11 +437,23 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
         f"{indent}{inputs} = tuple(getattr(a, 'copy', lambda a=a: a)() for a in ({copies}))\n",
     )
     edits = []
+    # Objects (dataclass instances such as simplification's SimplifyState) that the block changes, directly or
+    # through the lab's functions, are results too: a block that does nothing leaves them as it found them.
+    changed_params = [p for p in params if p in _stored_bases(n for s in stmts for n in [s, *_walk_no_defs(s)])]
+    kept = list(dict.fromkeys(changed_params + _changed_through_calls(stmts, params, defs or {})))
+    objs = f"{_HELPER}_obj"
+    restore = f", restore={objs}" if kept else ""
+    if kept:
+        capture = (
+            at_start,
+            at_start,
+            capture[2] + f"{indent}{objs} = {_HELPER}_keep(({''.join(f'{p}, ' for p in kept)}))\n",
+        )
     # Returns inside the block give trivial values.
     for s in stmts:
         if isinstance(s, ast.Return) and s.value is not None:
             a, z = _span(lines, s.value)
-            edits.append((a, z, f"{_HELPER}(({text[a:z]}), {{mode!r}}, {inputs})"))
+            edits.append((a, z, f"{_HELPER}(({text[a:z]}), {{mode!r}}, {inputs}{restore})"))
     # Names the block binds or changes in place, read elsewhere in the function, become trivial after it.
     bound, changed = [], []
     for s in stmts:
@@ -428,7 +484,10 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block) -> tuple[list, str]:
         if name in read_outside and name not in changed:
             resets.append(f"{indent}{name} = {_HELPER}({name}, {{mode!r}}, {inputs})")
     for name in changed:
-        resets.append(f"{indent}{name} = {_HELPER}({name}, {{mode!r}}, {inputs}, inplace=True)")
+        resets.append(f"{indent}{name} = {_HELPER}({name}, {{mode!r}}, {inputs}, inplace=True{restore})")
+        restore = ""
+    if restore:
+        resets.append(f"{indent}{_HELPER}(None, {{mode!r}}{restore})")
     last = stmts and max(s.end_lineno for s in stmts)
     if resets and not (
         stmts and any(isinstance(s, ast.Return) for s in stmts if s.end_lineno == last and s.col_offset == len(indent))
@@ -473,6 +532,10 @@ def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) 
     seen: set[str] = set()
     texts: dict[str, tuple[str, ast.Module]] = {}
     glsl: list[Mutant] = []
+    defs = {}  # the lab's module-level functions by name (objects changed through them, see _nothing_edits)
+    for f in sorted(lab_dir.rglob("*.py")):
+        if "__pycache__" not in f.parts:
+            defs |= {n.name: n for n in ast.parse(f.read_text()).body if isinstance(n, ast.FunctionDef)}
     for b in blocks:
         if not b.file.endswith(".py"):
             glsl += _glsl_mutants(lab, lab_dir, b, notes)
@@ -481,7 +544,7 @@ def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) 
             text = (lab_dir / b.file).read_text()
             texts[b.file] = (text, ast.parse(text))
         text, tree = texts[b.file]
-        edits, why = _nothing_edits(text, tree, b)
+        edits, why = _nothing_edits(text, tree, b, defs)
         chain = _enclosing(tree, b)
         fname = chain[0].name if chain else ""
         if not edits:

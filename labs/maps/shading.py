@@ -144,7 +144,8 @@ def shade(
         colour = ambient * albedo
                + sum over lights  L * (albedo * max(n . l, 0) + specular * max(n . h, 0)^shininess [n . l > 0])
 
-    with ``L`` the light's colour times intensity. The geometry stays flat; only ``n`` changes.
+    with ``L`` the light's colour times intensity. The geometry stays flat; only ``n`` changes. A
+    pixel whose ``n`` has zero length before normalising is shaded with ``n = (0, 0, 1)``.
     Background pixels get ``background``. The result is clipped to ``[0, 1]`` (no gamma).
 
     Parameters

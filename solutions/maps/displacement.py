@@ -97,7 +97,8 @@ def displace(
     UV seams: a vertex on a seam exists once per chart (same position, different UV), and the copies
     read different texels. With ``weld_seams`` the copies (found by
     :func:`geomlib.textures.weld_by_position`) get the MEAN of their offsets ``bias + scale h`` and
-    the mean of their normals, so they move together and the seam does not crack open.
+    the mean of their normals, so they move together and the seam does not crack open. Copies whose
+    normals cancel (a mean of zero length) move along ``(0, 0, 1)``.
 
     Parameters
     ----------

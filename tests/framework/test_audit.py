@@ -13,6 +13,7 @@ import os
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from geomlib.grading import audit, stubs
@@ -224,3 +225,27 @@ def test_labs_with_compiled_kernels_get_a_fresh_zygote_per_request():
     root = _impl.course_root() / "solutions"
     assert audit._jit_request(root / "remeshing") == {"fresh": True, "time_limit": audit.COMPILED_CALL_LIMIT}
     assert audit._jit_request(root / "subdivision") == {}
+
+
+def test_does_nothing_restores_the_objects_the_block_changes(tmp_path):
+    """A block that changes an object through one of the lab's functions (simplification's greedy loop
+    calls ``contract_pair(state, ...)``) does nothing only if the object is left as the block found it."""
+    lab = tmp_path / "toy"
+    lab.mkdir()
+    (lab / "__init__.py").write_text("")
+    (lab / "work.py").write_text(
+        "from dataclasses import dataclass\n\nimport numpy as np\n\n\n@dataclass\nclass State:\n    x: np.ndarray\n"
+        "    n: int\n\n\ndef step(state, k):\n    state.x[k] += 1.0\n    state.n -= 1\n\n\n"
+        "def loop(state, times):\n    # BEGIN SOLUTION: Task 1 (loop): step times\n    for k in range(times):\n"
+        "        step(state, k)\n    return state.n\n    # END SOLUTION\n"
+    )
+    mutants, _ = audit.generate("toy", lab, check_glsl=False)
+    nothing = {m.op: m for m in mutants if m.kind == "nothing" and m.function == "loop"}
+    assert set(nothing) == set(audit.NOTHING_MODES)
+    for mode, m in nothing.items():
+        ns = {}
+        exec(compile(m.source, "work.py", "exec"), ns)
+        state = ns["State"](np.zeros(3), 5)
+        out = ns["loop"](state, 3)
+        assert state.x.tolist() == [0.0, 0.0, 0.0] and state.n == 5, (mode, state)
+        assert out == {"zeros": 0, "input": 3, "constant": 1}[mode], (mode, out)

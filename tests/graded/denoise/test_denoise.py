@@ -330,7 +330,7 @@ def test_map_lookup_by_hand(lab):
 
 @graded(points=1, part="denoising through the map")
 def test_integer_maps_are_decoded(lab):
-    """uint8 255 reads as h = 1, uint16 32768 as h = 32768/65535"""
+    """uint8 code q reads as h = q/255 (255 as h = 1), uint16 32768 as h = 32768/65535"""
     V, F, UV = _five_points()
     N = np.tile(UP, (5, 1))
     X8 = lab.denoise_with_map(V, F, UV, N, np.full((4, 4), 255, np.uint8), 0.1, 0.2, 1.0, weld=False)
@@ -340,6 +340,20 @@ def test_integer_maps_are_decoded(lab):
         np.full(5, -0.3),
         atol=1e-12,
         name="z",
+        mesh=(V, F),
+    )
+    # A 2 x 2 uint8 map of different codes, read at its texel centres and in the middle: h = [[0, 1], [0.4, 0.2]],
+    # s = 0.1 + 0.2 h: centre 0.1 + 0.2 * 0.4 = 0.18; (1/4, 3/4) -> [0, 0]: 0.1; (1/4, 1/4) -> [1, 0]: 0.18;
+    # (3/4, 1/4) -> [1, 1]: 0.14; (3/4, 3/4) -> [0, 1]: 0.3.
+    codes = np.array([[0, 255], [102, 51]], np.uint8)
+    X8 = lab.denoise_with_map(V, F, UV, N, codes, 0.1, 0.2, 1.0, weld=False)
+    expect_close(
+        "denoise_with_map with the uint8 map [[0, 255], [102, 51]]",
+        np.asarray(X8)[:, 2],
+        [-0.18, -0.1, -0.18, -0.14, -0.3],
+        atol=1e-12,
+        name="z",
+        hint="each vertex reads its own h = q / 255 from the map (bilinear lookup); p' = p - lam (bias + scale h) n",
         mesh=(V, F),
     )
     X16 = lab.denoise_with_map(V, F, UV, N, np.full((4, 4), 32768, np.uint16), 0.0, 1.0, 0.5, weld=False)
@@ -397,7 +411,7 @@ def test_map_route_matches_direct_route(lab):
 
 @graded(points=1, part="seam fix")
 def test_weld_by_hand(lab):
-    """two triangles cut apart in UV: vertices 3 and 4 copy 1 and 2, so 4 groups remain"""
+    """two triangles cut apart in UV: vertices 3 and 4 copy 1 and 2, so 4 groups remain (also with tol)"""
     out = lab.weld_seams(SPLIT_V, SPLIT_F)
     expected = {
         "Vw": SPLIT_V[[0, 1, 2, 5]],
@@ -408,6 +422,17 @@ def test_weld_by_hand(lab):
         raise Mismatch("weld_seams should return three values (Vw, Fw, group)")
     msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
     expect_true("weld_seams on two triangles cut along their shared edge", msg is None, str(msg))
+    # With tol: copies that an exporter wrote 1e-4 apart are joined the same way (each group keeps the
+    # position of its first member).
+    Vt = SPLIT_V.astype(float)
+    Vt[3] += [1e-4, 0.0, 0.0]
+    Vt[4] += [0.0, -1e-4, 0.0]
+    out = lab.weld_seams(Vt, SPLIT_F, tol=1e-3)
+    if not isinstance(out, tuple | list) or len(out) != 3:
+        raise Mismatch("weld_seams(tol=1e-3) should return three values (Vw, Fw, group)")
+    expected["Vw"] = Vt[[0, 1, 2, 5]]
+    msg = weld_check().fn(expected, dict(zip(("Vw", "Fw", "group"), out, strict=True)), Context(label="weld_seams"))
+    expect_true("weld_seams(tol=1e-3) with copies 1e-4 apart", msg is None, str(msg))
 
 
 @graded(points=1, part="seam fix")
@@ -495,6 +520,16 @@ def test_map_route_keeps_seams_closed(lab):
     cracked = copy_spread(lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7, weld=False), group)
     expect_true(
         "denoise_with_map(weld=False)", cracked > 1e-3 * h, "with weld=False the copies should read different texels"
+    )
+    # ... and the vertices read the map's varying values: lam s = (Vn - X) . n spans much of [bias, bias + scale]
+    # (the map spans all of [0, 1]), not one offset for every vertex.
+    X = np.asarray(lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7, weld=False), float)
+    s = np.sum((Vn - X) * N, axis=1) / 0.7
+    expect_true(
+        "denoise_with_map(weld=False) on a UV torus",
+        np.ptp(s) > 0.25 * h and s.min() >= -0.5 * h - 1e-9 and s.max() <= 0.5 * h + 1e-9,
+        f"the offsets s = bias + scale h(uv) span [{s.min():.3g}, {s.max():.3g}]; the map's values span [0, 1], so "
+        f"with bias {-0.5 * h:.3g} and scale {h:.3g} they should vary within [{-0.5 * h:.3g}, {0.5 * h:.3g}]",
     )
     expect_closed_seams(
         "denoise_with_map(weld=True) on a UV torus", lab.denoise_with_map(Vn, F, UV, N, image, -0.5 * h, h, 0.7), group,

@@ -94,7 +94,7 @@ def test_mirrored_uvs_flip_w(lab):
 
 @graded(points=1, part="tangent frames")
 def test_frames_are_orthonormal_without_nan(lab):
-    """random and partly degenerate UVs: unit T, B, N, T . N = 0, B = w N x T, no NaN"""
+    """random and partly degenerate UVs: unit T, B, N, T . N = 0, B = w N x T, T along the faces' dP/du, no NaN"""
     V, F = datasets.icosphere(2)
     UV = np.random.default_rng(0).random((len(V), 2))
     UV[F[:6].ravel()] = 0.3
@@ -115,6 +115,31 @@ def test_frames_are_orthonormal_without_nan(lab):
     )
     expect_close(
         "tangent_frames B - w N x T", B - w[:, None] * np.cross(N, T), np.zeros_like(B), atol=1e-9, mesh=(V, F)
+    )
+    # Orthonormal is not enough (any frame built from N passes the checks above): T points where u grows.
+    # The handout's sum T_sum = sum over usable faces of area * unit(dP/du) (unit(dP/du) sign-adjusted by
+    # det, as dividing by det does), and T = normalize(T_sum - (N . T_sum) N), so T . T_sum = |T_sum - (N .
+    # T_sum) N| > 0 wherever a usable face gives a tangential T_sum.
+    E1, E2 = V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]
+    d1, d2 = UV[F[:, 1]] - UV[F[:, 0]], UV[F[:, 2]] - UV[F[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    dPdu = d2[:, 1:2] * E1 - d1[:, 1:2] * E2
+    area = 0.5 * np.linalg.norm(np.cross(E1, E2), axis=1)
+    usable = np.abs(det) > 1e-6
+    face_t = np.zeros_like(dPdu)
+    face_t[usable] = unit(dPdu[usable]) * (area * np.sign(det))[usable, None]
+    T_sum = np.zeros_like(V)
+    for k in range(3):
+        np.add.at(T_sum, F[:, k], face_t)
+    tangential = np.linalg.norm(T_sum - np.sum(N * T_sum, axis=1)[:, None] * N, axis=1)
+    has_u = tangential > 1e-3 * np.linalg.norm(T_sum, axis=1) + 1e-12
+    along = np.sum(T * T_sum, axis=1)
+    bad = np.flatnonzero(has_u & ~(along > 0.5 * tangential))
+    expect(
+        bad.size == 0,
+        f"tangent_frames: at vertex {bad[0] if bad.size else -1} T does not point where u grows "
+        f"(T . T_sum = {along[bad[0]] if bad.size else 0:.3g}, where T_sum is the area-weighted sum of the unit "
+        f"dP/du of its faces); {bad.size} of {int(has_u.sum())} vertices with a usable face",
     )
 
 
@@ -209,7 +234,7 @@ def test_matches_the_analytic_gradient(lab):
 
 @graded(points=1, part="shading")
 def test_lambert_by_hand(lab):
-    """light at 60 degrees, no ambient, no specular: colour = albedo * cos 60 = albedo / 2"""
+    """light at 60 degrees, no ambient, no specular: colour = albedo * cos 60 = albedo / 2, also with zero normals"""
     g, eye = quad_gbuffer(8)
     d = (np.sin(np.pi / 3), 0.0, -np.cos(np.pi / 3))
     img = np.asarray(lab.shade(g, [{"direction": d}], eye, (0.8, 0.6, 0.4), ambient=0.0, specular=0.0), float)
@@ -221,6 +246,18 @@ def test_lambert_by_hand(lab):
         hint="diffuse = albedo max(n . l, 0) with l = -direction",
     )
     expect_close("shade: background pixels", img[~g.mask], np.ones((int((~g.mask).sum()), 3)), atol=0)
+    # A zero interpolated normal is shaded with n = (0, 0, 1) (the docstring): a light at 60 degrees from the
+    # vertical, towards (1, 1, 0), gives albedo / 2 again (a fallback tilted towards x or y gives another colour).
+    g.attributes["normal"] = np.zeros_like(np.asarray(g.attributes["normal"]))
+    d = (np.sin(np.pi / 3) / np.sqrt(2), np.sin(np.pi / 3) / np.sqrt(2), -np.cos(np.pi / 3))
+    img = np.asarray(lab.shade(g, [{"direction": d}], eye, (0.8, 0.6, 0.4), ambient=0.0, specular=0.0), float)
+    expect_close(
+        "shade with zero normals in the G-buffer",
+        img[g.mask],
+        np.tile([0.4, 0.3, 0.2], (int(g.mask.sum()), 1)),
+        atol=1e-5,
+        hint="a zero-length normal falls back to (0, 0, 1)",
+    )
 
 
 @graded(points=1, part="shading")
@@ -279,7 +316,7 @@ def test_constant_map_by_hand(lab):
 
 @graded(points=1, part="displacement")
 def test_seam_copies_move_together(lab):
-    """UV sphere with a random map: vertices that share a position still share it after displacement, each moved by at most lam"""
+    """UV sphere with a random map: vertices that share a position still share it after displacement, each moved by at most lam; copies whose normals cancel move along +z"""
     V, F, UV = datasets.uv_sphere(8, 16)
     H = np.random.default_rng(1).random((16, 16))
     Vd = np.asarray(lab.displace(V, F, UV, None, H, lam=0.2), float)
@@ -300,6 +337,18 @@ def test_seam_copies_move_together(lab):
             "offsets and normals when weld_seams=True",
             marked_picture("displace: seam copies", V, F, V[~(gaps < 1e-12)], "seam vertices whose copies split"),
         )
+    # Copies whose normals cancel move along (0, 0, 1), as the docstring says: two triangles cut apart, the
+    # copies 1 and 3 (at (1, 0, 0)) facing +z and -z, a constant map h = 1/2: P' = P + 0.5 (0, 0, 1).
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.0]])
+    F = np.array([[0, 1, 2], [3, 5, 4]])
+    UV = np.array([[0.0, 0.0], [0.45, 0.0], [0.0, 0.45], [0.55, 0.55], [0.55, 1.0], [1.0, 1.0]])
+    N = np.tile([0.0, 0.0, 1.0], (6, 1))
+    N[3] = [0.0, 0.0, -1.0]
+    Vd = np.asarray(lab.displace(V, F, UV, N, np.full((4, 4), 0.5)), float)
+    expect_close(
+        "displace of seam copies whose normals cancel (vertices 1 and 3)", Vd[[1, 3]], [[1, 0, 0.5], [1, 0, 0.5]],
+        atol=1e-12, hint="a zero mean normal falls back to (0, 0, 1)", mesh=(V, F),
+    )  # fmt: skip
 
 
 # ------------------------------------------------------------------------------ baking

@@ -400,7 +400,8 @@ def _agree_with_ray_casting(lab, V, F, d, M, D, cull):
 
 @graded(points=1, part="all together")
 def test_render_is_an_image(lab):
-    """render_with_shadows returns an (h, w, 3) image in [0, 1] with shadows on the floor"""
+    """render_with_shadows returns an (h, w, 3) image in [0, 1] with shadows on the floor, and none where nothing
+    stands between the light and the surface"""
     img, vis = lab.render_with_shadows(scene_meshes(), CAMERA, (0.4, 0.5, -0.75), size=(80, 60), map_size=256,
                                        return_visibility=True)  # fmt: skip
     img, vis = np.asarray(img), np.asarray(vis)
@@ -409,6 +410,27 @@ def test_render_is_an_image(lab):
     covered = np.isfinite(vis)
     if not 0.02 < np.mean(vis[covered] < 0.5) < 0.5:
         fail(f"{100 * np.mean(vis[covered] < 0.5):.1f}% of the scene is in shadow; expected a few percent to a third")
+    # A scene where nothing casts a shadow on anything seen, built so that the bias and the frustum matter: a
+    # low light grazes the floor (slope-scaled bias needed), a large panel facing the light beside it keeps
+    # most pixels' slopes small (one bias for all is too small for the floor), its shadow falls beyond the
+    # floor, and the map's box covers only the middle of the floor (the rest is outside the map: lit).
+    d = np.array([-0.9, 0.3, -0.25])
+    n = -d / np.linalg.norm(d)
+    across = np.cross([0.0, 0.0, 1.0], n) / np.linalg.norm(np.cross([0.0, 0.0, 1.0], n))
+    G, GF = datasets.grid_patch(4, 2.4)
+    G = G - np.array([1.2, 1.2, 0.0])
+    panel = np.array([-2.6, 0.0, 1.4]) + G[:, :1] * across + G[:, 1:2] * np.cross(n, across)
+    V, F = datasets.grid_patch(4, 6.0)
+    scene = [(V - np.array([3.0, 3.0, 0.0]), F, (0.8, 0.8, 0.8)), (panel, GF, (0.8, 0.5, 0.3))]
+    _, vis = lab.render_with_shadows(scene, CAMERA, d, size=(80, 60), map_size=256, return_visibility=True,
+                                     bounds=[[-1.5, -1.5, 0.0], [1.5, 1.5, 2.6]])  # fmt: skip
+    vis = np.asarray(vis, float)
+    dark = np.mean(vis[np.isfinite(vis)] < 0.999)
+    if not dark <= 0.005:
+        fail(f"render_with_shadows of a floor under a low light beside a panel, nothing in between: "
+             f"{100 * dark:.1f}% of the visible points are not fully lit (allowed 0.5%); expected all lit: check the "
+             "slope-scaled bias per point (receiver_depth_gradient, shadow_bias) and that points outside the map's "
+             "box count as lit (outside_frustum)")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ bad input

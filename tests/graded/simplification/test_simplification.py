@@ -378,9 +378,16 @@ def test_box_simplifies_to_twelve_exact_triangles(lab):
 
 @graded(points=1, part="greedy loop")
 def test_unreachable_target_gives_a_clear_error(lab):
-    """two tetrahedra (8 faces) cannot lose a face without breaking the link condition"""
+    """two tetrahedra (8 faces) cannot lose a face without breaking the link condition; an icosahedron beside a
+    tetrahedron stops at 8 too, once the icosahedron is down to a tetrahedron"""
     V, F = two_tetrahedra()
     expect_rejected(lab, "qem_simplify", V, F, 4, match="stopped at 8", label="qem_simplify(two tetrahedra, 4)")
+    # The same stop after real work (a loop that does nothing stops at the icosahedron's 20 + 4 faces).
+    Vi, Fi = datasets.icosphere(0)
+    V, F = np.r_[Vi, TET_V + 3.0], np.r_[Fi, TET_F + len(Vi)]
+    expect_rejected(
+        lab, "qem_simplify", V, F, 4, match="stopped at 8", label="qem_simplify(icosahedron and tetrahedron, 4)"
+    )
 
 
 @graded(points=1, part="greedy loop")
