@@ -347,9 +347,11 @@ class _Zygote:
 
             try:
                 uid, gid = sandbox_ids(self.user)
-                os.chown(self.jit_cache, uid, gid)
                 os.chown(self.scratch_root, -1, gid)
                 self.scratch_root.chmod(0o710)
+                # The sandbox user may enter, not write: each snapshot's own cache is its (_jit_folder).
+                os.chown(self.jit_cache, -1, gid)
+                self.jit_cache.chmod(0o710)
             except KeyError:
                 self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
             _protect_hidden()
