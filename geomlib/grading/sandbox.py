@@ -16,7 +16,7 @@ Protection levels (reported by :func:`status`):
 
 - root with ``GEOMLIB_SANDBOX_USER`` (Gradescope): student code runs as that user; hidden cases and
   references are made readable by root only; with Landlock also nothing outside Python, geomlib,
-  the stubs and its own lab is readable and nothing but a scratch folder and the run's numba cache writable;
+  the stubs and its own lab is readable and nothing but a scratch folder and its snapshot's numba cache writable;
 - any user with Landlock (``geomlib grade`` / ``grade-all`` by an instructor): the same file-system
   confinement, no TCP, no signals to the grader;
 - neither: only the process isolation (fresh zygote, closed descriptors, limits, killed
@@ -24,7 +24,9 @@ Protection levels (reported by :func:`status`):
 
 Before a student's code runs, its lab folder is copied (plain files only, never following links)
 into a private read-only snapshot, and each module is merged with the course's stub so that given
-code stays the course's (see :mod:`geomlib.grading.worker`).
+code stays the course's (see :mod:`geomlib.grading.worker`). A snapshot is known by the bytes it
+holds, checked at every call: a folder edited since (a notebook's ``check()`` run again, one process
+grading many copies) gets a new snapshot and a new numba cache, never the old code.
 
 :class:`LabProxy` makes this look like a module: ``lab.loop_subdivide(V, F)`` runs the student's
 ``loop_subdivide`` in a worker and returns its result, or raises a
@@ -34,6 +36,7 @@ code stays the course's (see :mod:`geomlib.grading.worker`).
 from __future__ import annotations
 
 import atexit
+import hashlib
 import json
 import os
 import pickle
@@ -49,6 +52,7 @@ import sysconfig
 import tempfile
 import threading
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from geomlib.grading import tolerances, wire
@@ -185,6 +189,102 @@ def _protect_hidden() -> None:
             pass
 
 
+#: Lab folders larger than these are copied in part (the same rule for the digest and the copy).
+_FILE_LIMIT = 64 << 20
+_TOTAL_LIMIT = 512 << 20
+_SKIP_DIRS = ("__pycache__", ".git", ".ipynb_checkpoints")
+
+
+def _lab_files(lab_dir: Path):
+    """``(relative path, os.lstat)`` of the plain files a snapshot of ``lab_dir`` holds, in a fixed order."""
+    total = 0
+    for dirpath, dirnames, filenames in os.walk(lab_dir, followlinks=False):
+        dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS)
+        rel = Path(dirpath).relative_to(lab_dir)
+        yield rel, None  # the folder itself (an empty folder is part of the snapshot too)
+        for name in sorted(filenames):
+            try:
+                st = os.lstat(Path(dirpath) / name)
+            except OSError:
+                continue
+            if not stat.S_ISREG(st.st_mode) or st.st_size > _FILE_LIMIT or total > _TOTAL_LIMIT:
+                continue
+            total += st.st_size
+            yield rel / name, st
+
+
+def _read_plain(path: Path) -> bytes:
+    """A plain file's bytes, never following a link (nor waiting on a pipe put in its place)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    with os.fdopen(fd, "rb") as f:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise OSError(f"{path} is not a plain file")
+        return f.read()
+
+
+#: ``path -> (stat key, sha256, when hashed in ns)``: a file is hashed again only when its stat key
+#: (inode, size, modification and change times) differs, or it changed so close to its hashing that
+#: a later write could keep the same times (file-system clocks tick every few milliseconds; the
+#: change time cannot be set back, unlike the modification time: ``os.utime`` moves it forward).
+_DIGESTS: dict[str, tuple[tuple, str, int]] = {}
+_RACY_NS = 2_000_000_000
+
+
+def _file_digest(path: Path, st: os.stat_result) -> str:
+    key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
+    known = _DIGESTS.get(str(path))
+    if known is not None and known[0] == key and st.st_ctime_ns < known[2] - _RACY_NS:
+        return known[1]
+    now = time.time_ns()
+    digest = hashlib.sha256(_read_plain(path)).hexdigest()
+    _DIGESTS[str(path)] = (key, digest, now)
+    return digest
+
+
+def _folder_digest(lab_dir: Path) -> str:
+    """What a snapshot of ``lab_dir`` would hold (names and bytes), as one sha256."""
+    h = hashlib.sha256()
+    for rel, st in _lab_files(lab_dir):
+        try:
+            digest = _file_digest(lab_dir / rel, st) if st is not None else "dir"
+        except OSError:
+            continue
+        h.update(f"{rel.as_posix()}\0{digest}\n".encode("utf-8", "surrogateescape"))
+    return h.hexdigest()
+
+
+def _copy_lab(lab_dir: Path, dest: Path) -> str:
+    """Copy ``lab_dir`` into ``dest`` (read-only); returns the digest of what was copied."""
+    h = hashlib.sha256()
+    for rel, st in _lab_files(lab_dir):
+        if st is None:
+            (dest / rel).mkdir(parents=True, exist_ok=True)
+            digest = "dir"
+        else:
+            try:
+                data = _read_plain(lab_dir / rel)
+            except OSError:
+                continue
+            (dest / rel).write_bytes(data)
+            digest = hashlib.sha256(data).hexdigest()
+        h.update(f"{rel.as_posix()}\0{digest}\n".encode("utf-8", "surrogateescape"))
+    for dirpath, _dirnames, filenames in os.walk(dest.parent):
+        os.chmod(dirpath, 0o555)
+        for name in filenames:
+            os.chmod(os.path.join(dirpath, name), 0o444)
+    return h.hexdigest()
+
+
+@dataclass
+class _Snapshot:
+    """A read-only copy of a lab folder, known by the digest of what it holds."""
+
+    key: str
+    dest: Path
+    #: digest of the course's stubs (``""``: none) -> the numba cache folder of this code
+    jit: dict[str, Path] = field(default_factory=dict)
+
+
 class _Zygote:
     def __init__(self):
         parent, child = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -231,22 +331,27 @@ class _Zygote:
         # own uid and gid) can reach this run's snapshots, scratch folders or numba cache.
         self.scratch_root = Path(tempfile.mkdtemp(prefix="geomlib-sandbox-"))
         self.scratch_root.chmod(0o700)
-        # One numba cache for every worker of this run (NUMBA_CACHE_DIR in the worker, see
-        # geomlib.jit): the first call compiles a lab's kernels, later calls load them. Each call's
-        # own scratch folder would make every call compile again (seconds per call). Workers run
-        # the same submission, so what one writes there can only change that submission's calls.
+        # numba's caches (NUMBA_CACHE_DIR in the worker, see geomlib.jit), one per snapshot of a
+        # submission and version of the stubs: the first call compiles a lab's kernels, later calls
+        # of the same code load them (each call's own scratch folder would make every call compile
+        # again, seconds per call). numba knows a source by path, mtime and size only, and a given
+        # kernel of the stubs that calls a task kernel holds the submission's machine code: a
+        # cache shared by two versions of a submission would run the first version's kernels.
         self.jit_cache = self.scratch_root / "numba-cache"
         self.jit_cache.mkdir(mode=0o700)
-        self.snapshots: dict[str, Path] = {}
+        #: resolved lab folder -> its current snapshot (most recently used last)
+        self.snapshots: dict[str, _Snapshot] = {}
         self.problems: list[str] = []
         if self.user:
             from geomlib.grading.zygote import sandbox_ids
 
             try:
                 uid, gid = sandbox_ids(self.user)
-                os.chown(self.jit_cache, uid, gid)
                 os.chown(self.scratch_root, -1, gid)
                 self.scratch_root.chmod(0o710)
+                # The sandbox user may enter, not write: each snapshot's own cache is its (_jit_folder).
+                os.chown(self.jit_cache, -1, gid)
+                self.jit_cache.chmod(0o710)
             except KeyError:
                 self.problems.append(f"the sandbox user {self.user!r} (GEOMLIB_SANDBOX_USER) does not exist")
             _protect_hidden()
@@ -295,41 +400,78 @@ class _Zygote:
         else:
             self.problems += info.get("problems", [])
 
-    def snapshot(self, lab_dir: Path) -> Path:
-        """A private, read-only copy of a lab folder: plain files only, links never followed."""
-        key = str(lab_dir.resolve())
-        if key in self.snapshots:
-            return self.snapshots[key]
-        dest = Path(tempfile.mkdtemp(prefix="lab-", dir=self.scratch_root)) / lab_dir.name
-        total = 0
-        for dirpath, dirnames, filenames in os.walk(lab_dir, followlinks=False):
-            rel = Path(dirpath).relative_to(lab_dir)
-            dirnames[:] = [d for d in dirnames if d not in ("__pycache__", ".git", ".ipynb_checkpoints")]
-            (dest / rel).mkdir(parents=True, exist_ok=True)
-            for name in filenames:
-                src = Path(dirpath) / name
-                st = os.lstat(src)
-                if not stat.S_ISREG(st.st_mode) or st.st_size > 64 << 20 or total > 512 << 20:
-                    continue
-                total += st.st_size
-                shutil.copyfile(src, dest / rel / name, follow_symlinks=False)
-        for dirpath, _dirnames, filenames in os.walk(dest.parent):
-            os.chmod(dirpath, 0o555)
-            for name in filenames:
-                os.chmod(os.path.join(dirpath, name), 0o444)
-        self.snapshots[key] = dest
-        return dest
+    def snapshot(self, lab_dir: Path, stubs: Path | None = None) -> tuple[Path, Path]:
+        """A private, read-only copy of a lab folder (plain files only, links never followed) and the
+        numba cache folder of its workers.
+
+        Known by its contents, checked at every call: a folder whose bytes changed since its snapshot
+        was made (even with its files' size and modification time put back) gets a new snapshot in a
+        new folder and a new numba cache, and the old ones are removed. The cache is also per
+        version of the course's ``stubs`` (given kernels are compiled with the submission's).
+        """
+        path = lab_dir.resolve()
+        key = _folder_digest(path)
+        snap = self.snapshots.pop(str(path), None)
+        if snap is not None and snap.key != key:
+            self._drop(snap)
+            snap = None
+        if snap is None:
+            self._evict()
+            dest = Path(tempfile.mkdtemp(prefix="lab-", dir=self.scratch_root)) / lab_dir.name
+            snap = _Snapshot(_copy_lab(path, dest), dest)
+        self.snapshots[str(path)] = snap
+        stubs_key = _folder_digest(stubs.resolve()) if stubs is not None else ""
+        if stubs_key not in snap.jit:
+            snap.jit[stubs_key] = self._jit_folder()
+        return snap.dest, snap.jit[stubs_key]
+
+    def _jit_folder(self) -> Path:
+        """A new numba cache folder that the workers (the sandbox user) can write."""
+        folder = Path(tempfile.mkdtemp(prefix="jit-", dir=self.jit_cache))
+        if self.user:
+            from geomlib.grading.zygote import sandbox_ids
+
+            try:
+                os.chown(folder, *sandbox_ids(self.user))
+            except KeyError:
+                pass  # reported by self.problems
+        return folder
+
+    #: Snapshots kept for folders graded earlier in this process (an audit grades hundreds of copies).
+    KEEP = 8
+
+    def _evict(self) -> None:
+        """Drop the snapshots of folders that are gone, and the oldest beyond :attr:`KEEP`."""
+        for path in list(self.snapshots):
+            if not os.path.isdir(path) or len(self.snapshots) >= self.KEEP:
+                self._drop(self.snapshots.pop(path))
+                for name in [n for n in _DIGESTS if n.startswith(path + os.sep)]:
+                    del _DIGESTS[name]
+
+    @staticmethod
+    def _drop(snap: _Snapshot) -> None:
+        for dirpath, _, _ in os.walk(snap.dest.parent):
+            try:
+                os.chmod(dirpath, 0o755)
+            except OSError:
+                pass
+        shutil.rmtree(snap.dest.parent, ignore_errors=True)
+        for folder in snap.jit.values():
+            shutil.rmtree(folder, ignore_errors=True)
 
     def run(self, req: dict, blob: bytes, timeout: float, max_bytes: int | None = None, on_pid=None) -> dict:
-        """Send one request; returns ``{"data": bytes|None, "why": ..., "status": ..., "printed": str}``."""
+        """Send one request; returns ``{"data": bytes|None, "why": ..., "status": ..., "printed": str}``.
+
+        ``req["jit_cache"]``: the numba cache of the submission's snapshot (:meth:`snapshot`).
+        """
         from geomlib.grading.zygote import recv_msg, send_msg
 
         r, w = os.pipe()
         out_fd, out_path = tempfile.mkstemp(prefix="geomlib-out-", dir=self.scratch_root)
         scratch = tempfile.mkdtemp(prefix="call-", dir=self.scratch_root)
         os.chmod(scratch, 0o700)
-        jit = str(self.jit_cache)
-        req = {**req, "scratch": scratch, "jit_cache": jit, "write": [scratch, jit, os.devnull]}
+        jit = req.get("jit_cache")
+        req = {**req, "scratch": scratch, "write": [scratch, *([jit] if jit else []), os.devnull]}
         pid = None
         try:
             try:
@@ -383,7 +525,7 @@ class _Zygote:
         except Exception:  # noqa: BLE001
             self.proc.kill()
         for snap in self.snapshots.values():
-            for dirpath, _, _ in os.walk(snap.parent):
+            for dirpath, _, _ in os.walk(snap.dest.parent):
                 os.chmod(dirpath, 0o755)
         shutil.rmtree(self.scratch_root, ignore_errors=True)
 
@@ -559,8 +701,8 @@ def call(
     except Exception as e:  # noqa: BLE001
         raise GraderError(f"grader problem (not your code): cannot pass the inputs of {function} ({e})") from None
     lab_dir = Path(lab_dir)
-    snap = z.snapshot(lab_dir)
     stubs = _stubs_dir(lab, lab_dir)
+    snap, jit = z.snapshot(lab_dir, stubs)
     max_bytes = max(tolerances.RESULT_MIN_MB << 20, tolerances.RESULT_INPUT_FACTOR * _input_bytes(args, kwargs))
     req = z.request(
         {
@@ -574,6 +716,7 @@ def call(
             "cwd": str(snap),
             "read": [str(snap)] + ([str(stubs)] if stubs else []),
             "not_allowed": _not_allowed(lab),
+            "jit_cache": str(jit),
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)

@@ -23,6 +23,7 @@ import __future__
 
 import ast
 import copy
+import hashlib
 import importlib
 import importlib.abc
 import importlib.util
@@ -76,8 +77,9 @@ def _parsed(path: Path, *, student: bool) -> ast.Module:
 
 
 #: The course's stubs, parsed and compiled once in the zygote (:func:`prepare_stubs`) and inherited by
-#: every worker it forks: ``path -> (mtime_ns, size)`` of what ``_TREES`` holds, and the code of each
-#: top-level stub statement by ``id`` of the statement.
+#: every worker it forks: ``path -> sha256`` of the bytes ``_TREES`` holds (a size and mtime kept
+#: across an edit must not keep the old code), and the code of each top-level stub statement by
+#: ``id`` of the statement.
 _STUB_STAT: dict = {}
 _STUB_CODE: dict = {}
 #: ``id(stub tree) -> (task names, given names)`` (:func:`merge_module`), for the trees in ``_TREES``.
@@ -93,19 +95,20 @@ def prepare_stubs(stubs_dir: str | None) -> None:
     flags = __future__.annotations.compiler_flag
     for path in sorted(Path(stubs_dir).glob("*.py")):
         try:
-            st = path.stat()
+            data = path.read_bytes()
         except OSError:
             continue
-        if _STUB_STAT.get(str(path)) == (st.st_mtime_ns, st.st_size):
+        digest = hashlib.sha256(data).hexdigest()
+        if _STUB_STAT.get(str(path)) == digest:
             continue
         old = _TREES.pop((str(path), False), None)
         for stmt in getattr(old, "body", ()):  # their ids may be reused once the old tree is freed
             _STUB_CODE.pop(id(stmt), None)
         _STUB_NAMES.pop(id(old), None)
-        _STUB_STAT[str(path)] = (st.st_mtime_ns, st.st_size)
+        _STUB_STAT[str(path)] = digest
         try:
-            tree = _parsed(path, student=False)
-        except (SyntaxError, OSError, ValueError):
+            tree = _TREES[(str(path), False)] = ast.parse(data.decode("utf-8"), filename=str(path))
+        except (SyntaxError, ValueError):
             continue
         tasks = task_names(tree)
         _STUB_NAMES[id(tree)] = (

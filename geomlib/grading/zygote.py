@@ -14,7 +14,7 @@ For each request the zygote forks a worker that
 3. as root with ``GEOMLIB_SANDBOX_USER`` set, becomes that user (``nobody``, or a private uid per
    submission under ``geomlib grade-all``);
 4. where the kernel has Landlock, may read only Python, the libraries, geomlib, the course's stubs
-   and its own lab, write only a private scratch folder (and the run's shared numba cache), and neither open TCP connections nor signal
+   and its own lab, write only a private scratch folder (and its submission's numba cache), and neither open TCP connections nor signal
    processes outside its sandbox;
 5. (Linux x86_64/aarch64) can open no network socket: a seccomp filter lets ``socket()`` create
    ``AF_UNIX`` sockets only (:mod:`geomlib.grading.seccomp`), so no UDP, TCP, IPv6 or raw packet
@@ -264,7 +264,7 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
     if scratch:
         os.environ["TMPDIR"] = scratch
     if req.get("jit_cache"):
-        os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the run's workers (geomlib.jit)
+        os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the calls of one snapshot (geomlib.jit)
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
     if req.get("seccomp"):

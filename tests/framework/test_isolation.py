@@ -158,7 +158,7 @@ SPY = """    import glob as _glob
         except OSError:
             pass
     for _d in _glob.glob(_os.path.join(_base, "geomlib-sandbox-*", "numba-cache")):
-        if _d != _os.environ.get("NUMBA_CACHE_DIR"):
+        if _d != _os.path.dirname(_os.environ.get("NUMBA_CACHE_DIR", "")):  # its own run's: numba-cache/jit-*
             try:
                 with open(_os.path.join(_d, "spy-was-here"), "w") as _f:
                     _f.write("x")

@@ -97,3 +97,19 @@ def test_a_sandboxed_call_sees_the_stub_as_it_is_now(tmp_path, monkeypatch):
     assert lab.task(2) == 7
     _write(stubs_root / "toy", STUB.format(scale=5) + "\n# edited\n")
     assert lab.task(2) == 11
+
+
+def test_a_stub_changed_with_its_size_and_mtime_kept_is_read_again(tmp_path, monkeypatch):
+    """The zygote's stub trees and code are known by the stub's bytes, not by its size and mtime."""
+    stubs_root, student = tmp_path / "stubs", tmp_path / "sub" / "toy"
+    stub = stubs_root / "toy" / "ops.py"
+    _write(stubs_root / "toy", STUB.format(scale=3))
+    _write(student, STUDENT)
+    monkeypatch.setenv("GEOMLIB_STUBS", str(stubs_root))
+    lab = LabProxy("toy", student)
+    assert lab.task(2) == 7
+    st = stub.stat()
+    _write(stubs_root / "toy", STUB.format(scale=5))
+    os.utime(stub, ns=(st.st_atime_ns, st.st_mtime_ns))
+    assert (stub.stat().st_size, stub.stat().st_mtime_ns) == (st.st_size, st.st_mtime_ns)
+    assert lab.task(2) == 11, "the zygote ran the stub's code as it was before the change"
