@@ -145,6 +145,10 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     items.sort(key=lambda item: (-SECONDS.get(work_unit(item.nodeid), 0.0), order[id(item)]))
 
 
+# optionalhook: a grading run (geomlib grade, check()) starts pytest with plugin autoload off, so
+# xdist and its hook specs are absent there; without the flag pluggy refuses the unknown hook and
+# no graded test runs at all.
+@pytest.hookimpl(optionalhook=True)
 def pytest_xdist_make_scheduler(config: pytest.Config, log):
     """``--dist loadfile`` with the units of :func:`work_unit` instead of whole files. (Not xdist's
     ``--dist loadgroup``: under pytest 9 its ``xdist_group`` marks are silently ignored, since it
