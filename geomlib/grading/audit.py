@@ -383,13 +383,20 @@ def _stored_bases(nodes) -> list[str]:
     """Names whose attributes or items the nodes assign to (``state.V[i] = p`` gives ``state``)."""
     out = []
     for n in nodes:
-        if isinstance(n, ast.Subscript | ast.Attribute) and isinstance(n.ctx, ast.Store):
-            base = n.value
-            while isinstance(base, ast.Subscript | ast.Attribute):
-                base = base.value
-            if isinstance(base, ast.Name) and base.id not in out:
-                out.append(base.id)
+        name = _stored_base(n)
+        if name is not None and name not in out:
+            out.append(name)
     return out
+
+
+def _stored_base(n) -> str | None:
+    """The name an item or attribute store writes into (``state.V[i] = p`` gives ``state``), else None."""
+    if not (isinstance(n, ast.Subscript | ast.Attribute) and isinstance(n.ctx, ast.Store)):
+        return None
+    base = n.value
+    while isinstance(base, ast.Subscript | ast.Attribute):
+        base = base.value
+    return base.id if isinstance(base, ast.Name) else None
 
 
 def _changed_through_calls(stmts, params: list[str], defs: dict) -> list[str]:
@@ -460,12 +467,9 @@ def _nothing_edits(text: str, tree: ast.Module, b: _Block, defs: dict | None = N
         for n in _walk_no_defs(s) if not isinstance(s, ast.Return) else ():
             if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Store) and n.id not in bound:
                 bound.append(n.id)
-            elif isinstance(n, ast.Subscript | ast.Attribute) and isinstance(n.ctx, ast.Store):
-                base = n.value
-                while isinstance(base, ast.Subscript | ast.Attribute):
-                    base = base.value
-                if isinstance(base, ast.Name) and base.id not in changed:
-                    changed.append(base.id)
+            elif _stored_base(n) is not None:
+                if _stored_base(n) not in changed:
+                    changed.append(_stored_base(n))
             elif isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute) and isinstance(n.func.value, ast.Name):
                 if (
                     n.func.attr in ("append", "extend", "insert", "update", "add", "fill", "sort")
