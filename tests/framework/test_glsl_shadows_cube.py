@@ -200,6 +200,14 @@ def test_a_wrong_face_entry_is_caught_by_the_public_room_case(face, wrong):
     assert re.search(rf"by the light's cube face: {re.escape(name)}: \d+$", msg.splitlines()[0]), msg
 
 
+@pytest.mark.parametrize("old", ["if (ad.y > ad[a]) {", "if (ad.z > ad[a]) {"], ids=["x-y-tie-to-y", "z-tie-to-z"])
+def test_the_later_axis_on_a_face_tie_is_caught(old):
+    """`>` turned `>=` in cube_face (the audit's mutants): points exactly on a cube edge read the later axis's face."""
+    msg = _fail_of(_edit("cube_shadow.frag", old, old.replace(">", ">=")), "check_glsl_cube_shadow",
+                   "glsl-cube-ties-defaults")  # fmt: skip
+    assert "exactly between two faces" in msg and "points differ" in msg, msg
+
+
 def test_a_broken_cube_lookup_costs_only_its_own_tests():
     """cube_shadow.frag that does not compile: the cube pass's check, and Task 10's, still pass on the same copy."""
     from tests.graded.shadows import test_shadows_cube_glsl, test_shadows_glsl

@@ -33,6 +33,8 @@ LIGHTS = {
     "room": (np.array([0.23, -0.11, 1.52]), 0.1, 6.0),
     "room2": (np.array([-0.37, 0.41, 0.93]), 0.1, 7.0),
 }
+#: A light and a far plane with few binary digits, so that P - light is exact in float32 and float64 alike.
+LIGHTS["ties"] = (np.array([0.25, -0.125, 1.5]), 0.125, 4.0)
 #: key -> (centre, half extents): the rooms the "room" lights stand in (room_scene).
 ROOMS = {
     "room": (np.array([0.1, -0.2, 1.4]), np.array([2.1, 1.8, 1.5])),
@@ -80,9 +82,47 @@ def room_points(key: str):
     return np.ones((n, 6 * n), bool), P.reshape(-1, 3), N.reshape(-1, 3)
 
 
+def _cube_edges():
+    """The 12 edges of the cube as (a, sa, b, sb): the faces 2a + (sa < 0) and 2b + (sb < 0), a < b."""
+    return [(a, sa, b, sb) for a in range(3) for b in range(a + 1, 3) for sa in (1, -1) for sb in (1, -1)]
+
+
+def ties_scene():
+    """One quad per cube edge of light "ties", half a unit from it, across the edge's diagonal direction and
+    only on the side of the edge's first axis a (|d_a| > |d_b|): it covers face a's texels along the edge
+    and none of face b's."""
+    pos = LIGHTS["ties"][0]
+    Vs, Fs = [], []
+    for a, sa, b, sb in _cube_edges():
+        u, w, k = np.zeros(3), np.zeros(3), np.zeros(3)
+        u[a], w[b], k[3 - a - b] = sa, sb, 1.0
+        c = pos + 0.5 * (u + w)
+        V = np.array([c - 0.3 * k, c + 0.25 * (u - w) - 0.3 * k, c + 0.25 * (u - w) + 0.3 * k, c + 0.3 * k])
+        Vs.append(V)
+        Fs.append(np.array([[0, 1, 2], [0, 2, 3]]) + 4 * len(Fs))
+    return np.vstack(Vs), np.vstack(Fs)
+
+
+def ties_points():
+    """``(mask, P, N)``: 8 points behind each quad of ties_scene, exactly on its cube edge's diagonal (|d_a| = |d_b|
+    to the last bit): the face the first axis gives (cube_face_index's rule on ties) sees them in shadow, the
+    other face lit. A 12 x 8 picture, one row per edge."""
+    pos = LIGHTS["ties"][0]
+    P = []
+    for a, sa, b, sb in _cube_edges():
+        for t in (1.0, 1.25, 1.5, 1.75):
+            for c in (-0.4, 0.3):
+                d = np.zeros(3)
+                d[a], d[b], d[3 - a - b] = sa * t, sb * t, c * t
+                P.append(pos + d)
+    P = np.array(P)
+    return np.ones((12, 8), bool), P, np.tile([0.0, 0.0, 1.0], (len(P), 1))
+
+
 def case_points(key: str):
-    """The points a cube_shadow.frag case of light ``key`` shades: the room's walls, or the eye view's pixels."""
-    return room_points(key) if key in ROOMS else eye_points()
+    """The points a cube_shadow.frag case of light ``key`` shades: the room's walls, the cube edges' diagonals,
+    or the eye view's pixels."""
+    return room_points(key) if key in ROOMS else ties_points() if key == "ties" else eye_points()
 
 
 def _prefix(visibility: str) -> str:
@@ -102,7 +142,7 @@ def linear_maps_entry(key: str, size: int, cull: str, visibility: str = "visible
     pos, near, far = LIGHTS[key]
 
     def make():
-        V, F = room_scene(key) if key in ROOMS else small_scene()
+        V, F = room_scene(key) if key in ROOMS else ties_scene() if key == "ties" else small_scene()
         return {"V": V, "F": F, "position": pos, "size": size, "near": near, "far": far}
 
     return Case(id=f"{_prefix(visibility)}glsl-cube-linear-{key}-{size}-{cull}", function="cube_distance_maps",
@@ -155,10 +195,17 @@ STORED += [
     linear_maps_entry("room", 64, "front"),
     cube_visibility_entry("glsl-cube-room-defaults", "glsl-cube-linear-room-64-front", "room"),
     cube_visibility_entry("glsl-cube-room-pcf3", "glsl-cube-linear-room-64-front", "room", bias=0.01, pcf=3),
+    # points exactly on the cube's edges: the first axis's face on ties
+    matrices_entry("ties"),
+    linear_maps_entry("ties", 32, "none"),
+    cube_visibility_entry("glsl-cube-ties-defaults", "glsl-cube-linear-ties-32-none", "ties"),
 ]
 STORED_HIDDEN += [
     matrices_entry("room2", H),
     linear_maps_entry("room2", 56, "none", H),
     cube_visibility_entry("glsl-cube-room-defaults", "hidden-glsl-cube-linear-room2-56-none", "room2", H),
     cube_visibility_entry("glsl-cube-room-bias", "hidden-glsl-cube-linear-room2-56-none", "room2", H, bias=0.004),
+    matrices_entry("ties", H),
+    linear_maps_entry("ties", 48, "none", H),
+    cube_visibility_entry("glsl-cube-ties-pcf3", "hidden-glsl-cube-linear-ties-48-none", "ties", H, pcf=3),
 ]

@@ -131,7 +131,8 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
     if bad.mean() <= CUBE_VISIBILITY_BAD and not np.isnan(g).any():
         return
     room = "-room-" in case_id  # the walls of a room around the light, side by side, instead of the eye view
-    mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else eye_points()[0]
+    ties = "-ties-" in case_id  # 8 points on each of the cube's 12 edges, a row per edge
+    mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else np.ones((12, 8), bool) if ties else eye_points()[0]
     img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
     img_e[mask], img_g[mask] = e, g
     i = int(np.flatnonzero(np.isnan(g))[0]) if np.isnan(g).any() else int(np.flatnonzero(bad)[0])
@@ -141,7 +142,14 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
     axis = np.abs(d).argmax(axis=1)  # the light's cube face of each point: major axis, its sign
     face = 2 * axis + (d[np.arange(len(d)), axis] < 0)
     per_face = ", ".join(f"{FACES[f]}: {int((bad & (face == f)).sum())}" for f in range(6) if (bad & (face == f)).any())
-    where = f"wall point [{r}, {c}] (walls +x -x +y -y +z -z side by side)" if room else f"pixel [{r}, {c}] of the eye view"
+    where = f"pixel [{r}, {c}] of the eye view"
+    if room:
+        where = f"wall point [{r}, {c}] (walls +x -x +y -y +z -z side by side)"
+    if ties:
+        where = (
+            f"point {c} of cube edge {r}, exactly between two faces (|d_a| = |d_b|: the first axis's face, as "
+            f"cube_face_index, must be read)"
+        )
     raise Mismatch(
         f"{label}: {where} expected visibility {e[i]:.6g}, got {g[i]:.6g}{nan}; "
         f"{int(bad.sum())} of {bad.size} points differ by more than {CUBE_VISIBILITY_ATOL:g} (at most "
@@ -188,6 +196,12 @@ def test_glsl_cube_shadow_every_face(lab):
     """a light inside a room: lit and shadowed wall points on all six cube faces (each face's (s, t) table entry)"""
     check_glsl_cube_shadow(lab, "glsl-cube-room-defaults")
     check_glsl_cube_shadow(lab, "glsl-cube-room-pcf3")
+
+
+@graded(points=1, part="cube shadow lookup", timeout=60)
+def test_glsl_cube_shadow_face_ties(lab):
+    """points exactly on the cube's edges (|d_a| = |d_b|): the face of the first axis, as cube_face_index"""
+    check_glsl_cube_shadow(lab, "glsl-cube-ties-defaults")
 
 
 @graded(points=1, part="cube light pass", timeout=120)

@@ -31,3 +31,4 @@ def test_glsl_cube_shadow_every_face_hidden(lab):
     check_glsl_cube_depth(lab, "hidden-glsl-cube-linear-room2-56-none")
     check_glsl_cube_shadow(lab, "hidden-glsl-cube-room-defaults")
     check_glsl_cube_shadow(lab, "hidden-glsl-cube-room-bias")
+    check_glsl_cube_shadow(lab, "hidden-glsl-cube-ties-pcf3")
