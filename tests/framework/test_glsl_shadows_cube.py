@@ -208,6 +208,16 @@ def test_the_later_axis_on_a_face_tie_is_caught(old):
     assert "exactly between two faces" in msg and "points differ" in msg, msg
 
 
+@pytest.mark.parametrize("code", ["4", "0"], ids=["back-never-culled", "back-culled-under-none"])
+def test_wrong_back_culling_is_caught_inside_the_room(code):
+    """The audit's survivors `cull == 2` -> `cull == 4` / `cull == 0`: back culling dropped (the small scene's
+    closed meshes show the same nearest faces either way); from inside the room the walls are back faces."""
+    old = "(cull == 2 && !gl_FrontFacing)"
+    msg = _fail_of(_edit("cube_depth.frag", old, old.replace("2", code)), "check_glsl_cube_depth",
+                   "glsl-cube-linear-room-48-back")  # fmt: skip
+    assert 'cull="back"' in msg and "cube_depth.frag culls the wrong faces" in msg, msg
+
+
 def test_a_broken_cube_lookup_costs_only_its_own_tests():
     """cube_shadow.frag that does not compile: the cube pass's check, and Task 10's, still pass on the same copy."""
     from tests.graded.shadows import test_shadows_cube_glsl, test_shadows_glsl

@@ -193,6 +193,7 @@ STORED_HIDDEN = [
 STORED += [
     matrices_entry("room"),
     linear_maps_entry("room", 64, "front"),
+    linear_maps_entry("room", 48, "back"),  # from inside, the walls are back faces: back culling drops them
     cube_visibility_entry("glsl-cube-room-defaults", "glsl-cube-linear-room-64-front", "room"),
     cube_visibility_entry("glsl-cube-room-pcf3", "glsl-cube-linear-room-64-front", "room", bias=0.01, pcf=3),
     # points exactly on the cube's edges: the first axis's face on ties
