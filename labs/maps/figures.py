@@ -169,9 +169,9 @@ def _fig_glsl(out: Path, L, quick: bool) -> Drawn:
         "The normal-mapped torus of the first figure under the key and fill lights, shaded on one G-buffer twice: "
         "left by the NumPy route (shade), middle by the shaders (glsl_shade: the TBN matrix from tbn.vert, the "
         "tangent-space normal decoded and turned to world space and lit in normalmap.frag), right their difference "
-        "per pixel, the largest of the three linear RGB channels in 8-bit levels (1 level = 1/255). Over the "
+        "per pixel, the largest of the three linear RGB channels in 8-bit levels (steps of 1/255). Over the "
         "{n:,} covered pixels they differ by at most {mx:.2g} levels (mean {mean:.2g}; {over:,} pixels above half "
-        "a level, where rounding to 8 bits could show): float32 against float64 arithmetic, the same picture.",
+        "a level, where rounding to whole levels could show): float32 against float64 arithmetic, the same picture.",
         n=int(covered.sum()), mx=float(d8.max()), mean=float(d8[covered].mean()), over=int((d8 > 0.5).sum()),
     )  # fmt: skip
 
