@@ -191,7 +191,7 @@ def test_glsl_cube_shadow_pcf_and_far(lab):
     check_glsl_cube_shadow(lab, "glsl-cube-eye-short-far")
 
 
-@graded(points=2, part="cube shadow lookup", timeout=60)
+@graded(points=1, part="cube shadow lookup", timeout=60)
 def test_glsl_cube_shadow_every_face(lab):
     """a light inside a room: lit and shadowed wall points on all six cube faces (each face's (s, t) table entry)"""
     check_glsl_cube_shadow(lab, "glsl-cube-room-defaults")
