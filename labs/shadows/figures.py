@@ -358,7 +358,7 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
     return Drawn.claimed(
         page,
         "Each row renders the same view twice: left with the NumPy route (depth_map and shadow_visibility; "
-        "cube_distance_maps and linear_point_shadow_visibility), middle with the GLSL shaders of tasks 9-12 "
+        "cube_distance_maps and linear_point_shadow_visibility), middle with the lab's GLSL shaders "
         "(depth.vert/.frag and shadow.frag; cube_depth.vert/.frag and cube_shadow.frag), right the difference "
         "of the two visibilities per pixel, in visibility units (from shadow to lit). Directional light: "
         "{d_n:,} of {d_t:,} pixels differ by more than {tol_vis:g} (max {d_mx:.3g}); the {ms}² depth maps agree to "
