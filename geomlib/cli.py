@@ -181,7 +181,8 @@ def _cmd_audit(a) -> int:
     from geomlib.grading import audit
 
     try:
-        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs, kind=a.kind, sample=a.sample)
+        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs, kind=a.kind, sample=a.sample, tasks=a.task,
+                             files=a.file)  # fmt: skip
     except audit.AuditError as e:
         print(f"geomlib audit: error: {e}", file=sys.stderr)
         return 1
@@ -335,6 +336,8 @@ def build_parser() -> argparse.ArgumentParser:
     au.add_argument("--jobs", type=int, default=1, help="mutants graded at once (default 1)")
     au.add_argument("--kind", choices=("nothing", "operator"), help="only does-nothing or only operator mutants")
     au.add_argument("--sample", type=int, help="a fixed, seeded sample of N mutants per lab (of --kind)")
+    au.add_argument("--task", type=int, action="append", help="only the mutants of this task number (repeatable)")
+    au.add_argument("--file", action="append", help="only mutants of files whose path has this (repeatable)")
     au.add_argument("--out", help="also write audit.md and audit.json into this folder")
     au.set_defaults(func=_cmd_audit)
     return p

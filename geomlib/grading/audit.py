@@ -849,11 +849,15 @@ def audit(
     log=print,
     kind: str | None = None,
     sample: int | None = None,
+    tasks: list[int] | None = None,
+    files: list[str] | None = None,
 ) -> dict:
     """Grade the mutants of each lab; returns the report as a dict (see :func:`markdown`).
 
     ``kind`` (``"nothing"`` or ``"operator"``) keeps one kind of mutant; ``sample`` grades a fixed,
-    seeded sample of that many mutants per lab (after ``kind``)."""
+    seeded sample of that many mutants per lab (after ``kind``); ``tasks`` keeps the mutants of those
+    task numbers, ``files`` those whose solution file (``shaders/cube_shadow.frag``) contains one of
+    the strings (``shaders/``: the GLSL part)."""
     from geomlib.grading import tasks as _tasks
 
     names = labs or _impl.lab_names()
@@ -865,6 +869,8 @@ def audit(
     os.chmod(work, 0o755)
     t_start = time.time()
     report: dict = {"labs": {}, "quick": quick, "jobs": jobs, "kind": kind, "sample": sample}
+    if tasks or files:
+        report["only"] = {"tasks": tasks or [], "files": files or []}
     if kind not in (None, "nothing", "operator"):
         raise AuditError(f"unknown mutant kind {kind!r}: 'nothing' or 'operator'")
     runs_of: dict[str, dict] = {}  # lab -> {function: every lab function a call of it runs}
@@ -881,6 +887,10 @@ def audit(
             total = len(muts)
             if kind:
                 muts = [m for m in muts if m.kind == kind]
+            if tasks:
+                muts = [m for m in muts if m.task in tasks]
+            if files:
+                muts = [m for m in muts if any(f in m.file for f in files)]
             if quick:
                 muts = quick_sample(muts, lab)
             elif sample:

@@ -302,6 +302,77 @@ def fig_lights(out: Path, L, quick: bool) -> Drawn:
     )
 
 
+def _vis_image(eb, vis: np.ndarray) -> np.ndarray:
+    """A visibility per covered pixel as an (h, w) image, NaN on the background."""
+    img = np.full(eb.mask.shape, np.nan)
+    img[eb.mask] = vis
+    return img
+
+
+@figure_name("shadows_glsl")
+def fig_glsl(out: Path, L, quick: bool) -> Drawn:
+    """The same pictures by the NumPy route and by the GLSL shaders (tasks 9-12), and their difference."""
+    meas = _measured(L, "zoom", quick)
+    S, eb = meas.scene, meas.eb
+    ms = 512 if quick else 1024
+    # Directional light: depth pass and lookup, PCF 3, the defaults' bias (tasks 2-7 against 9-10).
+    M = L.light_setup(S, L.CLASSIC_LIGHT).matrices[0]
+    D_np = L.depth_map(S.V, S.F, M, ms, cull="none")
+    D_gl = L.glsl_depth_map(S.V, S.F, M, ms, cull="none")
+    v_np = L.shadow_visibility(eb.P, eb.N_face, D_np, M, pcf=3)
+    v_gl = L.glsl_shadow_visibility(eb.P, eb.N_face, D_gl, M, pcf=3)
+    # Point light: the linear cube pass and lookup (tasks 11-12 against their NumPy twins).
+    setup = L.light_setup(S, POINT_LIGHT)
+    pos, near, far = setup.light["position"], setup.near, setup.far
+    cs = ms // 2
+    C_np = L.cube_distance_maps(S.V, S.F, pos, cs, near, far, cull="front")
+    C_gl = L.glsl_cube_depth_maps(S.V, S.F, pos, cs, near, far, cull="front")
+    p_np = L.linear_point_shadow_visibility(eb.P, eb.N_face, C_np, pos, near, far)
+    p_gl = L.glsl_point_shadow_visibility(eb.P, eb.N_face, C_gl, pos, near, far)
+    grey = (205, 215, 230)
+    rows, caps, stats = [], [], {}
+    for key, light, a, b, what in (
+        ("dir", L.CLASSIC_LIGHT, v_np, v_gl, f"directional light, {ms}² map, PCF 3 x 3"),
+        ("pt", POINT_LIGHT, p_np, p_gl, f"point light, six {cs}² linear-depth faces"),
+    ):
+        diff = np.abs(a - b)
+        stats[key] = (int((diff > 1e-6).sum()), float(diff.max()), len(diff))  # 1e-6: the graded tolerance
+        rows += [
+            _u8(L.shade(eb, a, light)),
+            _u8(L.shade(eb, b, light)),
+            with_colorbar(
+                heatmap_image(_vis_image(eb, diff), "magma_r", 0, 1, nan_color=grey),
+                colorbar(0, 1, "magma_r", label="|visibility NumPy - GLSL|", height=eb.mask.shape[0]),
+            ),
+        ]
+        n, mx, tot = stats[key]
+        caps += [
+            f"NumPy route: {what}",
+            "GLSL route: the same, by the shaders",
+            f"|difference| (visibility, 0..1)\n{n:,} of {tot:,} pixels differ, max {mx:.3g}",
+        ]
+    cov = (D_np < 1) != (D_gl < 1)
+    both = (D_np < 1) & (D_gl < 1)
+    ecov = np.abs(C_np - C_gl) > 1e-3
+    page = panels(rows, caps, ncols=3, title="The shaders against the NumPy route (same scene, same light, same map)")
+    return Drawn.claimed(
+        page,
+        "Each row renders the same view twice: left with the NumPy route (depth_map and shadow_visibility; "
+        "cube_distance_maps and linear_point_shadow_visibility), middle with the lab's GLSL shaders "
+        "(depth.vert/.frag and shadow.frag; cube_depth.vert/.frag and cube_shadow.frag), right the difference "
+        "of the two visibilities per pixel, in visibility units (from shadow to lit). Directional light: "
+        "{d_n:,} of {d_t:,} pixels differ by more than {tol_vis:g} (max {d_mx:.3g}); the {ms}² depth maps agree to "
+        "{d_depth:.2g} in window depth where both hold a surface, and {d_cov:,} texels are covered in one map "
+        "only. Point light: {p_n:,} of {p_t:,} pixels differ (max {p_mx:.3g}); the linear cube maps differ by "
+        "more than {tol_depth:g} (distance / far) in {p_cov:,} of {p_all:,} texels. What differs sits on texel "
+        "borders, where the GPU's rasterizer and the NumPy route round a tie differently (the handout's GLSL "
+        "section gives the tolerances).",
+        tol_vis=1e-6, tol_depth=1e-3, d_n=stats["dir"][0], d_t=stats["dir"][2], d_mx=stats["dir"][1], ms=ms,
+        d_depth=float(np.abs(D_np - D_gl)[both].max()), d_cov=int(cov.sum()),
+        p_n=stats["pt"][0], p_t=stats["pt"][2], p_mx=stats["pt"][1], p_cov=int(ecov.sum()), p_all=ecov.size,
+    )  # fmt: skip
+
+
 def _refine_soup(V: np.ndarray, F: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Split every triangle into n*n triangles (a soup: no shared vertices), so shadows show per face."""
     i, j = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
@@ -345,6 +416,7 @@ def fig_view(L, quick: bool) -> MeshView:
 
 
 make_figures, make_view = lab_figure_makers(
-    LAB, __name__, (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights), fig_view,
+    LAB, __name__, (fig_bias, fig_frustum, fig_resolution, fig_pcf, fig_pyrender, fig_lights, fig_glsl),
+    fig_view,
     quick="Smaller images and maps (for the notebook and CI).", shared=_CACHE,
 )  # fmt: skip

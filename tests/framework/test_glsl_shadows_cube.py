@@ -154,7 +154,68 @@ def test_missing_culling_is_caught():
 )  # fmt: skip
 def test_a_wrong_lookup_is_caught(old, new, case):
     msg = _fail_of(_edit("cube_shadow.frag", old, new), "check_glsl_cube_shadow", case)
-    assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "pixels differ" in msg, msg
+    assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "points differ" in msg, msg
+
+
+#: Each face's (s, t) entry of cube_shadow.frag's table, and a wrong one: the face mirrored left-right (s negated).
+FACE_ENTRIES = [
+    ("sctc = vec2(-d.z, -d.y);", "sctc = vec2(d.z, -d.y);"),  # +x
+    ("sctc = vec2(d.z, -d.y);", "sctc = vec2(-d.z, -d.y);"),  # -x
+    ("sctc = vec2(d.x, d.z);", "sctc = vec2(-d.x, d.z);"),  # +y
+    ("sctc = vec2(d.x, -d.z);", "sctc = vec2(-d.x, -d.z);"),  # -y
+    ("sctc = vec2(d.x, -d.y);", "sctc = vec2(-d.x, -d.y);"),  # +z
+    ("sctc = vec2(-d.x, -d.y);", "sctc = vec2(d.x, -d.y);"),  # -z
+]
+
+
+def _face_edit(face: int, new: str):
+    """Replace the table entry of ``face`` only (the -x and +z entries read like other faces' right-hand sides)."""
+    branch = "if (face == 0) {" if face == 0 else f"if (face == {face}) {{" if face < 5 else "} else {"
+    old = FACE_ENTRIES[face][0]
+
+    def edit(dest):
+        path = dest / "shaders" / "cube_shadow.frag"
+        text = path.read_text()
+        head, tail = text.split(branch, 1)
+        assert tail.lstrip().startswith(old), (face, tail[:80])
+        path.write_text(head + branch + tail.replace(old, new, 1))
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    ("face", "wrong"),
+    [(f, w) for f, (_, mirrored) in enumerate(FACE_ENTRIES) for w in (mirrored, "swap")],
+    ids=[f"{face}-{kind}" for face in ("+x", "-x", "+y", "-y", "+z", "-z") for kind in ("mirrored", "transposed")],
+)
+def test_a_wrong_face_entry_is_caught_by_the_public_room_case(face, wrong):
+    """Every face's (s, t) table entry mirrored, or its s and t swapped, fails the public room case and names the
+    face (the eye view has no +z point and light "a" no shadow on +x: the room case is what catches those)."""
+    if wrong == "swap":
+        s, t = FACE_ENTRIES[face][0].removeprefix("sctc = vec2(").removesuffix(");").split(", ")
+        wrong = f"sctc = vec2({t}, {s});"
+    msg = _fail_of(_face_edit(face, wrong), "check_glsl_cube_shadow", "glsl-cube-room-defaults")
+    name = ("+x", "-x", "+y", "-y", "+z", "-z")[face]
+    assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg, msg
+    assert re.search(rf"by the light's cube face: {re.escape(name)}: \d+$", msg.splitlines()[0]), msg
+
+
+@pytest.mark.parametrize("old", ["if (ad.y > ad[a]) {", "if (ad.z > ad[a]) {"], ids=["x-y-tie-to-y", "z-tie-to-z"])
+def test_the_later_axis_on_a_face_tie_is_caught(old):
+    """`>` turned `>=` in cube_face (the audit's mutants): points exactly on a cube edge read the later axis's face."""
+    msg = _fail_of(_edit("cube_shadow.frag", old, old.replace(">", ">=")), "check_glsl_cube_shadow",
+                   "glsl-cube-ties-defaults")  # fmt: skip
+    assert "exactly between two faces" in msg and "points differ" in msg, msg
+
+
+@pytest.mark.parametrize("code", ["4", "0"], ids=["back-never-culled", "back-culled-under-none"])
+def test_wrong_back_culling_is_caught_inside_the_room(code):
+    """The audit's survivors `cull == 2` -> `cull == 4` / `cull == 0`: back culling dropped (the small scene's
+    closed meshes show the same nearest faces either way); from inside the room the walls are back faces."""
+    old = "(cull == 2 && !gl_FrontFacing)"
+    msg = _fail_of(_edit("cube_depth.frag", old, old.replace("2", code)), "check_glsl_cube_depth",
+                   "glsl-cube-linear-room-48-back")  # fmt: skip
+    assert 'cull="back"' in msg and "cube_depth.frag culls the wrong faces" in msg, msg
 
 
 def test_a_broken_cube_lookup_costs_only_its_own_tests():

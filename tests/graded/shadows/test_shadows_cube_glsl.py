@@ -30,7 +30,7 @@ from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
-from .cases_cube_glsl import STORED, STORED_HIDDEN
+from .cases_cube_glsl import ROOM_GRID, STORED, STORED_HIDDEN
 from .cases_glsl import eye_points
 
 CUBE_DEPTH_ATOL = 1e-3
@@ -116,7 +116,8 @@ def check_glsl_cube_depth(lab, case_id: str) -> None:
 def check_glsl_cube_shadow(lab, case_id: str) -> None:
     """``glsl_point_shadow_visibility`` per eye pixel against the stored ``linear_point_shadow_visibility``."""
     case = _case(case_id)
-    got = lab.glsl_point_shadow_visibility(**case.inputs(), **case.params)
+    inp = case.inputs()
+    got = lab.glsl_point_shadow_visibility(**inp, **case.params)
     e = stored_input("shadows", case_id)["visibility"]
     opts = ", ".join(f"{k}={v!r}" for k, v in case.params.items()) or "the defaults"
     label = f'{CUBE_SHADOW_LABEL} on "{case_id}" ({opts})'
@@ -129,16 +130,30 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
     bad = ~(np.abs(g - e) <= CUBE_VISIBILITY_ATOL)  # NaN counts as wrong
     if bad.mean() <= CUBE_VISIBILITY_BAD and not np.isnan(g).any():
         return
-    mask = eye_points()[0]
+    room = "-room-" in case_id  # the walls of a room around the light, side by side, instead of the eye view
+    ties = "-ties-" in case_id  # 8 points on each of the cube's 12 edges, a row per edge
+    mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else np.ones((12, 8), bool) if ties else eye_points()[0]
     img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
     img_e[mask], img_g[mask] = e, g
     i = int(np.flatnonzero(np.isnan(g))[0]) if np.isnan(g).any() else int(np.flatnonzero(bad)[0])
     r, c = (int(x) for x in np.argwhere(mask)[i])
     nan = " (NaN: a division by zero, or a read outside the cube map?)" if np.isnan(g[i]) else ""
+    d = np.asarray(inp["P"], float) - np.asarray(inp["position"], float)
+    axis = np.abs(d).argmax(axis=1)  # the light's cube face of each point: major axis, its sign
+    face = 2 * axis + (d[np.arange(len(d)), axis] < 0)
+    per_face = ", ".join(f"{FACES[f]}: {int((bad & (face == f)).sum())}" for f in range(6) if (bad & (face == f)).any())
+    where = f"pixel [{r}, {c}] of the eye view"
+    if room:
+        where = f"wall point [{r}, {c}] (walls +x -x +y -y +z -z side by side)"
+    if ties:
+        where = (
+            f"point {c} of cube edge {r}, exactly between two faces (|d_a| = |d_b|: the first axis's face, as "
+            f"cube_face_index, must be read)"
+        )
     raise Mismatch(
-        f"{label}: pixel [{r}, {c}] of the eye view expected visibility {e[i]:.6g}, got {g[i]:.6g}{nan}; "
-        f"{int(bad.sum())} of {bad.size} pixels differ by more than {CUBE_VISIBILITY_ATOL:g} (at most "
-        f"{CUBE_VISIBILITY_BAD:.1%} may, points on a texel border)",
+        f"{label}: {where} expected visibility {e[i]:.6g}, got {g[i]:.6g}{nan}; "
+        f"{int(bad.sum())} of {bad.size} points differ by more than {CUBE_VISIBILITY_ATOL:g} (at most "
+        f"{CUBE_VISIBILITY_BAD:.1%} may, points on a texel border); by the light's cube face: {per_face}",
         failure_picture(label, img_g, img_e, name="visibility", atol=CUBE_VISIBILITY_ATOL),
     )
 
@@ -174,3 +189,23 @@ def test_glsl_cube_shadow_pcf_and_far(lab):
     """3 x 3 PCF within a face, and points beyond the far plane lit"""
     check_glsl_cube_shadow(lab, "glsl-cube-eye-pcf3")
     check_glsl_cube_shadow(lab, "glsl-cube-eye-short-far")
+
+
+@graded(points=1, part="cube shadow lookup", timeout=60)
+def test_glsl_cube_shadow_every_face(lab):
+    """a light inside a room: lit and shadowed wall points on all six cube faces (each face's (s, t) table entry)"""
+    check_glsl_cube_shadow(lab, "glsl-cube-room-defaults")
+    check_glsl_cube_shadow(lab, "glsl-cube-room-pcf3")
+
+
+@graded(points=1, part="cube shadow lookup", timeout=60)
+def test_glsl_cube_shadow_face_ties(lab):
+    """points exactly on the cube's edges (|d_a| = |d_b|): the face of the first axis, as cube_face_index"""
+    check_glsl_cube_shadow(lab, "glsl-cube-ties-defaults")
+
+
+@graded(points=1, part="cube light pass", timeout=120)
+def test_glsl_cube_depth_maps_inside_a_room(lab):
+    """the cube pass from inside a closed room: every texel of all six faces covered; back culling drops the walls"""
+    check_glsl_cube_depth(lab, "glsl-cube-linear-room-64-front")
+    check_glsl_cube_depth(lab, "glsl-cube-linear-room-48-back")

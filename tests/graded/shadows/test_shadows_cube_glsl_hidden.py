@@ -23,3 +23,17 @@ def test_glsl_cube_shadow_pcf_hidden(lab):
 def test_glsl_cube_shadow_defaults_hidden(lab):
     """the default bias on a hidden light"""
     check_glsl_cube_shadow(lab, "hidden-glsl-cube-eye-defaults")
+
+
+@graded(points=2, part="cube light pass", visibility="hidden", timeout=120)
+def test_glsl_cube_depth_maps_room_hidden(lab):
+    """shaders/cube_depth.vert + cube_depth.frag from inside another room, unculled"""
+    check_glsl_cube_depth(lab, "hidden-glsl-cube-linear-room2-56-none")
+
+
+@graded(points=2, part="cube shadow lookup", visibility="hidden", timeout=60)
+def test_glsl_cube_shadow_every_face_hidden(lab):
+    """another room, unculled: lit and shadowed wall points on all six cube faces, default and small bias; face ties"""
+    check_glsl_cube_shadow(lab, "hidden-glsl-cube-room-defaults")
+    check_glsl_cube_shadow(lab, "hidden-glsl-cube-room-bias")
+    check_glsl_cube_shadow(lab, "hidden-glsl-cube-ties-pcf3")
