@@ -840,6 +840,18 @@ def _first_failure(res: dict) -> str:
     return ""
 
 
+def select_mutants(muts: list, *, kind: str | None = None, tasks=None, files=None) -> list:
+    """The mutants ``geomlib audit --kind/--task/--file`` keep: of that kind, of one of those task
+    numbers, of a solution file whose path contains one of the strings (all given filters apply)."""
+    if kind:
+        muts = [m for m in muts if m.kind == kind]
+    if tasks:
+        muts = [m for m in muts if m.task in tasks]
+    if files:
+        muts = [m for m in muts if any(f in m.file for f in files)]
+    return muts
+
+
 def audit(
     labs: list[str] | None = None,
     *,
@@ -885,12 +897,7 @@ def audit(
             ids = {m.id for m in muts}
             stale = [i for i in eq if i not in ids]
             total = len(muts)
-            if kind:
-                muts = [m for m in muts if m.kind == kind]
-            if tasks:
-                muts = [m for m in muts if m.task in tasks]
-            if files:
-                muts = [m for m in muts if any(f in m.file for f in files)]
+            muts = select_mutants(muts, kind=kind, tasks=tasks, files=files)
             if quick:
                 muts = quick_sample(muts, lab)
             elif sample:

@@ -249,3 +249,15 @@ def test_does_nothing_restores_the_objects_the_block_changes(tmp_path):
         out = ns["loop"](state, 3)
         assert state.x.tolist() == [0.0, 0.0, 0.0] and state.n == 5, (mode, state)
         assert out == {"zeros": 0, "input": 3, "constant": 1}[mode], (mode, out)
+
+
+def test_task_and_file_filters_keep_exactly_their_mutants():
+    """``geomlib audit --task 11 --file shaders/`` grades the cube light pass's shader mutants only."""
+    root = _impl.course_root() / "solutions"
+    muts, _ = audit.generate("shadows", root / "shadows", check_glsl=False)
+    kept = audit.select_mutants(muts, tasks=[11], files=["shaders/"])
+    assert kept and {m.task for m in kept} == {11}, {m.task for m in kept}
+    assert {m.file for m in kept} == {"shaders/cube_depth.vert", "shaders/cube_depth.frag"}, {m.file for m in kept}
+    assert len(kept) == sum(m.task == 11 and m.file.startswith("shaders/") for m in muts)
+    nothing = audit.select_mutants(muts, kind="nothing", files=["lookup.py"])
+    assert nothing and all(m.kind == "nothing" and "lookup.py" in m.file for m in nothing)
