@@ -13,6 +13,10 @@ imports pyrender; an EGL context by pyrender's ``EGLPlatform``. Never mix EGL an
 process (PyOpenGL binds its platform once, at import). Every call makes this module's context
 current first, so it coexists with pyrender's own contexts.
 
+Longer than most modules (about 700 lines) on purpose: the context, the shader compiler with
+its student-facing error messages, textures, render targets and the two draw calls are one harness
+that every GLSL lab uses; split, each part would need the others' private state.
+
 Conventions, those of every texture in geomlib: image row 0 is ``v = 1`` (the top); the
 full-screen quad passes ``uv`` in [0, 1]² with ``v`` up, and pixel ``(r, c)`` of a ``(h, w)``
 output has its centre at ``uv = ((c + 0.5) / w, 1 - (r + 0.5) / h)``. Textures are uploaded with

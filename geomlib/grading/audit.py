@@ -694,7 +694,9 @@ def _worker_main() -> int:
     from geomlib.grading import sandbox
     from geomlib.grading.grade import grade
 
-    user_limit = os.environ.get("GEOMLIB_TIME_LIMIT")
+    from geomlib.grading.settings import env
+
+    user_limit = env("GEOMLIB_TIME_LIMIT")
     for line in sys.stdin:
         req = json.loads(line)
         t = time.time()

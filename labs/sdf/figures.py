@@ -6,6 +6,9 @@ work (a figure whose tasks are missing is replaced by a panel naming them); comp
 ``docs/figures/sdf/``. Numbers in the captions and panel labels are measured when the figure is made.
 Images are sphere-traced by :func:`render_sdf` (the lab's own tracer); the hit mask is compared with
 geomlib's rasterizer.
+
+Longer than most modules (about 650 lines): one builder per figure of the handout, each with the
+measurements its caption quotes; they share the scene set-up at the top.
 """
 
 from __future__ import annotations

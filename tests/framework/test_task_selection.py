@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -129,8 +131,29 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     assert p.stdout.strip().splitlines() == cli.strip().splitlines()
 
 
+def _student_copy(lab: str, dest: Path) -> Path:
+    """What a student's bundle holds of ``lab``: its stubs, public graded tests and references (no
+    hidden material, no solutions), with the grader, in ``dest``."""
+    from geomlib.grading.course import Course
+
+    hidden = shutil.ignore_patterns("__pycache__", "*hidden*")
+    for rel in ("geomlib", f"labs/{lab}", f"tests/graded/{lab}", f"tests/reference/{lab}"):
+        shutil.copytree(ROOT / rel, dest / rel, ignore=hidden)
+    for rel in (
+        "pyproject.toml",
+        "tests/conftest.py",
+        *(p.relative_to(ROOT) for p in (ROOT / "tests/graded").glob("*.py")),
+    ):
+        shutil.copy2(ROOT / rel, dest / rel)
+    assert not Course(dest).hidden_paths(), "the copy must hold no hidden material"
+    return dest
+
+
 def test_a_task_graded_through_the_loop_runs_the_loop_tests_and_says_so(tmp_path):
-    out = run_geomlib(ROOT, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "6", cwd=tmp_path).stdout
+    """In the student's bundle, remeshing's Task 6 (equalize valences) has no public test of its own
+    (its own checks are hidden): ``--task 6`` runs the loop's tests that call it, and says so."""
+    root = _student_copy("remeshing", tmp_path / "course")
+    out = run_geomlib(root, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "6", cwd=tmp_path).stdout
     assert out.startswith("Task 6: equalize valences has no test of its own"), out
     assert "Task 10 (the loop)" in out, out
 
