@@ -340,16 +340,18 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
         rows += [
             _u8(L.shade(eb, a, light)),
             _u8(L.shade(eb, b, light)),
+            # On the graded tolerance's scale: how far each pixel is from failing (0..1 visibility
+            # would paint every pixel the same colour).
             with_colorbar(
-                heatmap_image(_vis_image(eb, diff), "magma_r", 0, 1, nan_color=grey),
-                colorbar(0, 1, "magma_r", label="|visibility NumPy - GLSL|", height=eb.mask.shape[0]),
+                heatmap_image(_vis_image(eb, diff / 1e-6), "magma_r", 0, 1, nan_color=grey),
+                colorbar(0, 1, "magma_r", label="|NumPy - GLSL| / 1e-6", height=eb.mask.shape[0]),
             ),
         ]
         n, mx, tot = stats[key]
         caps += [
             f"NumPy route: {what}",
             "GLSL route: the same, by the shaders",
-            f"|difference| (visibility, 0..1)\n{n:,} of {tot:,} pixels differ, max {mx:.3g}",
+            f"|difference| in units of the graded tolerance 1e-6\n{n:,} of {tot:,} pixels beyond it, max {mx:.3g}",
         ]
     cov = (D_np < 1) != (D_gl < 1)
     both = (D_np < 1) & (D_gl < 1)
@@ -360,7 +362,8 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
         "Each row renders the same view twice: left with the NumPy route (depth_map and shadow_visibility; "
         "cube_distance_maps and linear_point_shadow_visibility), middle with the lab's GLSL shaders "
         "(depth.vert/.frag and shadow.frag; cube_depth.vert/.frag and cube_shadow.frag), right the difference "
-        "of the two visibilities per pixel, in visibility units (from shadow to lit). Directional light: "
+        "of the two visibilities per pixel, in units of the graded tolerance {tol_vis:g} (a visibility runs from "
+        "shadow to lit). Directional light: "
         "{d_n:,} of {d_t:,} pixels differ by more than {tol_vis:g} (max {d_mx:.3g}); the {ms}² depth maps agree to "
         "{d_depth:.2g} in window depth where both hold a surface, and {d_cov:,} texels are covered in one map "
         "only. Point light: {p_n:,} of {p_t:,} pixels differ (max {p_mx:.3g}); the linear cube maps differ by "
