@@ -7,6 +7,7 @@ throw-away copy of the course, so an attack that got through could not damage th
 from __future__ import annotations
 
 import json
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -25,7 +26,12 @@ def _grade(kind: str, tmp_path: Path, python: str | None = None, **env) -> dict:
     work = Path(tempfile.mkdtemp(prefix=f"geomlib-hostile-{kind}-"))
     work.chmod(0o755)
     course = Path(__file__).resolve().parents[2]
-    r = grade_planted(kind, course, work, python=python or sys.executable, env=env, timeout=600)
+    try:
+        r = grade_planted(kind, course, work, python=python or sys.executable, env=env, timeout=600)
+    finally:
+        # The course copy holds whatever the checkout holds beside the sources (up to 2.6 GB each
+        # before): left behind, a few suite runs filled the disk and the next run failed everywhere.
+        shutil.rmtree(work, ignore_errors=True)
     assert not r["hung"], r["log"]
     assert r["results"] is not None, r["log"]
     validate_results(r["results"])
