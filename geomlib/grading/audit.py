@@ -693,7 +693,6 @@ def _worker_main() -> int:
     from geomlib.grading import audit as registered  # the module pytest loads with -p (this one is __main__)
     from geomlib.grading import sandbox
     from geomlib.grading.grade import grade
-
     from geomlib.grading.settings import env
 
     user_limit = env("GEOMLIB_TIME_LIMIT")
