@@ -19,25 +19,12 @@ from geomlib.grading.stubs import make_stub
 from tests.graded.shadows.support import small_scene
 
 from .course import planted_solution
+from .test_glsl_shadows import _edit, _line_of  # the same shaders folder: one set of edit helpers
 
 COURSE = Path(__file__).resolve().parents[2]
 SHADERS = COURSE / "solutions" / "shadows" / "shaders"
 TASK = {"cube_depth.vert": 11, "cube_depth.frag": 11, "cube_shadow.frag": 12}
 LIGHT = {"position": np.array([0.2, -0.3, 2.6]), "near": 0.2, "far": 12.0}
-
-
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
-def _edit(shader: str, old: str, new: str):
-    return lambda dest: _replace(dest / "shaders" / shader, old, new)
-
-
-def _line_of(shader: str, text: str) -> int:
-    return next(i for i, ln in enumerate((SHADERS / shader).read_text().splitlines(), start=1) if text in ln)
 
 
 def _depth_inputs():
