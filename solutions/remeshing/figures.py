@@ -487,12 +487,13 @@ def fig_view(R, quick: bool) -> MeshView:
     U, G = R.isotropic_remesh(V, F, L, iterations=5 if quick else 10)
     U, G = np.asarray(U, float), np.asarray(G)
     H = topology.halfedge_mesh(G, len(U))
-    dev = np.abs(H.valence - np.where(H.boundary_vertex, 4, 6)).astype(float)
+    # signed, as in the PNGs (blue below the target, grey at it, red above), not |valence - 6|
+    dev = (H.valence - np.where(H.boundary_vertex, TARGET_BOUNDARY, TARGET_INSIDE)).astype(float)
     return MeshView(
         U, G, dev, title=f"Remeshed bunny (L = {L})", up="z",
-        cmap="viridis", scalar_name="|valence - 6|",
-        caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by how far "
-        "its valence is from 6 (0: regular).",
+        cmap="coolwarm", clim=(-3.0, 3.0), scalar_name="valence - target (6 inside, 4 on the boundary)",
+        caption=f"Turn it: the metaball bunny after isotropic remeshing to L = {L}, each vertex coloured by its "
+        "valence minus the target, as in the pictures: blue below 6, grey at 6 (regular), red above.",
     )  # fmt: skip
 
 
