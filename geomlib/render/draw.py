@@ -243,4 +243,8 @@ def _check_attributes(V, m, o: RenderOptions, *, where):
         if hp.size and (hp.min() < 0 or hp.max() >= n):
             bad = int(hp[(hp < 0) | (hp >= n)][0])
             raise MeshError(f"{where}: highlight_points has vertex index {bad}, valid indices are 0..{n - 1}")
+    if np.ndim(o.point_color) == 2:  # one colour per dot
+        if hp is None:
+            raise MeshError(f"{where}: point_color gives one colour per dot, but highlight_points is not given")
+        _as_rgb(o.point_color, "point_color", where, n=len(hp), per="entry of highlight_points")
     return C, FC, UV, TEX, N, hp

@@ -65,8 +65,9 @@ class RenderOptions:
         pixel, so a dense mesh is not painted solid black.
     highlight_points : (k,) int array_like, optional
         Vertex indices to mark with dots (e.g. extraordinary vertices); hidden ones are not drawn.
-    point_color : RGB in [0, 1]
-        Colour of the dots.
+    point_color : RGB in [0, 1], or (k, 3) array_like
+        Colour of the dots: one for all, or one per entry of ``highlight_points`` (e.g. a dot's
+        colour telling its valence).
     point_radius : float
         Dot radius in output pixels.
     highlight_lines : (k, 2, 3) array_like, optional
@@ -245,7 +246,7 @@ def check_options(o: RenderOptions, where: str) -> Checked:
         base=_as_rgb(o.base_color, "base_color", where),
         back=_as_rgb(o.back_color, "back_color", where) if o.back_color is not None else None,
         wire_rgb=_as_rgb(o.wire_color, "wire_color", where),
-        point_rgb=_as_rgb(o.point_color, "point_color", where),
+        point_rgb=_point_rgb(o.point_color, where),
         up_vec=np.array([0.0, 1.0, 0.0]) if o.up_axis == "y" else np.array([0.0, 0.0, 1.0]),
     )
 
@@ -256,6 +257,13 @@ def _check_size(size, where: str) -> tuple[int, int]:
     w = check_int(size[0], "size[0] (width)", minimum=1, maximum=8192, where=where)
     h = check_int(size[1], "size[1] (height)", minimum=1, maximum=8192, where=where)
     return w, h
+
+
+def _point_rgb(c, where: str) -> np.ndarray:
+    """``point_color``: one colour, or one per highlighted point (rows checked against them when drawn)."""
+    if np.ndim(c) == 2:
+        return _as_rgb(c, "point_color", where, n=np.shape(c)[0], per="highlighted point")
+    return _as_rgb(c, "point_color", where)
 
 
 def _as_rgb(c, name: str, where: str, *, n: int | None = None, per: str = "vertex") -> np.ndarray:

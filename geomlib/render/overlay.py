@@ -114,7 +114,10 @@ def overlay(
     point_color: np.ndarray,
     point_px: float,
 ) -> np.ndarray:
-    """Draw depth-tested edges and dots onto the (supersampled) render."""
+    """Draw depth-tested edges and dots onto the (supersampled) render.
+
+    ``point_color`` is one RGB colour in [0, 1] (shape ``(3,)``) or one per point (``(k, 3)``).
+    """
     from scipy import ndimage
 
     H, W = depth.shape
@@ -135,7 +138,9 @@ def overlay(
         vis, ix, iy = _visible(px, py, z, dmax, tol)
         iy, ix = iy[vis], ix[vis]
         ring = _stamped(iy, ix, _disk(point_px + 0.3 * point_px + 2), (H, W))
-        core = _stamped(iy, ix, _disk(point_px), (H, W))
         out[ring] = 255.0  # white halo keeps dots readable on dark wireframes
-        out[core] = (255.0 * point_color).astype(np.float32)
+        rgb = np.broadcast_to(point_color, (len(points), 3))[vis]
+        for c in np.unique(rgb, axis=0):  # one stamp per colour (a handful), not one per dot
+            same = (rgb == c).all(axis=1)
+            out[_stamped(iy[same], ix[same], _disk(point_px), (H, W))] = (255.0 * c).astype(np.float32)
     return out

@@ -32,12 +32,14 @@ __all__ = [
     "bunny_head",
     "quality",
     "valence_colors",
+    "valence_dots",
 ]
 
 LAB = "remeshing"
 #: valence colours: blue below the target, grey at it, red above (target 6 inside, 4 on the boundary)
 LOW, SIX, HIGH = np.array([0.25, 0.45, 0.95]), np.array([0.82, 0.82, 0.82]), np.array([0.95, 0.3, 0.25])
 VALENCE_TITLE = "vertices coloured by valence: blue below 6, grey 6, red above"
+DOTS_TITLE = "dots mark irregular vertices: blue below valence 6, red above"
 #: the target valences: inside and on the boundary
 TARGET_INSIDE, TARGET_BOUNDARY = 6, 4
 #: boundary vertices (black, apart from the valence colours) and feature lines (green)
@@ -169,6 +171,19 @@ def valence_colors(V, F) -> np.ndarray:
     return np.where(d[:, None] < 0, LOW, np.where(d[:, None] > 0, HIGH, SIX))
 
 
+def valence_dots(V, F, radius: float = 1.6) -> dict:
+    """Render options marking each irregular vertex with a dot: :data:`LOW` below the target, :data:`HIGH` above.
+
+    Dots, not blended vertex colours (:func:`valence_colors`): on a mesh of long thin triangles the
+    blend smears one vertex's colour over its fan, and one cannot tell which vertex is irregular.
+    Regular vertices get no dot. Returns ``highlight_points``, ``point_color`` and ``point_radius``.
+    """
+    H = topology.halfedge_mesh(np.asarray(F), len(V))
+    d = H.valence - np.where(H.boundary_vertex, TARGET_BOUNDARY, TARGET_INSIDE)
+    off = np.flatnonzero(d != 0)
+    return dict(highlight_points=off, point_color=np.where(d[off, None] < 0, LOW, HIGH), point_radius=radius)
+
+
 def _histogram(meshes, labels, size, title) -> np.ndarray:
     xs, ys = [], []
     for V, F in meshes:
@@ -204,28 +219,28 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     missing = MissingTasks()  # tasks whose panels are left blank
     imgs, caps = [], []
     for name, (V, F) in (("bunny (marching cubes)", bunny), ("bunny decimated by QEM", decimated)):
-        imgs.append(render(V, F, colors=valence_colors(V, F), **kw))
+        imgs.append(render(V, F, **valence_dots(V, F), **kw))
         caps.append(f"{name}: {_summary(quality(V, F))}")
         result = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its))
         if result is None:
             imgs.append(_blank(size))
             caps.append("isotropic_remesh: not implemented yet")
         else:
-            imgs.append(render(*result, colors=valence_colors(*result), **kw))
+            imgs.append(render(*result, **valence_dots(*result), **kw))
             caps.append(f"remeshed, L = {L}: {_summary(quality(*result))}")
         meshes = [(V, F)] + ([result] if result is not None else [])
         hist_size = (max(size[0] + 40, 360), max(size[1], 280))
         imgs.append(_histogram(meshes, ["input", "remeshed"][: len(meshes)], hist_size, "angles (60° = equilateral)"))
         caps.append(f"corner angles of the {name.split(' (')[0]}")
-    img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {VALENCE_TITLE}")
+    img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {DOTS_TITLE}")
     return Drawn(
         img,
         missing.caption_head()
         + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
         f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
         f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
-        "Vertices are coloured by valence (blue below 6, grey 6, red above); the captions give the faces, the "
-        "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6; the "
+        "A dot marks each vertex whose valence is not 6 (blue below, red above; 4 on the boundary); the captions "
+        "give the faces, the smallest angle, the share of angles below 30° and the share of interior vertices of valence 6; the "
         "plots show the distribution of the corner angles, which remeshing gathers around 60°.",
     )
 
@@ -241,13 +256,13 @@ def fig_iterations(out: Path, R, quick: bool) -> Drawn:
     for its in range(6):
         U, G = R.isotropic_remesh(V, F, L, iterations=its)
         U, G = np.asarray(U, dtype=np.float64), np.asarray(G)
-        imgs.append(render(U, G, colors=valence_colors(U, G), **kw))
+        imgs.append(render(U, G, **valence_dots(U, G), **kw))
         caps.append(f"{its} iteration{'' if its == 1 else 's'}: {_summary(quality(U, G))}")
-    img = panels(imgs, caps, ncols=3, title=f"The decimated bunny after 0 to 5 iterations (L = {L}); {VALENCE_TITLE}")
+    img = panels(imgs, caps, ncols=3, title=f"The decimated bunny after 0 to 5 iterations (L = {L}); {DOTS_TITLE}")
     return Drawn(
         img,
         f"isotropic_remesh(V, F, {L}, iterations=k) of the QEM-decimated bunny for k = 0 (the input) to 5, "
-        "vertices coloured by valence (blue below 6, grey 6, red above); each caption gives the faces, the "
+        "a dot on each vertex whose valence is not 6 (blue below, red above); each caption gives the faces, the "
         "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6.",
     )
 

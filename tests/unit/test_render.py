@@ -245,6 +245,11 @@ def test_egl_fallback_renders_like_osmesa(tmp_path):
         (dict(uv=np.zeros((3, 2)), texture=np.zeros((8, 8, 3))), r"uv has 3 rows, expected 4"),
         (dict(normals=np.zeros((4, 3))), r"normals: row 0 is the zero vector"),
         (dict(highlight_points=[7]), r"highlight_points has vertex index 7"),
+        (
+            dict(highlight_points=[0, 1], point_color=np.ones((3, 3))),
+            r"point_color has 3 rows, expected 2 \(one colour per entry of highlight_points\)",
+        ),
+        (dict(point_color=np.ones((2, 3))), r"point_color gives one colour per dot, but highlight_points is not given"),
         (dict(highlight_lines=np.zeros((2, 3))), r"highlight_lines has shape \(2, 3\), expected \(n, 2, 3\)"),
         (dict(highlight_lines=np.zeros((1, 2, 3)), line_width=0), r"line_width must be > 0"),
         (dict(camera="isometric"), r"camera must be one of"),
@@ -280,6 +285,22 @@ def test_highlight_lines_are_drawn_where_visible(sphere, plain):
     hidden = R.render(V, F, size=SIZE, highlight_lines=under, line_color=(0.0, 0.8, 0.1), line_width=3)
     assert green(plain[0]) == 0 and green(img) >= 40, "a visible highlight line should be drawn in its colour"
     assert green(hidden) == 0, "a line behind the surface should be hidden by the depth test"
+
+
+@pytest.mark.render
+def test_highlight_points_take_one_colour_each(sphere, wired):
+    """Dots coloured one by one (e.g. by valence): each visible dot in its own colour, one colour as before."""
+    V, F = sphere
+    red = lambda img: int(((img[..., 0] > 200) & (img[..., 1] < 60) & (img[..., 2] < 60)).sum())  # noqa: E731
+    blue = lambda img: int(((img[..., 2] > 200) & (img[..., 0] < 60) & (img[..., 1] < 60)).sum())  # noqa: E731
+    top = int(np.argmax(V[:, 2]))
+    side = int(np.argmax(V @ [0.52, -0.74, 0.42]))  # facing the three_quarter eye (front right, above)
+    kw = dict(size=SIZE, wireframe=True, highlight_points=[top, side], point_radius=3)
+    both = R.render(V, F, point_color=[[0.9, 0.1, 0.1], [0.1, 0.1, 0.9]], **kw)
+    assert red(both) >= 10 and blue(both) >= 10, "each dot should be drawn in its own colour"
+    one = R.render(V, F, point_color=[[0.9, 0.1, 0.1], [0.9, 0.1, 0.1]], **kw)
+    np.testing.assert_array_equal(one, R.render(V, F, point_color=(0.9, 0.1, 0.1), **kw))
+    assert blue(one) == 0
 
 
 @pytest.mark.render
