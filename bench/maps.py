@@ -27,11 +27,10 @@ import time
 
 import igl
 import numpy as np
-import trimesh
 from igl.embree import line_mesh_intersection
 
-from bench.anchors import pyrender_normal_mapped_mesh
-from bench.measure import ROUTE_HEADER, SHARED, best_of, interleaved, load_average, peak_mib, route_row
+from bench.anchors import pyrender_mesh_frame, pyrender_normal_mapped_mesh
+from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
 from geomlib import camera, datasets
 from geomlib.textures import rasterize_uv, triangle_atlas
 from solutions.maps import (
@@ -210,41 +209,6 @@ def bench_bake(quick: bool, repeat: int) -> None:
         bench_bake_case(f"{fname} -> decimated, triangle atlas", V, F, Vs, Fs, UV, size, repeat)
 
 
-def pyrender_mesh_frame(V, F, pose, size: int):
-    """pyrender drawing a plain mesh at ``size``^2, the mesh built and uploaded in the call (its vertices
-    are new every frame, as a displaced mesh's are), one directional light."""
-    from geomlib import render as grender
-
-    pyrender = grender.import_pyrender()
-    renderer = grender.offscreen_renderer(size, size)
-    view = camera.look_at(pose[0], pose[1], (0, 0, 1))
-    light = np.linalg.inv(camera.look_at((1.0, -1.0, 2.0), (0, 0, 0), (0, 0, 1)))
-    cam = pyrender.PerspectiveCamera(yfov=np.radians(40), aspectRatio=1.0, znear=0.5, zfar=10.0)
-
-    def frame():
-        scene = pyrender.Scene(bg_color=[1.0, 1.0, 1.0, 1.0], ambient_light=[0.1] * 3)
-        scene.add(pyrender.Mesh.from_trimesh(trimesh.Trimesh(V, F, process=False), smooth=True))
-        scene.add(cam, pose=np.linalg.inv(view))
-        scene.add(pyrender.DirectionalLight(intensity=3.0), pose=light)
-        return renderer.render(scene)
-
-    return frame
-
-
-def glsl_first(fn) -> float:
-    """Wall time of the first call of a GLSL route (its shaders compiled, the program cached afterwards)."""
-    return best_of(fn, 1).wall
-
-
-def routes(name: str, numpy, glsl, anchor, repeat: int, agree) -> None:
-    """Time the NumPy route, the GLSL route (its first call apart) and the pyrender anchor (``None``: none),
-    interleaved; print the row with ``agree(numpy_out, glsl_out)``."""
-    first = glsl_first(glsl)
-    r = interleaved({"numpy": numpy, "glsl": glsl, **({} if anchor is None else {"pyrender": anchor})}, repeat)
-    pr = r["pyrender"].wall if "pyrender" in r else None
-    route_row(name, r["numpy"], r["glsl"], pr, first, agree(r["numpy"].out, r["glsl"].out))
-
-
 def route_shade(name, scene, g, lights, opts, size: int, repeat: int) -> None:
     from solutions.maps.figures import ALBEDO
 
@@ -255,7 +219,7 @@ def route_shade(name, scene, g, lights, opts, size: int, repeat: int) -> None:
     except Exception as err:  # no headless OpenGL for pyrender: the two routes alone
         print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
         renderer = None
-    routes(
+    compare_routes(
         f"shade: {name}",
         lambda: shade(g, lights, eye, ALBEDO, nmap, **opts),
         lambda: glsl_shade(g, lights, eye, ALBEDO, nmap, **opts),
@@ -274,7 +238,7 @@ def route_displace(name, V, F, UV, H, kw: dict, eye, size: int, repeat: int) -> 
     except Exception as err:
         print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
         frame = None
-    routes(
+    compare_routes(
         f"{name}, {len(V):,} v",
         lambda: displace(V, F, UV, None, H, **kw),
         lambda: glsl_displace(V, F, UV, None, H, **kw),
@@ -326,7 +290,7 @@ def bench_glsl(repeat: int) -> None:
     Nt = welded_vertex_normals(Vt, Ft)
     Tt, _, _, wt = tangent_frames(Vt, Ft, UVt, Nt)
     tgt = np.column_stack([Tt, wt])
-    routes(
+    compare_routes(
         f"tbn.vert: uv_torus(384, 128), {len(Vt):,} v",
         lambda: surface_frames(Nt, tgt),
         lambda: glsl_tbn(Nt, tgt),

@@ -86,10 +86,20 @@ def route_row(label: str, numpy: Timing, glsl: Timing, anchor: float | None, fir
     the ratios against the anchor, the GLSL route's first call (shader compilation included) and how the two
     routes' results agree."""
     a = "n/a" if anchor is None else f"{anchor:.3f}"
-    r_np = "n/a" if anchor is None else f"{numpy.wall / anchor:.1f}"
-    r_gl = "n/a" if anchor is None else f"{glsl.wall / anchor:.1f}"
+    r_np = "n/a" if anchor is None else f"{numpy.wall / anchor:.3g}"
+    r_gl = "n/a" if anchor is None else f"{glsl.wall / anchor:.3g}"
     print(
         f"  {label:<48} {numpy.wall:7.3f} ({numpy.cpu:6.3f}) {glsl.wall:7.3f} ({glsl.cpu:6.3f}) {a:>10} {r_np:>9} "
         f"{r_gl:>8} {first:>10.3f}   {agree}",
         flush=True,
     )
+
+
+def compare_routes(name: str, numpy, glsl, anchor, repeat: int, agree) -> None:
+    """Time a NumPy route, its GLSL route (first call timed apart: shader compilation) and the pyrender
+    ``anchor`` (``None``: no anchor), interleaved, best of ``repeat``; print :func:`route_row` with
+    ``agree(numpy_out, glsl_out)``, a few words on how the two results agree."""
+    first = best_of(glsl, 1).wall
+    r = interleaved({"numpy": numpy, "glsl": glsl, **({} if anchor is None else {"pyrender": anchor})}, repeat)
+    pr = r["pyrender"].wall if "pyrender" in r else None
+    route_row(name, r["numpy"], r["glsl"], pr, first, agree(r["numpy"].out, r["glsl"].out))
