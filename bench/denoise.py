@@ -30,8 +30,9 @@ Three parts:
    NumPy) against ``shaders/denoise.vert`` (``glsl_denoise_with_map``: every vertex drawn as a point,
    moved in the vertex stage, read back; the seam fix on the CPU) and against pyrender drawing the
    same denoised mesh at 512^2 (built and uploaded in the frame, as its vertices change every pass),
-   on the meshes with UVs: the lab's figure sphere (16-bit 256^2 map, lambda = 1), uv_torus and the
-   shared meshes with UVs (1024^2 maps, lambda = 0.7). One process, OSMesa for both.
+   on the meshes with UVs: the lab's figure sphere (16-bit 256^2 map, lambda = 1), uv_sphere, uv_torus
+   and the shared meshes with UVs (1024^2 maps, lambda = 0.7), and a dense uv_torus(400, 200) (80k
+   vertices). One process, OSMesa for both.
 
 Meshes: built-in (icosphere 4, torus, pyvista "nut", uv_sphere, uv_torus) and, when present, the
 real meshes in ``../shared/data/meshes``.
@@ -380,6 +381,8 @@ def bench_glsl(names: list[str], quick: bool) -> None:
         V, F, UV = load(name)
         if UV is not None:
             glsl_case(name, V, F, UV, 512 if quick else 1024, 8, 0.7, repeat)
+    if not quick:  # where the vertex stage has work to do: 80k vertices
+        glsl_case("uv_torus(400, 200)", *datasets.uv_torus(400, 200), 1024, 16, 0.7, repeat)
     print(
         "  (NumPy and GLSL compute the moved vertices, no picture; pyrender: the denoised mesh drawn, its upload\n"
         "   and trimesh's vertex normals included; 'GLSL 1st' is the route's first call: shader compilation + one run)\n"
