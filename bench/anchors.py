@@ -76,3 +76,28 @@ def pyrender_normal_mapped_mesh(V, F, UV, N, tangents, normal_map, *, base_color
         material=material,
     )
     return pyrender.Mesh([primitive])
+
+
+def pyrender_mesh_frame(V, F, pose, size: int):
+    """A call that draws the mesh ``(V, F)`` with pyrender at ``size`` x ``size`` from ``pose = (eye, target)``
+    (z up, 40 degrees, one directional light), building and uploading the mesh in the call: its vertices
+    change every frame, as a displaced or denoised mesh's do. Returns the function (``color, depth``)."""
+    import trimesh
+
+    from geomlib import camera
+    from geomlib import render as grender
+
+    pyrender = grender.import_pyrender()
+    renderer = grender.offscreen_renderer(size, size)
+    view = camera.look_at(pose[0], pose[1], (0, 0, 1))
+    light = np.linalg.inv(camera.look_at((1.0, -1.0, 2.0), (0, 0, 0), (0, 0, 1)))
+    cam = pyrender.PerspectiveCamera(yfov=np.radians(40), aspectRatio=1.0, znear=0.5, zfar=10.0)
+
+    def frame():
+        scene = pyrender.Scene(bg_color=[1.0, 1.0, 1.0, 1.0], ambient_light=[0.1] * 3)
+        scene.add(pyrender.Mesh.from_trimesh(trimesh.Trimesh(V, F, process=False), smooth=True))
+        scene.add(cam, pose=np.linalg.inv(view))
+        scene.add(pyrender.DirectionalLight(intensity=3.0), pose=light)
+        return renderer.render(scene)
+
+    return frame

@@ -1,8 +1,8 @@
 """Benchmark: lab "denoise" (reference solution) next to the anchor libraries, in one run.
 
-Run: ``uv run python bench/denoise.py [--quick] [--no-quality] [--no-timing]``
+Run: ``uv run python bench/denoise.py [--quick] [--no-quality] [--no-timing] [--no-glsl]``
 
-Two parts:
+Three parts:
 
 1. **Timing** (ratio = solution / anchor, lower is better; peak = tracemalloc peak of one call):
 
@@ -26,6 +26,14 @@ Two parts:
    16-bit maps next to the direct route. Meshes without UVs get a one-chart-per-triangle atlas
    (:func:`geomlib.textures.triangle_atlas`), so every vertex there is a seam vertex.
 
+3. **GLSL route** (issue 27), ``--no-glsl`` skips it: the map-driven pass (``denoise_with_map``,
+   NumPy) against ``shaders/denoise.vert`` (``glsl_denoise_with_map``: every vertex drawn as a point,
+   moved in the vertex stage, read back; the seam fix on the CPU) and against pyrender drawing the
+   same denoised mesh at 512^2 (built and uploaded in the frame, as its vertices change every pass),
+   on the meshes with UVs: the lab's figure sphere (16-bit 256^2 map, lambda = 1), uv_sphere, uv_torus
+   and the shared meshes with UVs (1024^2 maps, lambda = 0.7), and a dense uv_torus(400, 200) (80k
+   vertices). One process, OSMesa for both.
+
 Meshes: built-in (icosphere 4, torus, pyvista "nut", uv_sphere, uv_torus) and, when present, the
 real meshes in ``../shared/data/meshes``.
 """
@@ -33,12 +41,14 @@ real meshes in ``../shared/data/meshes``.
 from __future__ import annotations
 
 import argparse
+import time
 from pathlib import Path
 
 import igl
 import numpy as np
 
-from bench.measure import SHARED, best_of, peak_mib
+from bench.anchors import pyrender_mesh_frame
+from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
 from geomlib import datasets, mesh_io
 from geomlib.textures import rasterize_uv, triangle_atlas
 from solutions.denoise import (
@@ -46,6 +56,7 @@ from solutions.denoise import (
     denoise_vertices,
     denoise_with_map,
     error_stats,
+    glsl_denoise_with_map,
     laplacian_offsets,
     make_noisy,
     normal_offsets,
@@ -323,18 +334,77 @@ def bench_quality(names: list[str], quick: bool) -> None:
     print()
 
 
+# --------------------------------------------------------------------------------------------
+# GLSL route
+
+
+def glsl_case(name: str, V, F, UV, res: int, bits: int, lam: float, repeat: int) -> None:
+    Vn, N = make_noisy(V, F, 0.3, 0)
+    s = normal_offsets(laplacian_offsets(Vn, F), N)
+    img, bias, scale = bake_offset_map(Vn, F, UV, s, res, bits)
+    X = denoise_with_map(Vn, F, UV, N, img, bias, scale, lam)
+    c, r = 0.5 * (X.min(0) + X.max(0)), 0.5 * float(np.linalg.norm(X.max(0) - X.min(0)))
+    eye = c + np.array([0.6, -1.0, 0.7]) / np.linalg.norm([0.6, -1.0, 0.7]) * 2.9 * r
+    try:
+        # The anchor's camera has near 0.5, far 10: scale the mesh to a unit radius around the origin.
+        frame = pyrender_mesh_frame((X - c) / r, F, ((eye - c) / r, (0, 0, 0)), 512)
+        frame()  # warm
+    except Exception as err:  # no headless OpenGL for pyrender: the two routes alone
+        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
+        frame = None
+    h = float(np.linalg.norm(Vn[F[:, 1]] - Vn[F[:, 0]], axis=1).mean())
+    compare_routes(
+        f"{name}, {len(V):,} v, {res}^2 {bits}-bit, lam {lam:g}",
+        lambda: denoise_with_map(Vn, F, UV, N, img, bias, scale, lam),
+        lambda: glsl_denoise_with_map(Vn, F, UV, N, img, bias, scale, lam),
+        frame,
+        repeat,
+        lambda a, b: f"max {np.linalg.norm(a - b, axis=1).max() / h:.2g} h (mean edge)",
+    )
+
+
+def bench_glsl(names: list[str], quick: bool) -> None:
+    from geomlib import gl
+
+    repeat = 1 if quick else 3
+    t = time.perf_counter()
+    info = gl.renderer_info()  # creates the harness's OpenGL context
+    t_ctx = time.perf_counter() - t
+    print(
+        f"GLSL ROUTE  denoise_with_map vs shaders/denoise.vert vs pyrender drawing the denoised mesh at 512^2, "
+        f"best of {repeat}, interleaved; ratio = route / pyrender frame; {load_average()}"
+    )
+    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
+    print(ROUTE_HEADER)
+    glsl_case("figure sphere (32, 64)", *datasets.uv_sphere(32, 64), 256, 16, 1.0, repeat)
+    for name in names:
+        V, F, UV = load(name)
+        if UV is not None:
+            glsl_case(name, V, F, UV, 512 if quick else 1024, 8, 0.7, repeat)
+    if not quick:  # where the vertex stage has work to do: 80k vertices
+        glsl_case("uv_torus(400, 200)", *datasets.uv_torus(400, 200), 1024, 16, 0.7, repeat)
+    print(
+        "  (NumPy and GLSL compute the moved vertices, no picture; pyrender: the denoised mesh drawn, its upload\n"
+        "   and trimesh's vertex normals included; 'GLSL 1st' is the route's first call: shader compilation + one run)\n"
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="fewer meshes and settings, one repetition")
     ap.add_argument("--no-timing", action="store_true")
     ap.add_argument("--no-quality", action="store_true")
+    ap.add_argument("--no-glsl", action="store_true", help="skip the GLSL route")
     args = ap.parse_args(argv)
     names = mesh_names(args.quick)
-    print(f"lab denoise benchmark ({'quick' if args.quick else 'full'})\n")
+    print(f"lab denoise benchmark ({'quick' if args.quick else 'full'}); {load_average()}\n")
     if not args.no_timing:
         bench_timing(names, args.quick)
+    if not args.no_glsl:
+        bench_glsl(names, args.quick)
     if not args.no_quality:
         bench_quality(names, args.quick)
+    print(load_average())
     return 0
 
 

@@ -29,15 +29,17 @@ import igl
 import numpy as np
 from igl.embree import line_mesh_intersection
 
-from bench.anchors import pyrender_normal_mapped_mesh
-from bench.measure import SHARED, best_of, peak_mib
+from bench.anchors import pyrender_mesh_frame, pyrender_normal_mapped_mesh
+from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
 from geomlib import camera, datasets
 from geomlib.textures import rasterize_uv, triangle_atlas
 from solutions.maps import (
     bake_normal_map,
     displace,
     encode_normal_map,
+    glsl_displace,
     glsl_shade,
+    glsl_tbn,
     height_to_normal_map,
     rasterize_mesh,
     shade,
@@ -207,33 +209,110 @@ def bench_bake(quick: bool, repeat: int) -> None:
         bench_bake_case(f"{fname} -> decimated, triangle atlas", V, F, Vs, Fs, UV, size, repeat)
 
 
+def route_shade(name, scene, g, lights, opts, size: int, repeat: int) -> None:
+    from solutions.maps.figures import ALBEDO
+
+    V, F, UV, N, tangents, nmap, eye, view = scene
+    try:
+        renderer, pscene = pyrender_frame(V, F, UV, N, tangents, nmap, view, size)
+        renderer.render(pscene)  # warm: context, shader compilation, texture upload
+    except Exception as err:  # no headless OpenGL for pyrender: the two routes alone
+        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
+        renderer = None
+    compare_routes(
+        f"shade: {name}",
+        lambda: shade(g, lights, eye, ALBEDO, nmap, **opts),
+        lambda: glsl_shade(g, lights, eye, ALBEDO, nmap, **opts),
+        None if renderer is None else lambda: renderer.render(pscene),
+        repeat,
+        lambda a, b: f"max {np.abs(a - b).max():.2g} per channel",
+    )
+    if renderer is not None:
+        renderer.delete()
+
+
+def route_displace(name, V, F, UV, H, kw: dict, eye, size: int, repeat: int) -> None:
+    try:
+        frame = pyrender_mesh_frame(displace(V, F, UV, None, H, **kw), F, (eye, (0, 0, 0)), size)
+        frame()  # warm
+    except Exception as err:
+        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
+        frame = None
+    compare_routes(
+        f"{name}, {len(V):,} v",
+        lambda: displace(V, F, UV, None, H, **kw),
+        lambda: glsl_displace(V, F, UV, None, H, **kw),
+        frame,
+        repeat,
+        lambda a, b: f"max {np.linalg.norm(a - b, axis=1).max() / kw['lam']:.2g} x lam",
+    )
+
+
 def bench_glsl(repeat: int) -> None:
-    """One 512 x 512 normal-mapped frame three ways: NumPy ``shade``, ``shaders/normalmap.frag`` (``glsl_shade``:
-    G-buffer upload, draw, read-back) and a pyrender frame, all on the same G-buffer / scene (OSMesa here)."""
+    """512 x 512 frames of the lab's scenes three ways: the NumPy route, the lab's shaders (``glsl_shade``:
+    G-buffer upload, draw of ``normalmap.frag``, read-back; ``glsl_displace``/``glsl_tbn``: the vertices drawn
+    as points through ``displace.vert``/``tbn.vert``, read back) and pyrender (OSMesa here), in one run."""
+    from geomlib import gl
+    from solutions.maps.figures import KEY_LIGHTS, bump_tiles, smooth_noise
+
     size = 512
+    t = time.perf_counter()
+    info = gl.renderer_info()  # creates the harness's OpenGL context
+    t_ctx = time.perf_counter() - t
+    print(
+        f"GLSL route (issue 27): {size}x{size}, best of {repeat} warm calls, interleaved; "
+        f"ratio = route / pyrender frame; {load_average()}"
+    )
+    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
+    print(ROUTE_HEADER)
+
+    # normalmap.frag on two normal-mapped tori: this bench's bumpy one and the lab's figure's (maps_glsl)
     V, F, UV, N, tangents, nmap, eye, view, M = torus_scene(size, 512)
     g = rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
     lights = [{"direction": (-1.0, 1.0, -2.0)}, {"direction": (1.0, 0.5, -0.5), "intensity": 0.4}]
-    print(f"GLSL route: one {size}x{size} frame of the normal-mapped uv_torus, {int(g.mask.sum()):,} covered pixels")
-    ref = shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)
-    got = glsl_shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)  # warm: context, compilation
-    try:
-        renderer, scene = pyrender_frame(V, F, UV, N, tangents, nmap, view, size)
-        renderer.render(scene)
-    except Exception as e:  # no headless OpenGL for pyrender: report the two routes alone
-        print(f"  (pyrender unavailable: {type(e).__name__}: {e})")
-        renderer = None
-    t_np, t_gl, t_pr = [], [], []
-    for _ in range(repeat):
-        t_np.append(timed(lambda: shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)))
-        t_gl.append(timed(lambda: glsl_shade(g, lights, eye, (0.8, 0.7, 0.6), nmap)))
-        if renderer is not None:
-            t_pr.append(timed(lambda: renderer.render(scene)))
-    pr = f"{min(t_pr):.3f} s" if t_pr else "n/a"
-    print(f"  NumPy shade {min(t_np):.3f} s   normalmap.frag (llvmpipe) {min(t_gl):.3f} s   pyrender frame {pr}")
-    print(f"  NumPy vs GLSL: max difference {np.abs(got - ref).max():.2g} per pixel")
-    if renderer is not None:
-        renderer.delete()
+    route_shade(f"uv_torus(96, 48), {int(g.mask.sum()):,} px", (V, F, UV, N, tangents, nmap, eye, view), g, lights, {},
+                size, repeat)  # fmt: skip
+    H = bump_tiles(512, 24, 8)
+    nmap2 = encode_normal_map(height_to_normal_map(H, (0.05 / (2 * np.pi), 0.05 / (2 * np.pi * 0.35)), border="wrap"))
+    V2, F2, UV2 = datasets.uv_torus(48, 24, 1.0, 0.35)
+    N2 = welded_vertex_normals(V2, F2)
+    T2, _, _, w2 = tangent_frames(V2, F2, UV2, N2)
+    tg2 = np.column_stack([T2, w2])
+    eye2 = np.array([0.15, -1.0, 0.85]) * 2.2
+    view2 = camera.look_at(eye2, (0, 0, 0), (0, 0, 1))
+    g2 = rasterize_mesh(V2, F2, camera.perspective(40, 1.0, 0.5, 10.0) @ view2, size, size, UV=UV2, N=N2, tangents=tg2)
+    opts2 = dict(wrap="repeat", specular=0.25, shininess=24.0)
+    route_shade(f"torus(48, 24) bump tiles, {int(g2.mask.sum()):,} px", (V2, F2, UV2, N2, tg2, nmap2, eye2, view2),
+                g2, KEY_LIGHTS, opts2, size, repeat)  # fmt: skip
+
+    # tbn.vert: the per-vertex frames of the displaced torus's mesh (NumPy: surface_frames per vertex)
+    Vt, Ft, UVt = datasets.uv_torus(384, 128, 1.0, 0.35)
+    Nt = welded_vertex_normals(Vt, Ft)
+    Tt, _, _, wt = tangent_frames(Vt, Ft, UVt, Nt)
+    tgt = np.column_stack([Tt, wt])
+    compare_routes(
+        f"tbn.vert: uv_torus(384, 128), {len(Vt):,} v",
+        lambda: surface_frames(Nt, tgt),
+        lambda: glsl_tbn(Nt, tgt),
+        None,
+        repeat,
+        lambda a, b: f"max {max(float(np.abs(x - y).max()) for x, y in zip(a, b)):.2g}",
+    )
+
+    # displace.vert: the lab's displaced torus (mapped_vs_displaced) and the (bias, scale) sphere (bias_scale)
+    route_displace("displace: torus(384, 128) bump tiles", Vt, Ft, UVt, H, dict(lam=0.05, wrap="repeat"),
+                   np.array([0.15, -1.0, 0.85]) * 2.2, size, repeat)  # fmt: skip
+    Vs, Fs, UVs = datasets.uv_sphere(96, 192)
+    Hs = smooth_noise(256, seed=3)
+    for bias, scale in ((0.0, 1.0), (-1.0, 2.0), (-1.0, 5.0)):
+        kw = dict(lam=0.12, bias=bias, scale=scale, wrap="repeat")
+        route_displace(f"displace: uv_sphere(96, 192) ({bias:g}, {scale:g})", Vs, Fs, UVs, Hs, kw,
+                       np.array([1.0, -1.2, 0.9]) * 2.0, size, repeat)  # fmt: skip
+    print(
+        "  (pyrender: the same normal-mapped frame, warm; for displace, the displaced mesh drawn with its upload, "
+        "as its vertices change every frame.\n   The NumPy and GLSL tbn/displace routes compute vertices only, "
+        "no picture; 'GLSL 1st' is the route's first call: shader compilation + one run)"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -241,11 +320,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--quick", action="store_true", help="smaller inputs, one repetition")
     args = ap.parse_args(argv)
     repeat = 1 if args.quick else 3
-    print(f"lab maps benchmark ({'quick' if args.quick else 'full'}); ratio = solution / anchor (lower is better)\n")
+    print(
+        f"lab maps benchmark ({'quick' if args.quick else 'full'}); ratio = solution / anchor (lower is better); "
+        f"{load_average()}\n"
+    )
     bench_tangents(args.quick, repeat)
     bench_shade(args.quick, repeat)
     bench_bake(args.quick, repeat)
     bench_glsl(repeat)
+    print(f"\n{load_average()}")
     return 0
 
 

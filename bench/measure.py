@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import time
 import tracemalloc
 from pathlib import Path
@@ -55,3 +56,50 @@ def peak_mib(fn) -> float:
         return tracemalloc.get_traced_memory()[1] / 2**20
     finally:
         tracemalloc.stop()
+
+
+def load_average() -> str:
+    """``"load average 1.23 0.98 0.75"`` (1, 5 and 15 minutes): printed with every timing table."""
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def interleaved(fns: dict, repeat: int) -> dict[str, Timing]:
+    """Best-of timings of several contenders, called in turn ``repeat`` times (so a busy spell hits all of them)."""
+    runs = {name: ([], [], None) for name in fns}
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            wall, cpu, _ = runs[name]
+            w, c, out = _runs(fn, 1)
+            runs[name] = (wall + w, cpu + c, out)
+    return {name: Timing(min(w), min(c), out) for name, (w, c, out) in runs.items()}
+
+
+#: Column heads of :func:`route_row`.
+ROUTE_HEADER = (
+    f"  {'scene':<48} {'NumPy s (cpu)':>16} {'GLSL s (cpu)':>16} {'pyrender s':>10} {'NumPy/pyr':>9} "
+    f"{'GLSL/pyr':>8} {'GLSL 1st s':>10}   NumPy vs GLSL"
+)
+
+
+def route_row(label: str, numpy: Timing, glsl: Timing, anchor: float | None, first: float, agree: str) -> None:
+    """One scene of a GLSL benchmark: the NumPy route, the GLSL route and the pyrender anchor (warm, best of),
+    the ratios against the anchor, the GLSL route's first call (shader compilation included) and how the two
+    routes' results agree."""
+    a = "n/a" if anchor is None else f"{anchor:.3f}"
+    r_np = "n/a" if anchor is None else f"{numpy.wall / anchor:.3g}"
+    r_gl = "n/a" if anchor is None else f"{glsl.wall / anchor:.3g}"
+    print(
+        f"  {label:<48} {numpy.wall:7.3f} ({numpy.cpu:6.3f}) {glsl.wall:7.3f} ({glsl.cpu:6.3f}) {a:>10} {r_np:>9} "
+        f"{r_gl:>8} {first:>10.3f}   {agree}",
+        flush=True,
+    )
+
+
+def compare_routes(name: str, numpy, glsl, anchor, repeat: int, agree) -> None:
+    """Time a NumPy route, its GLSL route (first call timed apart: shader compilation) and the pyrender
+    ``anchor`` (``None``: no anchor), interleaved, best of ``repeat``; print :func:`route_row` with
+    ``agree(numpy_out, glsl_out)``, a few words on how the two results agree."""
+    first = best_of(glsl, 1).wall
+    r = interleaved({"numpy": numpy, "glsl": glsl, **({} if anchor is None else {"pyrender": anchor})}, repeat)
+    pr = r["pyrender"].wall if "pyrender" in r else None
+    route_row(name, r["numpy"], r["glsl"], pr, first, agree(r["numpy"].out, r["glsl"].out))

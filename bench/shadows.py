@@ -1,6 +1,6 @@
 """Benchmark: shadow mapping (solutions.shadows, NumPy rasterizer) next to pyrender's on OSMesa.
 
-Run: ``uv run python bench/shadows.py [--quick]``
+Run: ``uv run python bench/shadows.py [--quick] [--no-glsl]``
 
 For each scene (built-in: the classic scene and a 50k-face bumpy torus; plus meshes from
 ``../shared/data/meshes`` standing on a floor, when that folder exists) it prints:
@@ -15,6 +15,16 @@ For each scene (built-in: the classic scene and a 50k-face bumpy torus; plus mes
   agreement at a 2048^2 map (without a 2-pixel band at shadow edges), acne of our defaults and of
   pyrender's shadows, and how often our shadow regions agree with pyrender's.
 
+Then the GLSL route (issue 27) on the lab's scenes (classic, bumpy torus), one {frame}^2 frame three ways,
+best of a few warm calls, interleaved: the NumPy route (eye G-buffer, ``depth_map`` 1024^2 and
+``shadow_visibility`` PCF 3, ``shade``), the GLSL route (the same eye G-buffer and shading, the two passes by
+``shaders/depth.vert`` + ``depth.frag`` and ``shadow.frag``: ``glsl_depth_map``, ``glsl_shadow_visibility``)
+and pyrender's own shadowed frame (``SHADOWS_DIRECTIONAL``, warm). The point light (tasks 11-12): six 512^2
+linear-depth faces and the lookup, ``cube_distance_maps`` + ``linear_point_shadow_visibility`` against
+``cube_depth.vert``/``.frag`` + ``cube_shadow.frag``; pyrender 0.1.45 has no point-light shadows
+("Point light shadows not implemented"), so its anchor is the same frame lit by a point light without
+shadows. GLSL and pyrender both run on OSMesa in this one process.
+
 Target (issue 8): depth map 1024^2 + shaded frame 512^2 of a 50k-face scene <= 3 s on this machine.
 """
 
@@ -26,22 +36,30 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.measure import SHARED, best_of, peak_mib
+from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
 from geomlib.mesh_io import read_mesh
 from solutions.shadows import (
     CLASSIC_CAMERA,
     CLASSIC_LIGHT,
     classic_scene,
+    cube_distance_maps,
     depth_map,
     eye_gbuffer,
+    glsl_cube_depth_maps,
+    glsl_depth_map,
+    glsl_point_shadow_visibility,
+    glsl_shadow_visibility,
     light_setup,
     light_visibility,
+    linear_point_shadow_visibility,
     make_scene,
     pyrender_scene,
     pyrender_visibility,
     raycast_visibility,
     render_with_shadows,
+    shade,
     shadow_metrics,
+    shadow_visibility,
     torus_scene,
 )
 
@@ -95,9 +113,115 @@ def bench_scene(name, scene, camera, light, *, frame: int, repeat: int, quality:
     return row
 
 
+def agreement(tol: float = 1e-6):
+    """How two visibility images agree: pixels differing by more than the graded tolerance, and the max."""
+
+    def agree(a, b):
+        d = np.abs(a[1] - b[1])
+        return f"{int((d > tol).sum()):,} of {d.size:,} px > {tol:g}, max {d.max():.2g}"
+
+    return agree
+
+
+def pyrender_point_frame(scene, camera, position, size: int):
+    """pyrender's frame of the scene lit by a point light at ``position`` (no shadows: not in pyrender 0.1.45)."""
+    ps, rend, pyrender = pyrender_scene(scene, camera, TORUS_LIGHT, size=(size, size))
+    for node in list(ps.light_nodes):
+        ps.remove_node(node)
+    pose = np.eye(4)
+    pose[:3, 3] = position
+    ps.add(pyrender.PointLight(color=[1.0, 1.0, 1.0], intensity=30.0), pose=pose)
+    return lambda: rend.render(ps, flags=pyrender.RenderFlags.NONE)
+
+
+def glsl_scene(name, scene, camera, light, point_light, frame: int, repeat: int) -> None:
+    """The directional and the point light's rows of one scene (see :func:`bench_glsl`)."""
+    size = (frame, frame)
+
+    def frame_of(passes, lit):
+        def run():
+            eb = eye_gbuffer(scene, camera, size)
+            vis = passes(eb)
+            return shade(eb, vis, lit), vis
+
+        return run
+
+    M = light_setup(scene, light).matrices[0]
+
+    def numpy_dir(eb):
+        return shadow_visibility(eb.P, eb.N_face, depth_map(scene.V, scene.F, M, 1024, "none"), M, pcf=3)
+
+    def glsl_dir(eb):
+        return glsl_shadow_visibility(eb.P, eb.N_face, glsl_depth_map(scene.V, scene.F, M, 1024, "none"), M, pcf=3)
+
+    ps, rend, pyrender = pyrender_scene(scene, camera, light, size=size)
+    flags = pyrender.RenderFlags.SHADOWS_DIRECTIONAL
+    rend.render(ps, flags=flags)  # warm: upload, shaders
+    compare_routes(
+        f"{name} ({len(scene.F):,} f), directional, map 1024^2",
+        frame_of(numpy_dir, light),
+        frame_of(glsl_dir, light),
+        lambda: rend.render(ps, flags=flags),
+        repeat,
+        agreement(),
+    )
+    setup = light_setup(scene, point_light)
+    pos, near, far = setup.light["position"], setup.near, setup.far
+
+    def numpy_point(eb):
+        C = cube_distance_maps(scene.V, scene.F, pos, 512, near, far, cull="front")
+        return linear_point_shadow_visibility(eb.P, eb.N_face, C, pos, near, far)
+
+    def glsl_point(eb):
+        C = glsl_cube_depth_maps(scene.V, scene.F, pos, 512, near, far, cull="front")
+        return glsl_point_shadow_visibility(eb.P, eb.N_face, C, pos, near, far)
+
+    point_frame = pyrender_point_frame(scene, camera, pos, frame)
+    point_frame()  # warm
+    compare_routes(
+        f"{name}, point light, cube 6 x 512^2",
+        frame_of(numpy_point, point_light),
+        frame_of(glsl_point, point_light),
+        point_frame,
+        repeat,
+        agreement(),
+    )
+    eb = eye_gbuffer(scene, camera, size)
+    t_eye = best_of(lambda: eye_gbuffer(scene, camera, size), repeat)
+    vis = np.ones(len(eb.P))
+    t_shade = best_of(lambda: shade(eb, vis, light), repeat)
+    print(
+        f"  {'':<48} (of each frame, NumPy in both routes: eye G-buffer {t_eye.wall:.3f} s, shade {t_shade.wall:.3f} s)",
+        flush=True,
+    )
+
+
+def bench_glsl(scenes, frame: int, repeat: int) -> None:
+    from geomlib import gl
+    from solutions.shadows.figures import POINT_LIGHT
+
+    t = time.perf_counter()
+    info = gl.renderer_info()  # creates the harness's OpenGL context
+    t_ctx = time.perf_counter() - t
+    print(
+        f"\nGLSL route (issue 27): one {frame}x{frame} frame, best of {repeat} warm calls, interleaved; "
+        f"ratio = route / pyrender frame; {load_average()}"
+    )
+    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
+    print(ROUTE_HEADER)
+    for name, scene, camera, light in scenes:
+        glsl_scene(name, scene, camera, light, POINT_LIGHT, frame, repeat)
+    print(
+        "  (pyrender directional: its own shadowed frame, 2048^2 shadow map; point light: pyrender's frame without\n"
+        "   shadows, which pyrender 0.1.45 does not implement for point lights. 'GLSL 1st': the route's first call,\n"
+        "   shader compilation included. NumPy vs GLSL: visibility per covered pixel, graded tolerance 1e-6)"
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller frames, one repeat, no shared meshes")
+    ap.add_argument("--no-glsl", action="store_true", help="skip the GLSL route")
     args = ap.parse_args()
     frame, repeat, quality = (256, 1, 320) if args.quick else (512, 3, 640)
     scenes = [
@@ -108,7 +232,10 @@ def main() -> None:
         for fname in ("bunny_hr.obj", "armadillo.obj"):
             if (SHARED / fname).is_file():
                 scenes.append((fname, *mesh_on_floor(SHARED / fname)))
-    print(f"shadow mapping, frame {frame}x{frame}, map 1024^2, PCF 3; pyrender on OSMesa (warm, best of {repeat})")
+    print(
+        f"shadow mapping, frame {frame}x{frame}, map 1024^2, PCF 3; pyrender on OSMesa (warm, best of {repeat}); "
+        f"{load_average()}"
+    )
     print(
         f"{'scene':>16} {'faces':>7} {'map s':>7} {'frame s':>8} {'pyrender s':>10} {'ratio':>7} "
         f"{'pyr 1st s':>9} {'peak MB':>8}"
@@ -140,6 +267,9 @@ def main() -> None:
         f"\ntarget: 50k faces, 1024^2 map + {frame}^2 frame: {torus['frame']:.2f} s (frame includes its map)"
         + ("" if ok is None else f" -> {'OK' if torus['frame'] <= 3.0 else 'MISSED'} (<= 3 s)")
     )
+    if not args.no_glsl:
+        bench_glsl(scenes[:2], frame, repeat)  # the lab's scenes: classic and bumpy torus
+    print(f"\n{load_average()}")
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ what is stale, ``refs check`` words its messages for the solution and names each
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 
@@ -36,6 +37,25 @@ def test_refs_build_lists_what_changed_and_counts_the_rest(course):
     listed = [ln.split()[0] for ln in p.stdout.splitlines() if ln.startswith("  ")]
     assert listed == ["sample/tet-mid.npz", "sample/manifest.json"], p.stdout
     assert f"2 reference file(s) written (changed), {n - 2} unchanged" in p.stdout, p.stdout
+
+
+def test_refs_build_keeps_files_that_hold_the_same_arrays(course):
+    # A course set up with another Python patch release writes other zip headers for the same arrays
+    # (3.11.2 vs 3.11.7) and records another version: a rebuild must leave such files, and git, alone.
+    ref = course / "tests" / "reference" / "sample"
+    npz, manifest = ref / "tet-mid.npz", ref / "manifest.json"
+    with np.load(npz) as z:
+        arrays = {k: z[k] for k in z.files}
+    with open(npz, "wb") as f:
+        np.savez(f, **arrays)  # same arrays, other bytes (stored, not deflated)
+    m = json.loads(manifest.read_text())
+    m["versions"]["python"] = "3.11.0"
+    manifest.write_text(json.dumps(m, indent=1, sort_keys=True) + "\n")
+    before = npz.read_bytes(), manifest.read_text()
+    p = run_geomlib(course, "refs", "build")
+    assert not re.search(r"\.npz|manifest\.json", p.stdout), p.stdout
+    assert "0 reference file(s) written (changed)" in p.stdout, p.stdout
+    assert (npz.read_bytes(), manifest.read_text()) == before
 
 
 def test_stubs_build_and_check_report_what_they_found(course):
