@@ -289,7 +289,13 @@ def test_kernel_mutants_graded_in_one_zygote_each_run_their_own_kernel(sample_co
     assert lr["baseline"]["1"]["score"] == lr["baseline"]["1"]["max"] == 1, (lr["baseline"], p.stderr[-2000:])
     got = {r["op"]: r for r in lr["mutants"]}
     # 2.0 -> 0.0, 4.0, 1.0, 3.0 and * -> /: run(1.5) = 1.0, 7.0, 2.5, 5.5, 2.333... (each its own compiled scale)
-    expected = {"2.0 → 0.0": "1.0", "2.0 → 4.0": "7.0", "2.0 → 1.0": "2.5", "2.0 → 3.0": "5.5", "* → /": "2.333333333333333"}
+    expected = {
+        "2.0 → 0.0": "1.0",
+        "2.0 → 4.0": "7.0",
+        "2.0 → 1.0": "2.5",
+        "2.0 → 3.0": "5.5",
+        "* → /": "2.333333333333333",
+    }
     assert set(expected) <= set(got), sorted(got)
     for op, value in expected.items():
         r = got[op]
