@@ -691,7 +691,6 @@ def _worker_main() -> int:
     reply = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # anything else written to stdout goes to the log, not into the replies
     from geomlib.grading import audit as registered  # the module pytest loads with -p (this one is __main__)
-    from geomlib.grading import sandbox
     from geomlib.grading.grade import grade
     from geomlib.grading.settings import env
 
@@ -720,11 +719,6 @@ def _worker_main() -> int:
         except BaseException as e:  # noqa: BLE001  (the audit keeps going; the mutant's row says what happened)
             out = {"ok": False, "error": f"{type(e).__name__}: {e}"}
         out["seconds"] = time.time() - t
-        if req.get("fresh"):
-            # A new zygote, so a new numba cache: a given kernel (cached under the stub's path) that
-            # calls a task kernel keeps the task kernel it was compiled with, which would be the
-            # previous mutant's (numba does not check the functions a cached function calls).
-            sandbox.shutdown()
         reply.write(json.dumps(out) + "\n")
     return 0
 
@@ -818,9 +812,15 @@ COMPILED_CALL_LIMIT = 600.0
 
 
 def _jit_request(solution: Path) -> dict:
-    """For a lab with ``@njit`` kernels: a fresh zygote per request and :data:`COMPILED_CALL_LIMIT`."""
+    """For a lab with ``@njit`` kernels: :data:`COMPILED_CALL_LIMIT` per call.
+
+    No new zygote per mutant: each mutant is a new folder, so the sandbox gives it a new snapshot
+    with its own numba cache (:meth:`geomlib.grading.sandbox._Zygote.snapshot`), and a given kernel
+    that calls a task kernel (remeshing's ``clean_pass`` calls ``flip``) is compiled again with that
+    mutant's task kernel, never loaded with another mutant's.
+    """
     compiled = any("@njit" in p.read_text(encoding="utf-8") for p in sorted(solution.rglob("*.py")))
-    return {"fresh": True, "time_limit": COMPILED_CALL_LIMIT} if compiled else {}
+    return {"time_limit": COMPILED_CALL_LIMIT} if compiled else {}
 
 
 def _copy_lab(src: Path, dest: Path) -> None:

@@ -219,12 +219,89 @@ def test_a_survivor_is_graded_on_the_other_tasks_that_run_its_block(tmp_path, mo
     )
 
 
-def test_labs_with_compiled_kernels_get_a_fresh_zygote_per_request():
-    """A given kernel cached under the stub's path keeps the task kernel it was compiled with
-    (numba does not check callees): every request of a numba lab gets a new zygote and cache."""
-    root = _impl.course_root() / "solutions"
-    assert audit._jit_request(root / "remeshing") == {"fresh": True, "time_limit": audit.COMPILED_CALL_LIMIT}
-    assert audit._jit_request(root / "subdivision") == {}
+JIT_KERNELS = '''"""Planted lab: a given kernel that calls the task kernel (as remeshing's clean_pass calls flip)."""
+
+from numba import njit
+
+from geomlib.jit import use_cache_folder
+
+use_cache_folder(__name__, __file__)
+
+
+@njit(cache=True)
+def scale(x):
+    """Task 1: twice ``x``."""
+    # BEGIN SOLUTION: Task 1 (scale): 2 x
+    return 2.0 * x
+    # END SOLUTION
+
+
+@njit(cache=True)
+def driver(x):
+    return scale(x) + 1.0
+
+
+def run(x):
+    """Given: the given kernel, which calls the task kernel."""
+    return float(driver(float(x)))
+'''
+
+JIT_TEST = '''from geomlib.grading import graded
+
+
+@graded(points=1, part="scale")
+def test_run_through_the_given_kernel(lab):
+    """run(1.5) = 2 * 1.5 + 1 through the given kernel"""
+    got = lab.run(1.5)
+    assert got == 4.0, f"run(1.5) = {got!r}, expected 4.0"
+'''
+
+
+@pytest.mark.slow
+def test_kernel_mutants_graded_in_one_zygote_each_run_their_own_kernel(sample_course, tmp_path):
+    """The audit grades a numba lab's mutants one after another in one worker and one zygote (no
+    new zygote per mutant: a fresh sandbox costs about 1.7 s of CPU per request). A given kernel that
+    calls the task kernel links the task kernel's machine code into its own, and numba keys its
+    cache on the given kernel's file only; each mutant's folder must still get its own cache, or the
+    given kernel would run the solution's (graded first) or the previous mutant's task kernel and
+    every mutant would survive. Each operator mutant of ``2.0 * x`` gives its own ``run(1.5)``."""
+    root = tmp_path / "course"
+    shutil.copytree(sample_course, root, ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "solutions" / "jitlab").mkdir()
+    (root / "solutions" / "jitlab" / "__init__.py").write_text(
+        '"""Planted numba lab."""\n\nfrom .kernels import run, scale\n\n__all__ = ["run", "scale"]\n'
+    )
+    (root / "solutions" / "jitlab" / "kernels.py").write_text(JIT_KERNELS)
+    (root / "tests" / "graded" / "jitlab").mkdir()
+    (root / "tests" / "graded" / "jitlab" / "__init__.py").write_text('"""Planted numba lab graded tests."""\n')
+    (root / "tests" / "graded" / "jitlab" / "test_jitlab.py").write_text(JIT_TEST)
+    run_geomlib(root, "stubs", "build", "--lab", "jitlab")
+    for dirpath, _dirs, files in os.walk(tmp_path):
+        os.chmod(dirpath, 0o755)
+        for f in files:
+            os.chmod(os.path.join(dirpath, f), 0o644)
+    assert audit._jit_request(root / "solutions" / "jitlab") == {"time_limit": audit.COMPILED_CALL_LIMIT}
+    out = tmp_path / "report"
+    p = run_geomlib(root, "audit", "--lab", "jitlab", "--kind", "operator", "--jobs", "1", "--out", str(out),
+                    check=False, timeout=600)  # fmt: skip
+    data = json.loads((out / "audit.json").read_text())
+    lr = data["labs"]["jitlab"]
+    assert lr["baseline"]["1"]["score"] == lr["baseline"]["1"]["max"] == 1, (lr["baseline"], p.stderr[-2000:])
+    got = {r["op"]: r for r in lr["mutants"]}
+    # 2.0 -> 0.0, 4.0, 1.0, 3.0 and * -> /: run(1.5) = 1.0, 7.0, 2.5, 5.5, 2.333... (each its own compiled scale)
+    expected = {
+        "2.0 → 0.0": "1.0",
+        "2.0 → 4.0": "7.0",
+        "2.0 → 1.0": "2.5",
+        "2.0 → 3.0": "5.5",
+        "* → /": "2.333333333333333",
+    }
+    assert set(expected) <= set(got), sorted(got)
+    for op, value in expected.items():
+        r = got[op]
+        assert r["status"] == "killed", f"{op}: {r['status']}, graded with another version's kernel? {r['why']}"
+        assert f"run(1.5) = {value}," in r["why"], f"{op} ran another mutant's kernel: {r['why']}"
+    assert p.returncode == 0, p.stdout + p.stderr[-2000:]
 
 
 def test_does_nothing_restores_the_objects_the_block_changes(tmp_path):

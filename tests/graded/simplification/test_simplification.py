@@ -406,6 +406,26 @@ def test_non_edge_pairs_close_a_crack(lab):
 
 
 @graded(points=1, part="greedy loop")
+def test_flat_sheet_contracts_into_the_midpoint(lab):
+    """a flat 4 x 4 grid, boundary not kept: every pair costs 0 and the placement's ties go to the midpoint, so the
+    one contraction down to 31 faces leaves one new vertex, the midpoint of an edge of the grid"""
+    V, F = datasets.grid_patch(4)
+    V2, F2 = lab.qem_simplify(V, F, len(F) - 1, preserve_boundary=False)
+    V2 = np.asarray(V2, float)
+    new = V2[np.linalg.norm(V2[:, None] - V[None], axis=2).min(axis=1) > 1e-9]
+    E = topology.unique_edges(F)
+    mids = 0.5 * (V[E[:, 0]] + V[E[:, 1]])
+    at_mid = len(new) == 1 and np.linalg.norm(mids - new[0], axis=1).min() <= 1e-9
+    expect_true(
+        f"qem_simplify(flat 4 x 4 grid, {len(F) - 1}, preserve_boundary=False)",
+        at_mid,
+        f"got {len(new)} vertices not in the input ({np.round(new[:3], 4).tolist()}); expected exactly one, at the "
+        "midpoint of the contracted edge: on a flat sheet A is singular and the cost is 0 along every edge, so "
+        "optimal_contraction picks the midpoint — the heap's positions (also the first ones) come from it",
+    )
+
+
+@graded(points=1, part="greedy loop")
 def test_bad_targets(lab):
     """a valid call first, then MeshErrors for target < 4, target > faces and a non-integer target"""
     V, F = noisy_icosphere(1, 0.01, 0)
