@@ -368,12 +368,31 @@ def _truth(V, F, P, to_light, N):
 
 @graded(points=2, part="all together")
 def test_agrees_with_ray_casting(lab):
-    """shadows of the small scene agree with exact ray casting on >= 99% of surface points"""
+    """shadows of the small scene agree with exact ray casting on >= 99% of surface points, also with a map that
+    covers only the objects (the floor outside it is lit)"""
     V, F = small_scene()
     d = np.array([0.4, 0.5, -0.75])
     M = np.asarray(lab.directional_light_matrix(d, [V.min(0), V.max(0)]))
     for cull in ("front", "none"):  # without culling, the default bias alone must keep the lit faces lit
         _agree_with_ray_casting(lab, V, F, d, M, np.asarray(lab.depth_map(V, F, M, 1024, cull=cull)), cull)
+    # A map fitted to a box around the objects and their shadows only: the floor beside it and beyond its far
+    # plane lies outside the map, where ray casting finds it lit (about 4% of a grid over the floor is beyond
+    # the far plane), and shadow_visibility must leave it lit (Task 6).
+    B = np.array([[-1.55, -1.15, 0.0], [2.1, 2.2, 1.95]])
+    M = np.asarray(lab.directional_light_matrix(d, B))
+    D = np.asarray(lab.depth_map(V, F, M, 1024, cull="none"))
+    g = np.linspace(-2.9, 2.9, 41)
+    P = np.c_[np.array(np.meshgrid(g, g)).reshape(2, -1).T, np.zeros(41 * 41)]
+    N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    truth = _truth(V, F, P, np.tile(-d / np.linalg.norm(d), (len(P), 1)), N)
+    vis = np.asarray(lab.shadow_visibility(P, N, D, M))
+    agree = np.mean((vis >= 0.5) == truth)
+    if agree < 0.99:
+        wrong = P[(vis >= 0.5) != truth]
+        fail(f"with a map fitted to the box {B.tolist()} (the floor around it is outside the map), shadow_visibility "
+             f"agrees with ray casting on {100 * agree:.2f}% of {len(P)} floor points (need >= 99%): points outside "
+             "the light's frustum must count as lit (outside_frustum)",
+             marked_picture("shadow_visibility vs ray casting, partial map", V, F, wrong, "points where the two disagree"))  # fmt: skip
 
 
 def _agree_with_ray_casting(lab, V, F, d, M, D, cull):
