@@ -28,6 +28,8 @@ from .support import (
 
 LIGHT_DIR = np.array([0.4, 0.5, -0.75])
 CUBE_POS = np.array([0.2, -0.3, 2.6])
+#: The light of the public render case: steep, so the boxes' sides need more bias than the floor.
+RENDER_DIR = np.array([2.5, 1.5, -6.5])
 
 
 def _scene(**extra):
@@ -400,7 +402,8 @@ CASES = [
     Case(
         id="visibility-ortho-defaults",
         function="shadow_visibility",
-        inputs=_pick(MAP_ORTHO, "P", "N", "D", "M"),
+        # the map of M_PARTIAL covers the middle of the floor only: the points beside it must stay lit (Task 6)
+        inputs=lambda: {**dict(zip(("P", "N"), _points(5))), "D": stored("depth-partial-64")["D"], "M": M_PARTIAL},
         params={"pcf": 3},
         outputs=("visibility",),
         check=checks.Allclose(atol=1e-12),
@@ -414,9 +417,18 @@ CASES = [
         inputs=lambda: {
             "scene": small_scene(),
             "camera": CAMERA,
-            "light": {"type": "directional", "direction": LIGHT_DIR},
+            "light": {"type": "directional", "direction": RENDER_DIR},
         },
-        params={"size": [96, 72], "map_size": 256},
+        # The map's box covers the middle of the floor (the rest must be lit: Task 6), and the slope term alone
+        # (bias 0, slope_bias 1) must fit each point's own plane: a steep light on the floor and the boxes' sides
+        # (one gradient or one bias for every point shows as acne on the sides).
+        params={
+            "size": [96, 72],
+            "map_size": 256,
+            "bounds": [[-1.5, -1.5, 0.0], [1.5, 1.5, 1.9]],
+            "bias": 0.0,
+            "slope_bias": 1.0,
+        },
         outputs=("image",),
         check=checks.ImageMatch(),
         part="all together",

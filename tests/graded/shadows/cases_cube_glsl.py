@@ -104,19 +104,20 @@ def ties_scene():
 
 
 def ties_points():
-    """``(mask, P, N)``: 8 points behind each quad of ties_scene, exactly on its cube edge's diagonal (|d_a| = |d_b|
-    to the last bit): the face the first axis gives (cube_face_index's rule on ties) sees them in shadow, the
-    other face lit. A 12 x 8 picture, one row per edge."""
+    """``(mask, P, N)``: 10 points on each cube edge's diagonal (|d_a| = |d_b| to the last bit): 8 behind the
+    edge's quad of ties_scene, which the face the first axis gives (cube_face_index's rule on ties) sees in shadow
+    and the other face lit, and 2 in front of it (t = 0.3), lit on both faces (a lookup that finds everything in
+    shadow fails there). A 12 x 10 picture, one row per edge."""
     pos = LIGHTS["ties"][0]
     P = []
     for a, sa, b, sb in _cube_edges():
-        for t in (1.0, 1.25, 1.5, 1.75):
+        for t in (0.3, 1.0, 1.25, 1.5, 1.75):
             for c in (-0.4, 0.3):
                 d = np.zeros(3)
                 d[a], d[b], d[3 - a - b] = sa * t, sb * t, c * t
                 P.append(pos + d)
     P = np.array(P)
-    return np.ones((12, 8), bool), P, np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    return np.ones((12, 10), bool), P, np.tile([0.0, 0.0, 1.0], (len(P), 1))
 
 
 def case_points(key: str):

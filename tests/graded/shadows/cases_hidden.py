@@ -144,9 +144,19 @@ CASES = [
         inputs=lambda: {
             "scene": small_scene(),  # a (V, F) pair: one grey, flat-shaded mesh
             "camera": CAMERA,
-            "light": {"type": "spot", "position": np.array([-3.0, -3.5, 5.0]), "target": np.zeros(3), "fov_deg": 70.0},
+            "light": {"type": "spot", "position": np.array([-2.0, -2.5, 6.0]), "target": np.zeros(3), "fov_deg": 70.0},
         },
-        params={"size": [96, 72], "map_size": 256, "pcf": 1},
+        # A high spot: the boxes' sides are steep to it, the floor is not, so the slope term alone (bias 0,
+        # slope_bias 1) must fit each point's own plane. `bounds` sets the spot's near and far planes (light_setup):
+        # its far plane cuts the floor's far corner, which lies in the cone and must stay lit (z > 1: Task 6).
+        params={
+            "size": [96, 72],
+            "map_size": 256,
+            "pcf": 1,
+            "bounds": [[-2.0, -2.0, 0.0], [1.0, 1.0, 1.9]],
+            "bias": 0.0,
+            "slope_bias": 1.0,
+        },
         outputs=("image",),
         check=checks.ImageMatch(),
         part="all together",

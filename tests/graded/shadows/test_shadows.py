@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets
+from geomlib import camera, datasets
 from geomlib.geometry import ray_cast
 from geomlib.grading import expect_close, graded, reference_tests
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import marked_picture
+from geomlib.raster import rasterize
 
 from ..common import expect_rejected
 from .cases import CASES, LIGHT_DIR
@@ -368,12 +369,31 @@ def _truth(V, F, P, to_light, N):
 
 @graded(points=2, part="all together")
 def test_agrees_with_ray_casting(lab):
-    """shadows of the small scene agree with exact ray casting on >= 99% of surface points"""
+    """shadows of the small scene agree with exact ray casting on >= 99% of surface points, also with a map that
+    covers only the objects (the floor outside it is lit)"""
     V, F = small_scene()
     d = np.array([0.4, 0.5, -0.75])
     M = np.asarray(lab.directional_light_matrix(d, [V.min(0), V.max(0)]))
     for cull in ("front", "none"):  # without culling, the default bias alone must keep the lit faces lit
         _agree_with_ray_casting(lab, V, F, d, M, np.asarray(lab.depth_map(V, F, M, 1024, cull=cull)), cull)
+    # A map fitted to a box around the objects and their shadows only: the floor beside it and beyond its far
+    # plane lies outside the map, where ray casting finds it lit (about 4% of a grid over the floor is beyond
+    # the far plane), and shadow_visibility must leave it lit (Task 6).
+    B = np.array([[-1.55, -1.15, 0.0], [2.1, 2.2, 1.95]])
+    M = np.asarray(lab.directional_light_matrix(d, B))
+    D = np.asarray(lab.depth_map(V, F, M, 1024, cull="none"))
+    g = np.linspace(-2.9, 2.9, 41)
+    P = np.c_[np.array(np.meshgrid(g, g)).reshape(2, -1).T, np.zeros(41 * 41)]
+    N = np.tile([0.0, 0.0, 1.0], (len(P), 1))
+    truth = _truth(V, F, P, np.tile(-d / np.linalg.norm(d), (len(P), 1)), N)
+    vis = np.asarray(lab.shadow_visibility(P, N, D, M))
+    agree = np.mean((vis >= 0.5) == truth)
+    if agree < 0.99:
+        wrong = P[(vis >= 0.5) != truth]
+        fail(f"with a map fitted to the box {B.tolist()} (the floor around it is outside the map), shadow_visibility "
+             f"agrees with ray casting on {100 * agree:.2f}% of {len(P)} floor points (need >= 99%): points outside "
+             "the light's frustum must count as lit (outside_frustum)",
+             marked_picture("shadow_visibility vs ray casting, partial map", V, F, wrong, "points where the two disagree"))  # fmt: skip
 
 
 def _agree_with_ray_casting(lab, V, F, d, M, D, cull):
@@ -400,8 +420,8 @@ def _agree_with_ray_casting(lab, V, F, d, M, D, cull):
 
 @graded(points=1, part="all together")
 def test_render_is_an_image(lab):
-    """render_with_shadows returns an (h, w, 3) image in [0, 1] with shadows on the floor, and none where nothing
-    stands between the light and the surface"""
+    """render_with_shadows returns an (h, w, 3) image in [0, 1] with shadows on the floor, none where nothing
+    stands between the light and the surface, and no acne on steep faces with the slope-scaled bias alone"""
     img, vis = lab.render_with_shadows(scene_meshes(), CAMERA, (0.4, 0.5, -0.75), size=(80, 60), map_size=256,
                                        return_visibility=True)  # fmt: skip
     img, vis = np.asarray(img), np.asarray(vis)
@@ -431,6 +451,33 @@ def test_render_is_an_image(lab):
              f"{100 * dark:.1f}% of the visible points are not fully lit (allowed 0.5%); expected all lit: check the "
              "slope-scaled bias per point (receiver_depth_gradient, shadow_bias) and that points outside the map's "
              "box count as lit (outside_frustum)")  # fmt: skip
+    # The small scene under a steep light with the slope term alone (bias 0): the boxes' sides are much steeper to
+    # the light than the floor, so each point needs the bias of its own plane (one bias for all leaves acne on the
+    # sides). The eye's pixels are rasterized here with geomlib and their shadows found by exact ray casting.
+    d = np.array([2.5, 1.5, -6.5])
+    _, vis = lab.render_with_shadows(scene_meshes(), CAMERA, d, size=(80, 60), map_size=256, bias=0.0,
+                                     bounds=[[-1.5, -1.5, 0.0], [1.5, 1.5, 1.9]], return_visibility=True)  # fmt: skip
+    vis = np.asarray(vis, float)
+    V, F = small_scene()
+    eye, target, up = CAMERA
+    g = rasterize(V, F, camera.perspective_look_at(eye, target, up, 40.0, 80 / 60, 1.0, 20.0), 80, 60,
+                  attributes={"position": V})  # fmt: skip
+    seen = g.mask & np.isfinite(vis) if vis.shape == g.mask.shape else g.mask
+    if vis.shape != g.mask.shape or seen.sum() < 0.9 * g.mask.sum():
+        fail(f"render_with_shadows(..., return_visibility=True) gave visibility of shape {vis.shape} covering "
+             f"{int(np.isfinite(vis).sum())} pixels; expected (60, 80) with about {int(g.mask.sum())} covered")  # fmt: skip
+    P = g.attributes["position"][seen]
+    N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    N = (N / np.linalg.norm(N, axis=1, keepdims=True))[g.face_id[seen]]
+    L = -d / np.linalg.norm(d)
+    lit_side = N @ L > 0.05
+    truth = _truth(V, F, P[lit_side], np.tile(L, (int(lit_side.sum()), 1)), N[lit_side])
+    v = vis[seen][lit_side]
+    acne = np.mean(v[truth] < 0.5)
+    if acne > 0.005:
+        fail(f"render_with_shadows of the small scene under a steep light with bias=0: {100 * acne:.2f}% of the "
+             "visible points that ray casting finds lit are dark (acne, allowed 0.5%): each point needs the bias of "
+             "its own plane, b = slope_bias (|g_u| + |g_v|) / 2 (receiver_depth_gradient, shadow_bias)")  # fmt: skip
 
 
 # ------------------------------------------------------------------------------------------ bad input

@@ -30,7 +30,7 @@ from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
-from .cases_cube_glsl import ROOM_GRID, STORED, STORED_HIDDEN
+from .cases_cube_glsl import ROOM_GRID, STORED, STORED_HIDDEN, ties_points
 from .cases_glsl import eye_points
 
 CUBE_DEPTH_ATOL = 1e-3
@@ -131,8 +131,8 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
     if bad.mean() <= CUBE_VISIBILITY_BAD and not np.isnan(g).any():
         return
     room = "-room-" in case_id  # the walls of a room around the light, side by side, instead of the eye view
-    ties = "-ties-" in case_id  # 8 points on each of the cube's 12 edges, a row per edge
-    mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else np.ones((12, 8), bool) if ties else eye_points()[0]
+    ties = "-ties-" in case_id  # 10 points on each of the cube's 12 edges, a row per edge
+    mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else ties_points()[0] if ties else eye_points()[0]
     img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
     img_e[mask], img_g[mask] = e, g
     i = int(np.flatnonzero(np.isnan(g))[0]) if np.isnan(g).any() else int(np.flatnonzero(bad)[0])

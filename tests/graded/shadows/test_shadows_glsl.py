@@ -152,7 +152,8 @@ def test_glsl_depth_map_front_culled(lab):
 
 @graded(points=1, part="fragment shadow test", timeout=60)
 def test_glsl_shadow_bias(lab):
-    """shaders/shadow.frag per eye pixel: a constant bias, then the default constant + slope-scaled bias"""
+    """shaders/shadow.frag per eye pixel: a constant bias, then the default constant + slope-scaled bias with a map
+    over the middle of the floor (lit beside it)"""
     check_glsl_shadow(lab, "glsl-eye-ortho-constant-bias")
     check_glsl_shadow(lab, "glsl-eye-ortho-defaults")
 
@@ -166,6 +167,7 @@ def test_glsl_shadow_frustum(lab):
 
 @graded(points=2, part="fragment shadow test", timeout=60)
 def test_glsl_shadow_pcf(lab):
-    """3 x 3 PCF with the receiver-plane gradient, and PCF on the rotated Poisson disk"""
+    """3 x 3 PCF with the receiver-plane gradient (a spot whose far plane cuts the floor), and PCF on the rotated
+    Poisson disk"""
     check_glsl_shadow(lab, "glsl-eye-spot-pcf3")
     check_glsl_shadow(lab, "glsl-eye-spot-poisson")

@@ -15,14 +15,15 @@ def test_glsl_depth_map_hidden(lab):
 
 @graded(points=2, part="fragment shadow test", visibility="hidden", timeout=60)
 def test_glsl_shadow_pcf_hidden(lab):
-    """shaders/shadow.frag: 5 x 5 PCF with a large slope factor, and 32 Poisson samples on a hidden spot light"""
+    """shaders/shadow.frag: 5 x 5 PCF with a large slope factor (a map over part of the view), and 32 Poisson
+    samples on a hidden spot light"""
     check_glsl_shadow(lab, "hidden-glsl-eye-m2-pcf5")
     check_glsl_shadow(lab, "hidden-glsl-eye-s2-poisson32")
 
 
 @graded(points=2, part="fragment shadow test", visibility="hidden", timeout=60)
 def test_glsl_shadow_bias_hidden(lab):
-    """the default bias on a hidden light, and a small max_slope clamp"""
+    """the default bias on a hidden light, and a small max_slope clamp (a spot whose far plane cuts the floor)"""
     check_glsl_shadow(lab, "hidden-glsl-eye-m2-defaults")
     check_glsl_shadow(lab, "hidden-glsl-eye-s2-max-slope")
 
