@@ -265,6 +265,10 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
         os.environ["TMPDIR"] = scratch
     if req.get("jit_cache"):
         os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the calls of one snapshot (geomlib.jit)
+        # Mesa's compiled shaders too: llvmpipe compiles a shader at its first draw (about 0.3 s of
+        # CPU, most of a GLSL call); with its disk cache in the same folder the calls of one snapshot
+        # compile each shader once (its default, ~/.cache, is not writable under Landlock).
+        os.environ["MESA_SHADER_CACHE_DIR"] = req["jit_cache"]
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
     if req.get("seccomp"):
