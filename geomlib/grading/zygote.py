@@ -39,7 +39,7 @@ import struct
 import sys
 import time
 
-from geomlib.grading import landlock, seccomp
+from geomlib.grading import blacklist, landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -60,6 +60,7 @@ PRELOAD = (
     "geomlib.camera",
     "geomlib.raster",
     "geomlib.datasets",
+    "geomlib.grading.shader_watch",  # every worker installs it (its dataclasses cost ~5 ms per call)
     # The compiled kernels of sdf, simplification and remeshing: importing numba costs about a
     # second of CPU, which every worker of those labs paid per call (their stubs too).
     "numba",
@@ -380,6 +381,10 @@ def serve(sock: socket.socket) -> None:
         try:
             _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"))  # PyOpenGL, once, for a lab with shaders
         except Exception:  # noqa: BLE001 - the worker imports it itself (and reports what fails)
+            pass
+        try:
+            blacklist.prepare(req.get("not_allowed"))  # where the lab's forbidden functions are referenced
+        except Exception:  # noqa: BLE001 - each worker searches every module itself
             pass
         pid = os.fork()
         if pid == 0:
