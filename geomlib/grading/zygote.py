@@ -360,11 +360,15 @@ def _stub_imports(stubs_dir: str) -> set[str]:
     return names
 
 
+_PRELOADED_FOR: set = set()
+
+
 def _preload_for(stubs_dir: str | None) -> None:
     """Import the modules of :data:`PRELOAD_IF_USED` the lab uses (all of them without stubs)."""
     todo = [m for m in PRELOAD_IF_USED if m not in sys.modules]
-    if not todo:
+    if not todo or stubs_dir in _PRELOADED_FOR:
         return
+    _PRELOADED_FOR.add(stubs_dir)
     used = _stub_imports(stubs_dir) if stubs_dir else None
     for module in todo:
         if used is None or any(n == u or n.startswith(u + ".") for n in used for u in PRELOAD_IF_USED[module]):
