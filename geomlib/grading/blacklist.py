@@ -140,6 +140,39 @@ def given(code) -> None:
         todo.extend(k for k in c.co_consts if hasattr(k, "co_code"))
 
 
+#: Built by the zygote before it forks (:func:`prepare`), per lab's entries: ``(loaded, where)``,
+#: ``loaded`` the module objects loaded then (``name -> id``), ``where`` the id of each declared
+#: function loaded then -> the names of the modules whose namespace referenced it. A worker's search
+#: for references then reads only those modules and the ones loaded after the fork, instead of the
+#: namespace of every loaded module (about 1000; a fifth of a short call's CPU, copy-on-write pages).
+_INDEX: dict = {}
+
+
+def _index_key(entries: dict[str, str]) -> tuple:
+    return tuple(sorted(entries))
+
+
+def prepare(entries: dict[str, str] | None) -> None:
+    """In the zygote (nothing of a submission loaded): index where the declared functions are referenced."""
+    if not entries:
+        return
+    resolver = _Guards("", os.sep, entries)
+    raw = [found[2] for name in entries if (found := resolver._resolve(name)) is not None]  # may import
+    loaded = {name: id(mod) for name, mod in list(sys.modules.items())}
+    key = _index_key(entries)
+    if key in _INDEX and _INDEX[key][0] == loaded:
+        return
+    where: dict[int, set[str]] = {id(fn): set() for fn in raw}
+    for name, mod in list(sys.modules.items()):
+        try:
+            d = vars(mod)
+        except TypeError:
+            continue
+        for i in where.keys() & set(map(id, list(d.values()))):
+            where[i].add(name)
+    _INDEX[key] = (loaded, where, raw)  # raw keeps the ids valid
+
+
 class _Guards:
     """The installed guards of one worker (one lab, one submission)."""
 
@@ -151,6 +184,7 @@ class _Guards:
         self.guard_of: dict[int, object] = {}  # id(raw function) -> guard
         self.raw: list = []  # keeps the raw functions alive (their ids stay valid)
         self.roots = {name.split(".")[0] for name in entries}
+        self.index = _INDEX.get(_index_key(entries))
 
     # -- who is calling
 
@@ -221,7 +255,7 @@ class _Guards:
         After the import of ``module`` only that module is searched unless a declared function
         was found for the first time (then every loaded module is).
         """
-        new = False
+        new = []
         for name in list(self.pending):
             found = self._resolve(name)
             if found is None:
@@ -236,12 +270,23 @@ class _Guards:
                 setattr(owner, attr, guard)
             except (AttributeError, TypeError):
                 pass
-            new = True
+            new.append(id(raw))
         if new:
-            for mod in list(sys.modules.values()):
-                self.patch_module(mod)
+            for name, mod in list(sys.modules.items()):
+                if self._may_refer(name, mod, new):
+                    self.patch_module(mod)
         elif module is not None and self.guard_of:
             self.patch_module(module)
+
+    def _may_refer(self, name: str, mod, new: list[int]) -> bool:
+        """False when the zygote's index shows that module ``name`` references none of the functions
+        ``new`` (ids) and none of the functions guarded before (their references are patched)."""
+        if self.index is None:
+            return True
+        loaded, where, _ = self.index
+        if loaded.get(name) != id(mod) or any(i not in where for i in self.guard_of):
+            return True  # loaded or replaced after the fork, or a function the zygote did not see
+        return any(name in where[i] for i in new)
 
     def patch_module(self, mod) -> None:
         try:

@@ -381,7 +381,8 @@ def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None
 
     for stem, tree in stub_trees:
         if _defines(tree, function):
-            if function in task_names(tree) and not _student_defines(lab_dir / f"{stem}.py", function):
+            tasks = _STUB_NAMES[id(tree)][0] if id(tree) in _STUB_NAMES else task_names(tree)  # the zygote's
+            if function in tasks and not _student_defines(lab_dir / f"{stem}.py", function):
                 # The student moved the task to a file of their own.
                 for own, own_tree in own_trees:
                     if _defines(own_tree, function) and (fn := load(own)) is not None:

@@ -38,8 +38,9 @@ import socket
 import struct
 import sys
 import time
+from pathlib import Path
 
-from geomlib.grading import landlock, seccomp
+from geomlib.grading import blacklist, landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -52,7 +53,6 @@ PRELOAD = (
     "scipy.sparse.linalg",
     "scipy.spatial",
     "scipy.ndimage",
-    "scipy.fft",  # vdm's transport: 0.1 s per call otherwise
     "igl",
     "geomlib.validate",
     "geomlib.topology",
@@ -60,10 +60,19 @@ PRELOAD = (
     "geomlib.camera",
     "geomlib.raster",
     "geomlib.datasets",
-    # The compiled kernels of sdf, simplification and remeshing: importing numba costs about a
-    # second of CPU, which every worker of those labs paid per call (their stubs too).
-    "numba",
+    "geomlib.grading.shader_watch",  # every worker installs it (its dataclasses cost ~5 ms per call)
 )
+
+#: Imported by the zygote before the first call of a lab whose course stubs import them (or of a
+#: lab without known stubs), not for the others: 0.3 s of CPU at every start of the grader
+#: (``geomlib grade --task N``) and a larger process to fork. Module -> what in a stub's import
+#: means the lab uses it.
+PRELOAD_IF_USED = {
+    # The compiled kernels of sdf, simplification and remeshing: importing numba costs a quarter
+    # second of CPU, which every worker of those labs paid per call (their stubs too).
+    "numba": ("numba", "geomlib.jit"),
+    "scipy.fft": ("scipy.fft",),  # vdm's transport: 0.1 s per call otherwise
+}
 
 #: Processes (threads) a worker may add to what its user already runs.
 NPROC_EXTRA = 256
@@ -265,6 +274,10 @@ def confine(req: dict, result_fd: int, out_fd: int) -> None:
         os.environ["TMPDIR"] = scratch
     if req.get("jit_cache"):
         os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # shared by the calls of one snapshot (geomlib.jit)
+        # Mesa's compiled shaders too: llvmpipe compiles a shader at its first draw (about 0.3 s of
+        # CPU, most of a GLSL call); with its disk cache in the same folder the calls of one snapshot
+        # compile each shader once (its default, ~/.cache, is not writable under Landlock).
+        os.environ["MESA_SHADER_CACHE_DIR"] = req["jit_cache"]
     if req.get("landlock"):
         landlock.restrict(req.get("read", []), req.get("write", []))
     if req.get("seccomp"):
@@ -331,6 +344,40 @@ def _worker_main(req: dict, blob: bytes, result_fd: int, out_fd: int) -> None:
     _worker.run_call(result_fd, req["lab_dir"], req["lab"], req["function"], args, kwargs, *extra)
 
 
+def _stub_imports(stubs_dir: str) -> set[str]:
+    """The absolute modules the course's stubs import at their top level (parsed by prepare_stubs)."""
+    import ast
+
+    names = set()
+    for path in Path(stubs_dir).glob("*.py"):
+        tree = _worker._TREES.get((str(path), False))
+        for node in getattr(tree, "body", ()):
+            if isinstance(node, ast.Import):
+                names.update(a.name for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+                names.add(node.module)
+                names.update(f"{node.module}.{a.name}" for a in node.names)
+    return names
+
+
+_PRELOADED_FOR: set = set()
+
+
+def _preload_for(stubs_dir: str | None) -> None:
+    """Import the modules of :data:`PRELOAD_IF_USED` the lab uses (all of them without stubs)."""
+    todo = [m for m in PRELOAD_IF_USED if m not in sys.modules]
+    if not todo or stubs_dir in _PRELOADED_FOR:
+        return
+    _PRELOADED_FOR.add(stubs_dir)
+    used = _stub_imports(stubs_dir) if stubs_dir else None
+    for module in todo:
+        if used is None or any(n == u or n.startswith(u + ".") for n in used for u in PRELOAD_IF_USED[module]):
+            try:
+                importlib.import_module(module)
+            except Exception:  # noqa: BLE001 - a missing optional module only makes workers slower
+                pass
+
+
 # ---------------------------------------------------------------------------------- the server
 
 
@@ -374,8 +421,17 @@ def serve(sock: socket.socket) -> None:
         except Exception:  # noqa: BLE001 - the worker parses them itself
             pass
         try:
+            if req.get("op") == "call":
+                _preload_for(req.get("stubs_dir"))  # numba and scipy.fft, for the labs that use them
+        except Exception:  # noqa: BLE001 - the workers import them themselves
+            pass
+        try:
             _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"))  # PyOpenGL, once, for a lab with shaders
         except Exception:  # noqa: BLE001 - the worker imports it itself (and reports what fails)
+            pass
+        try:
+            blacklist.prepare(req.get("not_allowed"))  # where the lab's forbidden functions are referenced
+        except Exception:  # noqa: BLE001 - each worker searches every module itself
             pass
         pid = os.fork()
         if pid == 0:

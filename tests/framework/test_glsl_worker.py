@@ -103,3 +103,37 @@ def test_after_a_hung_and_a_broken_shader_the_next_glsl_call_is_graded_correctly
     finally:
         for d in (hung, broken, good):
             shutil.rmtree(d.parent, ignore_errors=True)
+
+
+CACHE_PROBE = """
+import os
+
+import numpy as np
+
+
+def gl_cached():
+    from geomlib import gl
+
+    folder = os.environ.get("MESA_SHADER_CACHE_DIR")
+    before = sum(len(files) for _, _, files in os.walk(folder)) if folder else -1
+    src = "#version 330 core\\nin vec2 uv; out vec4 color;\\nvoid main() { color = vec4(uv, 0.75, 1.0); }"
+    gl.render_quad(src, (2, 1))
+    gl.close()
+    return np.array([folder == os.environ.get("NUMBA_CACHE_DIR"), before], dtype=float)
+"""
+
+
+def test_glsl_workers_of_one_submission_share_mesas_shader_cache():
+    """llvmpipe compiles a shader at its first draw (~0.3 s of CPU, most of a GLSL call): the workers of
+    one snapshot keep Mesa's disk cache in their numba cache folder, which they may write, so the second
+    call of a shader finds it compiled."""
+    dest = planted_solution("shadows", lambda d: (d / "probe.py").write_text(CACHE_PROBE))
+    try:
+        lab = LabProxy("shadows", dest, timeout=180)
+        same, first = lab.gl_cached().tolist()
+        _, second = lab.gl_cached().tolist()
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+    assert same == 1.0, "MESA_SHADER_CACHE_DIR is not the snapshot's cache folder"
+    assert first == 0, "the first call of a new snapshot found another snapshot's shader cache"
+    assert second > 0, "the first call's compiled shader was not written to Mesa's cache"
