@@ -61,31 +61,34 @@ def run_autograder(release: Path, lab: str, submission: Path | None) -> dict:
 
     root = Path(tempfile.mkdtemp(prefix="geomlib-autograder-"))
     root.chmod(0o755)
-    with zipfile.ZipFile(release / f"autograder-{lab}.zip") as z:
-        z.extractall(root / "source")
-        names = z.namelist()
-    assert "setup.sh" in names and "run_autograder" in names
-    assert any("hidden" in n for n in names)  # the autograder does get the hidden tests
-    assert not any(n.startswith("solutions/") for n in names)
-    (root / "submission").mkdir()
-    if submission is not None:
-        shutil.copytree(submission, root / "submission" / "labs" / submission.name)
-    hidden = root / "source" / "tests" / "reference" / lab / "hidden"
-    hidden.chmod(0o700)  # as setup.sh does
-    run = root / "source" / "run_autograder"
-    run.chmod(0o755)
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
-    # The sandbox user's drop is exercised on the real course (test_release_course.py): this
-    # interpreter may live where `nobody` cannot read it.
-    env.update(
-        GEOMLIB_AUTOGRADER_ROOT=str(root),
-        GEOMLIB_PYTHON=sys.executable,
-        PYTHONPATH=str(root / "source"),
-        GEOMLIB_SANDBOX_USER="",
-    )
-    p = subprocess.run(["bash", str(run)], env=env, capture_output=True, text=True, timeout=300)
-    assert p.returncode == 0, p.stdout + p.stderr
-    return json.loads((root / "results" / "results.json").read_text())
+    try:
+        with zipfile.ZipFile(release / f"autograder-{lab}.zip") as z:
+            z.extractall(root / "source")
+            names = z.namelist()
+        assert "setup.sh" in names and "run_autograder" in names
+        assert any("hidden" in n for n in names)  # the autograder does get the hidden tests
+        assert not any(n.startswith("solutions/") for n in names)
+        (root / "submission").mkdir()
+        if submission is not None:
+            shutil.copytree(submission, root / "submission" / "labs" / submission.name)
+        hidden = root / "source" / "tests" / "reference" / lab / "hidden"
+        hidden.chmod(0o700)  # as setup.sh does
+        run = root / "source" / "run_autograder"
+        run.chmod(0o755)
+        env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_ROOT"}
+        # The sandbox user's drop is exercised on the real course (test_release_course.py): this
+        # interpreter may live where `nobody` cannot read it.
+        env.update(
+            GEOMLIB_AUTOGRADER_ROOT=str(root),
+            GEOMLIB_PYTHON=sys.executable,
+            PYTHONPATH=str(root / "source"),
+            GEOMLIB_SANDBOX_USER="",
+        )
+        p = subprocess.run(["bash", str(run)], env=env, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stdout + p.stderr
+        return json.loads((root / "results" / "results.json").read_text())
+    finally:  # every call unpacks an autograder (1.2 MB): none was ever removed from /tmp
+        shutil.rmtree(root, ignore_errors=True)
 
 
 def grade(root: Path, impl: str, *extra: str, env: dict | None = None, python: str | None = None) -> dict:

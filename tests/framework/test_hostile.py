@@ -1,7 +1,11 @@
 """Planted hostile submissions of the real subdivision lab, graded as users grade (issue 19, 13.4-13.6).
 
-Each test grades one submission from :mod:`tests.framework.hostile` with ``geomlib grade`` on a
-throw-away copy of the course, so an attack that got through could not damage this checkout.
+Each test grades one submission from :mod:`tests.framework.hostile` with ``geomlib grade`` (a
+grading run of its own: combined in one submission, an attack on the grader's pipes or messages
+would change what the others' tests see) on a throw-away copy of the course, so an attack that got
+through could not damage this checkout. The copy is made once per module and shared: an attack that
+changed it would fail its own test (``test_detached_children_forged_lines_and_tampering...`` checks
+the copy's checks.py is untouched) and the ones graded after it.
 """
 
 from __future__ import annotations
@@ -17,20 +21,32 @@ import pytest
 from geomlib.grading.results import plain_text, validate_results
 
 from .course import sandbox_python, sandbox_user_problem
-from .hostile import grade_planted
+from .hostile import course_copy, grade_planted
 
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")]
 
 
-def _grade(kind: str, tmp_path: Path, python: str | None = None, **env) -> dict:
+COURSE = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def course_root():
+    """One world-readable throw-away copy of the course (10 MB) for every grade of this module."""
+    base = Path(tempfile.mkdtemp(prefix="geomlib-hostile-course-"))
+    base.chmod(0o755)
+    try:
+        yield course_copy(base / "course", COURSE)
+    finally:
+        # Left behind, copies of the course filled the disk and a later run failed everywhere.
+        shutil.rmtree(base, ignore_errors=True)
+
+
+def _grade(kind: str, root: Path, python: str | None = None, **env) -> dict:
     work = Path(tempfile.mkdtemp(prefix=f"geomlib-hostile-{kind}-"))
     work.chmod(0o755)
-    course = Path(__file__).resolve().parents[2]
     try:
-        r = grade_planted(kind, course, work, python=python or sys.executable, env=env, timeout=600)
+        r = grade_planted(kind, COURSE, work, python=python or sys.executable, env=env, timeout=600, root=root)
     finally:
-        # The course copy holds whatever the checkout holds beside the sources (up to 2.6 GB each
-        # before): left behind, a few suite runs filled the disk and the next run failed everywhere.
         shutil.rmtree(work, ignore_errors=True)
     assert not r["hung"], r["log"]
     assert r["results"] is not None, r["log"]
@@ -45,8 +61,8 @@ def _tests(r: dict, words: str) -> list[dict]:
     return [t for t in r["results"]["tests"] if words in t["name"]]
 
 
-def test_nan_outputs_earn_nothing(tmp_path):
-    r = _grade("nan", tmp_path)
+def test_nan_outputs_earn_nothing(course_root):
+    r = _grade("nan", course_root)
     refs = [t for t in r["results"]["tests"] if ' on "' in t["name"] and t["max_score"] > 0]
     assert refs and all(t["status"] == "failed" for t in refs)
     assert sum(t["score"] for t in r["results"]["tests"] if t["visibility"] == "hidden") == 0
@@ -54,28 +70,28 @@ def test_nan_outputs_earn_nothing(tmp_path):
     assert r["score"] == 0
 
 
-def test_looking_up_stored_outputs_earns_nothing(tmp_path):
+def test_looking_up_stored_outputs_earns_nothing(course_root):
     """The worker holds no case list and cannot open the cases or references (Landlock or the sandbox user)."""
-    r = _grade("lookup", tmp_path)
+    r = _grade("lookup", course_root)
     assert r["score"] == 0
     assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
 
 
 @pytest.mark.parametrize("landlock", ["1", "0"], ids=["with-landlock", "file-permissions-only"])
-def test_as_the_sandbox_user_looking_up_stored_outputs_earns_nothing(tmp_path, landlock):
+def test_as_the_sandbox_user_looking_up_stored_outputs_earns_nothing(course_root, landlock):
     """Gradescope's set-up: root drops to nobody; hidden cases and references are root-only."""
     found = sandbox_python("nobody")
     if found is None:
         pytest.skip(sandbox_user_problem("nobody"))
     python, extra = found
     env = {"GEOMLIB_SANDBOX_USER": "nobody", "GEOMLIB_LANDLOCK": landlock, **extra}
-    r = _grade("lookup", tmp_path, python=python, **env)
+    r = _grade("lookup", course_root, python=python, **env)
     assert r["score"] == 0
     assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
 
 
-def test_a_lone_surrogate_in_a_message_costs_only_its_tests(tmp_path):
-    r = _grade("surrogate", tmp_path)
+def test_a_lone_surrogate_in_a_message_costs_only_its_tests(course_root):
+    r = _grade("surrogate", course_root)
     weight = _tests(r, "loop_weight([3, 4, 6]")
     assert r["score"] > 0
     assert any("bad \ufffd" in t["text"] for t in r["results"]["tests"])
@@ -83,28 +99,28 @@ def test_a_lone_surrogate_in_a_message_costs_only_its_tests(tmp_path):
     assert weight == [] or all(t["status"] == "failed" for t in weight)
 
 
-def test_a_half_written_message_header_cannot_hang_the_grader(tmp_path):
-    r = _grade("partial_header", tmp_path, GEOMLIB_TIME_LIMIT="2")
+def test_a_half_written_message_header_cannot_hang_the_grader(course_root):
+    r = _grade("partial_header", course_root, GEOMLIB_TIME_LIMIT="2")
     failed = [t for t in r["results"]["tests"] if "did not finish within 2 s" in t["text"]]
     assert failed and r["score"] > 0
 
 
-def test_a_huge_exception_is_cut_in_the_grader(tmp_path):
-    r = _grade("huge_message", tmp_path)
+def test_a_huge_exception_is_cut_in_the_grader(course_root):
+    r = _grade("huge_message", course_root)
     assert r["results_bytes"] < 1_000_000
     assert r["score"] > 0
 
 
-def test_a_forged_sparse_shape_is_refused_before_anything_is_allocated(tmp_path):
-    r = _grade("sparse_bomb", tmp_path)
+def test_a_forged_sparse_shape_is_refused_before_anything_is_allocated(course_root):
+    r = _grade("sparse_bomb", course_root)
     odd = [t for t in r["results"]["tests"] if "loop_odd_matrix" in t["text"] and t["max_score"] > 0]
     assert odd and all(t["status"] == "failed" for t in odd)
     assert any("300000000" in t["text"] for t in odd)
     assert r["score"] > 0
 
 
-def test_the_whole_run_stops_at_its_time_budget_and_still_writes_results(tmp_path):
-    r = _grade("slow", tmp_path, GEOMLIB_TIME_LIMIT="2", GEOMLIB_TIME_BUDGET="12")
+def test_the_whole_run_stops_at_its_time_budget_and_still_writes_results(course_root):
+    r = _grade("slow", course_root, GEOMLIB_TIME_LIMIT="2", GEOMLIB_TIME_BUDGET="12")
     texts = [t["text"] for t in r["results"]["tests"]]
     assert any("time budget of 12 s for the whole submission" in t for t in texts)
     # Within a 12 s budget at most 12 / 2 calls can each use up their 2 s (plus the one running when
@@ -115,8 +131,8 @@ def test_the_whole_run_stops_at_its_time_budget_and_still_writes_results(tmp_pat
     assert r["seconds"] < 12 + 300  # a hang (the grader did not stop at its budget), not slowness
 
 
-def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(tmp_path):
-    r = _grade("leftovers", tmp_path)
+def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(course_root):
+    r = _grade("leftovers", course_root)
     assert r["daemons"] == 0
     assert not r["tampered"]
     assert not r["forged"]
@@ -124,16 +140,16 @@ def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(tm
     assert r["score"] == sum(t["max_score"] for t in r["results"]["tests"])
 
 
-def test_rewriting_a_given_helper_gains_nothing(tmp_path):
+def test_rewriting_a_given_helper_gains_nothing(course_root):
     """catmull_clark is given: the course's version runs, calling the submission's (stub) tasks."""
-    r = _grade("edit_given", tmp_path)
+    r = _grade("edit_given", course_root)
     cc = [t for t in r["results"]["tests"] if "catmull_clark" in t["name"] and t["max_score"] > 0]
     assert cc and all(t["status"] == "failed" for t in cc)
     assert r["score"] == 0
 
 
-def test_a_broken_import_in_one_file_costs_only_that_files_functions(tmp_path):
-    r = _grade("blame_import", tmp_path)
+def test_a_broken_import_in_one_file_costs_only_that_files_functions(course_root):
+    r = _grade("blame_import", course_root)
     loop = [t for t in r["results"]["tests"] if "loop_faces" in t["name"] or "loop_weight" in t["name"]]
     assert loop and all(t["status"] == "passed" for t in loop)
     cc = [t for t in r["results"]["tests"] if "cc_face_points on" in t["name"]]

@@ -24,8 +24,11 @@ from .course import run_autograder, run_geomlib, user_cli
 def release(sample_course) -> Path:
     out = Path(tempfile.mkdtemp(prefix="geomlib-release-"))
     out.chmod(0o755)
-    run_geomlib(sample_course, "release", str(out))
-    return out
+    try:
+        run_geomlib(sample_course, "release", str(out))
+        yield out
+    finally:  # every run left one behind in /tmp
+        shutil.rmtree(out, ignore_errors=True)
 
 
 def test_student_bundle_has_no_solutions_and_no_hidden_material(release, sample_course):
@@ -80,11 +83,16 @@ def test_run_autograder_on_an_empty_submission_says_what_to_upload(release):
 # ------------------------------------------------------------------------------ failures, leaks
 
 
-def _course_copy(sample_course) -> Path:
+@pytest.fixture
+def course_copy(sample_course):
+    """A private copy of the built sample course, removed afterwards (every run left three in /tmp)."""
     base = Path(tempfile.mkdtemp(prefix="geomlib-sample-copy-"))
-    root = base / "course"
-    shutil.copytree(sample_course, root, symlinks=True)
-    return root
+    try:
+        root = base / "course"
+        shutil.copytree(sample_course, root, symlinks=True)
+        yield root
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
 
 
 def _plant(root: Path, lines: list[str]) -> None:
@@ -93,8 +101,8 @@ def _plant(root: Path, lines: list[str]) -> None:
     helper.write_text(helper.read_text() + "\n\ndef _planted(V, E, tol=None):\n" + "".join(f"    {x}\n" for x in lines))
 
 
-def test_a_planted_leak_stops_the_release_with_one_line_and_leaves_nothing(sample_course):
-    root = _course_copy(sample_course)
+def test_a_planted_leak_stops_the_release_with_one_line_and_leaves_nothing(course_copy):
+    root = course_copy
     _plant(root, ["M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])", "return M"])
     out = root.parent / "dist"
     out.mkdir()
@@ -108,10 +116,10 @@ def test_a_planted_leak_stops_the_release_with_one_line_and_leaves_nothing(sampl
     assert sorted(p.name for p in out.iterdir()) == ["keep.txt"]  # nothing half-written, nothing removed
 
 
-def test_generic_lines_of_a_solution_block_are_not_leaks(sample_course):
+def test_generic_lines_of_a_solution_block_are_not_leaks(course_copy):
     # Lines that the library ships anyway (`return False`, `if tol is None:`) give nothing away,
     # even inside a solution block: a helper may use them.
-    root = _course_copy(sample_course)
+    root = course_copy
     ops = root / "solutions" / "sample" / "ops.py"
     text = ops.read_text().replace(
         "    c = V.mean(axis=0)\n",
@@ -130,8 +138,8 @@ def test_generic_lines_of_a_solution_block_are_not_leaks(sample_course):
     assert p.returncode == 0, p.stdout + p.stderr
 
 
-def test_an_unknown_lab_or_stale_stubs_give_one_clear_line(sample_course):
-    root = _course_copy(sample_course)
+def test_an_unknown_lab_or_stale_stubs_give_one_clear_line(course_copy):
+    root = course_copy
     p = run_geomlib(root, "release", str(root.parent / "dist"), "--lab", "nope", check=False)
     assert p.returncode == 1 and p.stderr.strip() == "geomlib release: error: unknown lab(s) nope; known: sample"
     stub = root / "labs" / "sample" / "ops.py"
