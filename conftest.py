@@ -89,7 +89,6 @@ SECONDS: dict[str, float] = {
     "tests/solutions/test_deterministic.py": 130,
     "tests/framework/test_release_course.py": 80,
     "tests/test_notebooks.py::test_notebook_executes[remeshing]": 75,
-    "tests/test_course.py::test_stubs_score_zero_without_a_single_error": 61,
     "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[remeshing]": 58,
     "tests/test_notebooks.py::test_notebook_executes[shadows]": 51,
     "tests/graded/remeshing/test_remeshing.py": 50,

@@ -1,8 +1,10 @@
-"""Course-wide invariants: stubs are fresh, references reproduce, stubs score zero, lint is clean."""
+"""Course-wide invariants: stubs are fresh, references reproduce, lint is clean.
+
+That every lab's stubs score zero with no error but "not implemented yet" is checked where the
+stubs are graded once: the notebooks' check() cells on the stubs (tests/test_notebooks.py)."""
 
 from __future__ import annotations
 
-import json
 import os
 import subprocess
 import sys
@@ -12,7 +14,6 @@ import pytest
 
 from geomlib.grading import impl, stubs
 from geomlib.grading.course import course
-from geomlib.grading.results import validate_results
 
 ROOT = Path(__file__).resolve().parents[1]
 LABS = course(ROOT).solution_labs
@@ -40,25 +41,6 @@ def test_solutions_reproduce_the_stored_references():
     # inputs are reproduced, and no reference file is missing or stale.
     p = _cli("refs", "check", "--no-grade", "--no-rerun")
     assert p.returncode == 0, p.stdout[-4000:] + p.stderr[-2000:]
-
-
-@pytest.mark.slow
-def test_stubs_score_zero_without_a_single_error(tmp_path):
-    results = tmp_path / "results.json"
-    # Limits for hangs only (as `refs check` grades the solutions): the question is why each test
-    # fails, and a loaded machine must not turn "not implemented yet" into "time budget spent".
-    hangs = {"GEOMLIB_TIME_LIMIT": "300", "GEOMLIB_TIME_BUDGET": "0"}
-    p = _cli("grade", "--impl", "labs", "--results", str(results), "--feedback", str(tmp_path / "fb"), env=hangs)
-    assert p.returncode == 0, p.stderr[-3000:]
-    r = json.loads(results.read_text())
-    validate_results(r)
-    assert r["score"] == 0, [t["name"] for t in r["tests"] if t["score"]]
-    pointed = [t for t in r["tests"] if t["max_score"] > 0]
-    assert pointed
-    bad = [t for t in pointed if "not implemented yet" not in t["output"]]
-    assert not bad, "stub tests that fail for another reason than 'not implemented yet':\n" + "\n".join(
-        f"{t['name']}: {t['output'][:300]}" for t in bad
-    )
 
 
 def test_every_lab_is_complete():

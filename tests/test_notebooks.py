@@ -1,7 +1,18 @@
-"""Every notebook executes headless, top to bottom (small inputs, quick figures)."""
+"""Every notebook executes headless, top to bottom (small inputs, quick figures), on the solutions
+and on the stubs; on the stubs its ``check()`` cells show that every lab's stubs score zero.
+
+Each thing is graded once in the suite: ``tests/graded/<lab>`` grades every graded test against the
+solutions, and the stubs run here grades every graded test against the stubs (the notebook's
+``check(lab, task=N)`` cells, one per task; ``tests/framework/test_task_selection.py`` checks that
+together they select every graded test). So the run on the solutions executes every cell but the
+``check()`` cells after the first: the first one (task 1, it also imports ``check``) shows a
+passing report in a kernel, the others would grade the solutions a second time.
+"""
 
 from __future__ import annotations
 
+import json
+import re
 from pathlib import Path
 
 import pytest
@@ -12,43 +23,94 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 #: 2-core machine shared with 20 busy processes (the old 300 s made the test depend on the load).
 CELL_TIMEOUT = 3600
 
+#: A cell run after the notebook's own: the reports of its check() cells (IPython keeps every cell's
+#: value in ``Out``), by execution count.
+_REPORTS = """\
+import json as _json
+from geomlib.grading.grade import Report as _Report
+print("@@reports" + _json.dumps({k: v.results for k, v in Out.items() if isinstance(v, _Report)}))
+"""
 
-@pytest.mark.slow
-@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
-def test_notebook_executes(path, tmp_path):
+
+def _check_task(lab: str, source: str) -> int | None:
+    """N for a cell that runs ``check(lab, task=N)``, else None."""
+    m = re.search(rf'^check\("{lab}", task=(\d+)\)', source, re.M)
+    return int(m.group(1)) if m else None
+
+
+def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
+    """Run the notebook in a fresh kernel; return its cells' printed text and ``{task: results}``
+    of its check() cells. ``solutions``: the check() cells after the first are left out."""
     import nbformat
     from nbclient import NotebookClient
 
+    lab = path.stem
     nb = nbformat.read(path, as_version=4)
     assert not any(c.get("outputs") for c in nb.cells if c.cell_type == "code"), f"{path.name} is stored with outputs"
+    if solutions:
+        checks = [c for c in nb.cells if c.cell_type == "code" and _check_task(lab, c.source) is not None]
+        nb.cells = [c for c in nb.cells if c not in checks[1:]]
+    nb.cells.append(nbformat.v4.new_code_cell(_REPORTS))
     NotebookClient(
         nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(ROOT / "notebooks")}}
     ).execute()
+    last = "".join(o.get("text", "") for o in nb.cells.pop().outputs)
+    by_count = json.loads(last.split("@@reports", 1)[1])
+    reports = {}
+    for c in nb.cells:
+        task = _check_task(lab, c.source) if c.cell_type == "code" else None
+        if task is not None:
+            assert str(c.execution_count) in by_count, f"{path.name}: check(task={task}) returned no report"
+            reports[task] = by_count[str(c.execution_count)]
+    text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
+    return text, reports
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
+def test_notebook_executes(path, monkeypatch):
+    """On the solutions: every cell runs, and the first check() cell reports full marks."""
+    monkeypatch.setenv("GEOMLIB_IMPL", "solutions")
+    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
+    _, reports = _execute(path, solutions=True)
+    assert len(reports) == 1, f"{path.name}: check() cells run {sorted(reports)}"
+    ((task, r),) = reports.items()
+    assert r["tests"], f"check({path.stem!r}, task={task}) graded nothing"
+    failed = [f"{t['name']}: {t['output'][:300]}" for t in r["tests"] if t["score"] < t["max_score"]]
+    assert not failed, f"the solutions lose points in check({path.stem!r}, task={task}):\n" + "\n".join(failed)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs_on_the_stubs(path, monkeypatch):
-    """As in the student bundle before any work: every cell runs, and the missing tasks are named."""
-    import nbformat
-    from nbclient import NotebookClient
+    """As in the student bundle before any work: every cell runs, the missing tasks are named, and
+    every task's check() scores 0 with no failure other than "not implemented yet" (a stub that
+    fails for another reason, an error in the grader or in a given helper, shows here)."""
+    from geomlib.grading import tasks
+    from geomlib.grading.results import validate_results
 
+    lab = path.stem
     monkeypatch.setenv("GEOMLIB_IMPL", "labs")
-    nb = nbformat.read(path, as_version=4)
-    NotebookClient(
-        nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(ROOT / "notebooks")}}
-    ).execute()
-    text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
+    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
+    text, reports = _execute(path, solutions=False)
     assert "not implemented yet" in text
+    assert set(reports) == set(tasks.table(lab).titles), f"{path.name}: check() reports for tasks {sorted(reports)}"
+    pointed = {}
+    for task, r in sorted(reports.items()):
+        validate_results(r)
+        assert r["score"] == 0, (task, [t["name"] for t in r["tests"] if t["score"]])
+        pointed.update({t["name"]: t for t in r["tests"] if t["max_score"] > 0})
+    assert pointed, f"{lab}: no graded test with points"
+    bad = [t for t in pointed.values() if "not implemented yet" not in t["output"]]
+    assert not bad, "stub tests that fail for another reason than 'not implemented yet':\n" + "\n".join(
+        f"{t['name']}: {t['output'][:300]}" for t in bad
+    )
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_setup_is_one_call_and_every_task_has_a_check_cell(path):
     """The first code cell opens the lab with one call (no copy of the set-up code in nine notebooks),
     and each task of the handout's table has a cell that runs ``check(lab, task=N)``."""
-    import json
-    import re
-
     from geomlib.grading import tasks
 
     lab = path.stem

@@ -22,7 +22,7 @@ from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.course import course
 from geomlib.grading.results import build_results, write_results
-from geomlib.grading.settings import GradingSettings
+from geomlib.grading.settings import GradingSettings, env
 from geomlib.taskref import find_task, task_at_start
 
 __all__ = ["grade", "check", "Report", "report_lines"]
@@ -458,7 +458,9 @@ def check(
         from geomlib.grading import check
         check("subdivision", task=2)
 
-    ``pictures="all"`` draws a feedback picture for every failure, not only the first.
+    ``pictures="all"`` draws a feedback picture for every failure, not only the first. The
+    implementation graded is ``impl``, else ``GEOMLIB_IMPL``, else the default: the one the
+    notebook's ``open_lab`` loads, so a notebook grades what its cells run.
 
     Returns
     -------
@@ -466,5 +468,6 @@ def check(
         A list of the report's lines (it prints as the report); ``.score`` and ``.results`` hold
         the numbers.
     """
+    impl = impl or env("GEOMLIB_IMPL")
     data = grade(impl, [lab], feedback_dir=feedback_dir, task=task, part=part, pictures=pictures)
     return Report(data.pop("report"), data)

@@ -27,7 +27,7 @@ __all__ = ["VARIABLES", "GradingSettings", "env", "env_float", "markdown_table"]
 #: Every ``GEOMLIB_*`` environment variable: what it does (one line each; docs/autograder.md lists them).
 VARIABLES: dict[str, str] = {
     "GEOMLIB_ROOT": "the course folder (holding `tests/`, `solutions/`, `labs/`); default: the checkout geomlib is imported from",
-    "GEOMLIB_IMPL": "the implementation a notebook's `open_lab` loads (`solutions`, `labs` or a folder); default: the solutions where present, else `labs`",
+    "GEOMLIB_IMPL": "the implementation a notebook's `open_lab` loads and its `check()` grades (`solutions`, `labs` or a folder); default: the solutions where present, else `labs`",
     "GEOMLIB_TIME_BUDGET": "seconds for a whole grading run (`--time-budget`); later tests fail at once with a message",
     "GEOMLIB_TIME_LIMIT": "seconds allowed per call into the implementation (`--time-limit`); default each test's own (the test suite, run without `--impl`, sets 300: a limit for hangs)",
     "GEOMLIB_NO_FEEDBACK_PICTURES": "set (non-empty): draw no feedback pictures",
