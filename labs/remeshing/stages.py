@@ -134,7 +134,11 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
         N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
         D = c[cand] / np.maximum(deg[cand], 1)[:, None] - V[cand]
         D -= np.einsum("ij,ij->i", D, N)[:, None] * N
-        P = project(V[cand] + D)
+        Q = V[cand] + D
+        P = project(Q)
+        # where the surface bends away within the step (a tip, a ridge) the move would cut it: skip
+        flat = np.einsum("ij,ij->i", P - Q, P - Q) <= 0.0625 * np.einsum("ij,ij->i", D, D)
+        cand, P = cand[flat], P[flat]
         done = K.relocate_pass(*S.args(), cand, np.ascontiguousarray(P))
         total += done
         if not done:
