@@ -69,7 +69,8 @@ def isotropic_remesh(
     relaxation; projection of the vertices back onto the input (feature-line and boundary vertices
     onto the input's lines, the others onto its surface). After the last iteration,
     :func:`~.stages.clean_slivers` flips or collapses away the faces with an angle below 30° where
-    that raises the smallest angle around them.
+    that raises the smallest angle around them, then moves the vertices of faces below 40° toward
+    the centroid of their neighbours (on the surface) where that raises it.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear
@@ -107,4 +108,4 @@ def isotropic_remesh(
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     L, field = _target_field(target_length, len(V0), bool(adaptive), V0, F0, where)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
-    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat; then the given clean_slivers(S)')
+    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat; then the given clean_slivers(S, project=project)')

@@ -82,17 +82,64 @@ def _split_all(S: RemeshState) -> int:
 SLIVER_ANGLE = 30.0
 
 
-def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int = 10) -> int:
+def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int = 10, project=None) -> int:
     """The loop's last step (given): flips and collapses into an end on faces with an angle below
     ``min_angle`` degrees (:func:`.kernels.clean_pass`), until a pass changes nothing; returns the edits.
 
     Where the surface bends faster than the target length resolves, the passes of the loop leave a
     few slivers behind (a flip refused at a ridge, a collapse refused by its length bound); each edit
     here raises the smallest angle around it and moves no vertex off the surface.
+
+    With ``project`` (the loop's :class:`SurfaceProjector` of the input), the free vertices of the
+    faces still below 40° then move to the projection of the centroid of their neighbours, each only
+    where that raises the smallest angle around it (:func:`_relocate`): the last iteration's flips
+    leave their faces unrelaxed, and a few of them are the mesh's smallest angles.
     """
     total = 0
     for _ in range(passes):
         done = K.clean_pass(*S.args(), S.high, np.radians(min_angle))
+        total += done
+        if not done:
+            break
+    if project is not None:
+        total += _relocate(S, project, RELOCATE_ANGLE, passes)
+    return total
+
+
+#: Vertices of faces with a smaller angle (degrees) are moved to improve it (:func:`_relocate`).
+RELOCATE_ANGLE = 40.0
+
+
+def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
+    """Move the free vertices of faces with an angle below ``min_angle`` degrees to the closest
+    point on the surface of the centroid of their neighbours (taken in the tangent plane), each
+    only when that raises the smallest angle around it (:func:`.kernels.relocate_pass`)."""
+    total = 0
+    for _ in range(passes):
+        n = S.cnt[0]
+        Fl = S.faces()
+        V = S.V[:n]
+        bad = Fl[K.faces_min_angle(V, Fl) < np.radians(min_angle)]
+        cand = np.unique(bad)
+        cand = cand[S.cls[cand] == 0]
+        if not len(cand):
+            break
+        E = np.unique(np.sort(Fl[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)  # no new structure
+        deg = np.bincount(E.ravel(), minlength=n)
+        c = np.stack(
+            [np.bincount(E[:, 0], V[E[:, 1], k], n) + np.bincount(E[:, 1], V[E[:, 0], k], n) for k in range(3)], 1
+        )
+        X = np.cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
+        N = np.stack([np.bincount(Fl.ravel(), np.repeat(X[:, k], 3), minlength=n) for k in range(3)], axis=1)[cand]
+        N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
+        D = c[cand] / np.maximum(deg[cand], 1)[:, None] - V[cand]
+        D -= np.einsum("ij,ij->i", D, N)[:, None] * N
+        Q = V[cand] + D
+        P = project(Q)
+        # where the surface bends away within the step (a tip, a ridge) the move would cut it: skip
+        flat = np.einsum("ij,ij->i", P - Q, P - Q) <= 0.0625 * np.einsum("ij,ij->i", D, D)
+        cand, P = cand[flat], P[flat]
+        done = K.relocate_pass(*S.args(), cand, np.ascontiguousarray(P))
         total += done
         if not done:
             break

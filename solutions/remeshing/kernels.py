@@ -673,3 +673,59 @@ def clean_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, min_angle):
                 collapse(V, F, T, VH, val, cls, feat, falive, best_hh, p, hes)
                 done += 1
     return done
+
+
+@njit(cache=True)
+def _ring_min_angle(V, F, T, VH, v, x, y, z, hes):
+    """Smallest angle of the faces around ``v`` with ``v`` at ``(x, y, z)``; -1 when one turns over.
+
+    "Turns over": its normal turns by more than 60° from the face's now (``FLIP_COS``, the flips'
+    rule), or it degenerates.
+    """
+    n = ring(F, T, VH, v, hes)
+    if n < 0:
+        return -1.0
+    worst = np.pi
+    for i in range(n):
+        g = hes[i]
+        a, b = dst(F, g), org(F, pv(g))
+        n0 = normal(V, v, a, b)
+        n1 = normal_at(x, y, z, V, a, b)
+        l0, l1 = np.sqrt(dot(n0, n0)), np.sqrt(dot(n1, n1))
+        if l1 <= 1e-12 * (1.0 + l0) or dot(n0, n1) < FLIP_COS * l0 * l1:
+            return -1.0
+        at_v = corner_angle(x, y, z, V, a, b)
+        ux, uy, uz = V[b, 0] - V[a, 0], V[b, 1] - V[a, 1], V[b, 2] - V[a, 2]
+        wx, wy, wz = x - V[a, 0], y - V[a, 1], z - V[a, 2]
+        cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+        at_a = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
+        worst = min(worst, at_v, at_a, np.pi - at_v - at_a)
+    return worst
+
+
+@njit(cache=True)
+def relocate_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, P):
+    """Move vertex ``cand[i]`` to ``P[i]`` (a point on the surface) when that raises the smallest
+    angle of the faces around it and turns none over; in order, each test on the positions so far.
+    Returns the number of moves."""
+    hes = np.empty(RING, np.int64)
+    done = 0
+    for i in range(len(cand)):
+        v = cand[i]
+        if VH[v] < 0 or cls[v] != 0:
+            continue
+        before = _ring_min_angle(V, F, T, VH, v, V[v, 0], V[v, 1], V[v, 2], hes)
+        after = _ring_min_angle(V, F, T, VH, v, P[i, 0], P[i, 1], P[i, 2], hes)
+        if after > before:
+            V[v, 0], V[v, 1], V[v, 2] = P[i, 0], P[i, 1], P[i, 2]
+            done += 1
+    return done
+
+
+@njit(cache=True)
+def faces_min_angle(V, F):
+    """Smallest angle (radians) of every row of ``F``."""
+    out = np.empty(len(F))
+    for f in range(len(F)):
+        out[f] = face_min_angle(V, F[f, 0], F[f, 1], F[f, 2])
+    return out
