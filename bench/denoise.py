@@ -41,14 +41,13 @@ real meshes in ``../shared/data/meshes``.
 from __future__ import annotations
 
 import argparse
-import time
 from pathlib import Path
 
 import igl
 import numpy as np
 
 from bench.anchors import pyrender_mesh_frame
-from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
+from bench.measure import SHARED, best_of, compare_routes, glsl_route_header, load_average, peak_mib, warm_anchor
 from geomlib import datasets, mesh_io
 from geomlib.textures import rasterize_uv, triangle_atlas
 from solutions.denoise import (
@@ -345,13 +344,8 @@ def glsl_case(name: str, V, F, UV, res: int, bits: int, lam: float, repeat: int)
     X = denoise_with_map(Vn, F, UV, N, img, bias, scale, lam)
     c, r = 0.5 * (X.min(0) + X.max(0)), 0.5 * float(np.linalg.norm(X.max(0) - X.min(0)))
     eye = c + np.array([0.6, -1.0, 0.7]) / np.linalg.norm([0.6, -1.0, 0.7]) * 2.9 * r
-    try:
-        # The anchor's camera has near 0.5, far 10: scale the mesh to a unit radius around the origin.
-        frame = pyrender_mesh_frame((X - c) / r, F, ((eye - c) / r, (0, 0, 0)), 512)
-        frame()  # warm
-    except Exception as err:  # no headless OpenGL for pyrender: the two routes alone
-        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
-        frame = None
+    # The anchor's camera has near 0.5, far 10: scale the mesh to a unit radius around the origin.
+    frame = warm_anchor(lambda: pyrender_mesh_frame((X - c) / r, F, ((eye - c) / r, (0, 0, 0)), 512))
     h = float(np.linalg.norm(Vn[F[:, 1]] - Vn[F[:, 0]], axis=1).mean())
     compare_routes(
         f"{name}, {len(V):,} v, {res}^2 {bits}-bit, lam {lam:g}",
@@ -364,18 +358,11 @@ def glsl_case(name: str, V, F, UV, res: int, bits: int, lam: float, repeat: int)
 
 
 def bench_glsl(names: list[str], quick: bool) -> None:
-    from geomlib import gl
-
     repeat = 1 if quick else 3
-    t = time.perf_counter()
-    info = gl.renderer_info()  # creates the harness's OpenGL context
-    t_ctx = time.perf_counter() - t
-    print(
+    glsl_route_header(
         f"GLSL ROUTE  denoise_with_map vs shaders/denoise.vert vs pyrender drawing the denoised mesh at 512^2, "
-        f"best of {repeat}, interleaved; ratio = route / pyrender frame; {load_average()}"
+        f"best of {repeat}, interleaved; ratio = route / pyrender frame"
     )
-    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
-    print(ROUTE_HEADER)
     glsl_case("figure sphere (32, 64)", *datasets.uv_sphere(32, 64), 256, 16, 1.0, repeat)
     for name in names:
         V, F, UV = load(name)

@@ -30,7 +30,7 @@ import numpy as np
 from igl.embree import line_mesh_intersection
 
 from bench.anchors import pyrender_mesh_frame, pyrender_normal_mapped_mesh
-from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
+from bench.measure import SHARED, best_of, compare_routes, glsl_route_header, load_average, peak_mib, warm_anchor
 from geomlib import camera, datasets
 from geomlib.textures import rasterize_uv, triangle_atlas
 from solutions.maps import (
@@ -213,36 +213,27 @@ def route_shade(name, scene, g, lights, opts, size: int, repeat: int) -> None:
     from solutions.maps.figures import ALBEDO
 
     V, F, UV, N, tangents, nmap, eye, view = scene
-    try:
+
+    def make():
         renderer, pscene = pyrender_frame(V, F, UV, N, tangents, nmap, view, size)
-        renderer.render(pscene)  # warm: context, shader compilation, texture upload
-    except Exception as err:  # no headless OpenGL for pyrender: the two routes alone
-        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
-        renderer = None
+        return lambda: renderer.render(pscene)  # the renderer is deleted with this call (pyrender's __del__)
+
     compare_routes(
         f"shade: {name}",
         lambda: shade(g, lights, eye, ALBEDO, nmap, **opts),
         lambda: glsl_shade(g, lights, eye, ALBEDO, nmap, **opts),
-        None if renderer is None else lambda: renderer.render(pscene),
+        warm_anchor(make),
         repeat,
         lambda a, b: f"max {np.abs(a - b).max():.2g} per channel",
     )
-    if renderer is not None:
-        renderer.delete()
 
 
 def route_displace(name, V, F, UV, H, kw: dict, eye, size: int, repeat: int) -> None:
-    try:
-        frame = pyrender_mesh_frame(displace(V, F, UV, None, H, **kw), F, (eye, (0, 0, 0)), size)
-        frame()  # warm
-    except Exception as err:
-        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
-        frame = None
     compare_routes(
         f"{name}, {len(V):,} v",
         lambda: displace(V, F, UV, None, H, **kw),
         lambda: glsl_displace(V, F, UV, None, H, **kw),
-        frame,
+        warm_anchor(lambda: pyrender_mesh_frame(displace(V, F, UV, None, H, **kw), F, (eye, (0, 0, 0)), size)),
         repeat,
         lambda a, b: f"max {np.linalg.norm(a - b, axis=1).max() / kw['lam']:.2g} x lam",
     )
@@ -252,19 +243,12 @@ def bench_glsl(repeat: int) -> None:
     """512 x 512 frames of the lab's scenes three ways: the NumPy route, the lab's shaders (``glsl_shade``:
     G-buffer upload, draw of ``normalmap.frag``, read-back; ``glsl_displace``/``glsl_tbn``: the vertices drawn
     as points through ``displace.vert``/``tbn.vert``, read back) and pyrender (OSMesa here), in one run."""
-    from geomlib import gl
     from solutions.maps.figures import KEY_LIGHTS, bump_tiles, smooth_noise
 
     size = 512
-    t = time.perf_counter()
-    info = gl.renderer_info()  # creates the harness's OpenGL context
-    t_ctx = time.perf_counter() - t
-    print(
-        f"GLSL route (issue 27): {size}x{size}, best of {repeat} warm calls, interleaved; "
-        f"ratio = route / pyrender frame; {load_average()}"
+    glsl_route_header(
+        f"GLSL route (issue 27): {size}x{size}, best of {repeat} warm calls, interleaved; ratio = route / pyrender frame"
     )
-    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
-    print(ROUTE_HEADER)
 
     # normalmap.frag on two normal-mapped tori: this bench's bumpy one and the lab's figure's (maps_glsl)
     V, F, UV, N, tangents, nmap, eye, view, M = torus_scene(size, 512)

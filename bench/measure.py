@@ -74,6 +74,32 @@ def interleaved(fns: dict, repeat: int) -> dict[str, Timing]:
     return {name: Timing(min(w), min(c), out) for name, (w, c, out) in runs.items()}
 
 
+def warm_anchor(make):
+    """The anchor's frame call ``make()`` returns, called once to warm it (context, shader compilation,
+    upload); ``None``, with the reason printed, where pyrender has no headless OpenGL (the two routes
+    are then timed alone)."""
+    try:
+        frame = make()
+        frame()
+        return frame
+    except Exception as err:  # noqa: BLE001 - any failure to draw means no anchor, said in the table
+        print(f"  (pyrender unavailable: {type(err).__name__}: {err})")
+        return None
+
+
+def glsl_route_header(title: str) -> None:
+    """Start a GLSL benchmark's table: make geomlib.gl's OpenGL context (timed), print ``title`` with the
+    load average, the context line and :data:`ROUTE_HEADER`."""
+    from geomlib import gl
+
+    t = time.perf_counter()
+    info = gl.renderer_info()  # creates the harness's OpenGL context
+    t_ctx = time.perf_counter() - t
+    print(f"{title}; {load_average()}")
+    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
+    print(ROUTE_HEADER)
+
+
 #: Column heads of :func:`route_row`.
 ROUTE_HEADER = (
     f"  {'scene':<48} {'NumPy s (cpu)':>16} {'GLSL s (cpu)':>16} {'pyrender s':>10} {'NumPy/pyr':>9} "

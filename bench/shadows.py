@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bench.measure import ROUTE_HEADER, SHARED, best_of, compare_routes, load_average, peak_mib
+from bench.measure import SHARED, best_of, compare_routes, glsl_route_header, load_average, peak_mib
 from geomlib.mesh_io import read_mesh
 from solutions.shadows import (
     CLASSIC_CAMERA,
@@ -197,18 +197,12 @@ def glsl_scene(name, scene, camera, light, point_light, frame: int, repeat: int)
 
 
 def bench_glsl(scenes, frame: int, repeat: int) -> None:
-    from geomlib import gl
     from solutions.shadows.figures import POINT_LIGHT
 
-    t = time.perf_counter()
-    info = gl.renderer_info()  # creates the harness's OpenGL context
-    t_ctx = time.perf_counter() - t
-    print(
+    glsl_route_header(
         f"\nGLSL route (issue 27): one {frame}x{frame} frame, best of {repeat} warm calls, interleaved; "
-        f"ratio = route / pyrender frame; {load_average()}"
+        f"ratio = route / pyrender frame"
     )
-    print(f"  geomlib.gl on {info['platform'] or 'default'} ({info['renderer']}): context {t_ctx:.3f} s")
-    print(ROUTE_HEADER)
     for name, scene, camera, light in scenes:
         glsl_scene(name, scene, camera, light, POINT_LIGHT, frame, repeat)
     print(
