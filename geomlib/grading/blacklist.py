@@ -272,21 +272,21 @@ class _Guards:
                 pass
             new.append(id(raw))
         if new:
-            for name, mod in list(sys.modules.items()):
-                if self._may_refer(name, mod, new):
-                    self.patch_module(mod)
+            for mod in self._may_refer(new):
+                self.patch_module(mod)
         elif module is not None and self.guard_of:
             self.patch_module(module)
 
-    def _may_refer(self, name: str, mod, new: list[int]) -> bool:
-        """False when the zygote's index shows that module ``name`` references none of the functions
-        ``new`` (ids) and none of the functions guarded before (their references are patched)."""
-        if self.index is None:
-            return True
+    def _may_refer(self, new: list[int]) -> list:
+        """The loaded modules that may reference a function of ``new`` (ids): every module, unless the
+        zygote's index saw every guarded function; then the modules it lists for ``new`` and those
+        loaded or replaced after the fork (the references to functions guarded before are patched)."""
+        modules = list(sys.modules.items())
+        if self.index is None or any(i not in self.index[1] for i in self.guard_of):
+            return [mod for _, mod in modules]  # no index, or a function the zygote did not see
         loaded, where, _ = self.index
-        if loaded.get(name) != id(mod) or any(i not in where for i in self.guard_of):
-            return True  # loaded or replaced after the fork, or a function the zygote did not see
-        return any(name in where[i] for i in new)
+        listed = set().union(*(where[i] for i in new))
+        return [mod for name, mod in modules if loaded.get(name) != id(mod) or name in listed]
 
     def patch_module(self, mod) -> None:
         try:
