@@ -282,6 +282,18 @@ def corner_angle(ax, ay, az, V, j, k):
 
 
 @njit(cache=True)
+def min_angle_at(x, y, z, V, j, k):
+    """Smallest angle (radians) of the triangle ``(q, V[j], V[k])`` for the point ``q = (x, y, z)``
+    (a vertex's trial position: :func:`_min_angle_moved`, :func:`_ring_min_angle`)."""
+    aq = corner_angle(x, y, z, V, j, k)
+    ux, uy, uz = V[k, 0] - V[j, 0], V[k, 1] - V[j, 1], V[k, 2] - V[j, 2]
+    wx, wy, wz = x - V[j, 0], y - V[j, 1], z - V[j, 2]
+    cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
+    aj = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
+    return min(aq, aj, np.pi - aq - aj)
+
+
+@njit(cache=True)
 def face_min_angle(V, i, j, k):
     """Smallest angle (radians) of triangle ``(V[i], V[j], V[k])``."""
     a = corner_angle(V[i, 0], V[i, 1], V[i, 2], V, j, k)
@@ -302,13 +314,7 @@ def _min_angle_moved(V, F, T, VH, a, b, p, hes):
             x, y = dst(F, g), org(F, pv(g))
             if x == a or x == b or y == a or y == b:
                 continue
-            # angles of (p, x, y): at p, at x, at y
-            ap = corner_angle(p[0], p[1], p[2], V, x, y)
-            ux, uy, uz = V[y, 0] - V[x, 0], V[y, 1] - V[x, 1], V[y, 2] - V[x, 2]
-            wx, wy, wz = p[0] - V[x, 0], p[1] - V[x, 1], p[2] - V[x, 2]
-            cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-            ax = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
-            worst = min(worst, ap, ax, np.pi - ap - ax)
+            worst = min(worst, min_angle_at(p[0], p[1], p[2], V, x, y))
     return worst
 
 
@@ -425,12 +431,7 @@ def _ring_min_angle(V, F, T, VH, v, x, y, z, hes):
         l0, l1 = np.sqrt(dot(n0, n0)), np.sqrt(dot(n1, n1))
         if l1 <= 1e-12 * (1.0 + l0) or dot(n0, n1) < FLIP_COS * l0 * l1:
             return -1.0
-        at_v = corner_angle(x, y, z, V, a, b)
-        ux, uy, uz = V[b, 0] - V[a, 0], V[b, 1] - V[a, 1], V[b, 2] - V[a, 2]
-        wx, wy, wz = x - V[a, 0], y - V[a, 1], z - V[a, 2]
-        cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-        at_a = np.arctan2(np.sqrt(cx * cx + cy * cy + cz * cz), ux * wx + uy * wy + uz * wz)
-        worst = min(worst, at_v, at_a, np.pi - at_v - at_a)
+        worst = min(worst, min_angle_at(x, y, z, V, a, b))
     return worst
 
 
