@@ -9,7 +9,11 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
+
+import pytest
 
 SAMPLE = Path(__file__).parent / "sample_course"
 
@@ -179,3 +183,51 @@ def appended(module: str, source: str, who: str):
             f.write(f"\n\n# planted error ({who})\n" + textwrap.dedent(source))
 
     return edit
+
+
+def replace_once(path: Path, old: str, new: str) -> None:
+    """Replace the one occurrence of ``old`` in the file ``path`` by ``new`` (a planted error); fails
+    when ``old`` is not there exactly once, so a planted edit cannot silently miss after the file changed."""
+    text = path.read_text()
+    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
+    path.write_text(text.replace(old, new))
+
+
+def shader_edit(shader: str, old: str, new: str):
+    """An ``edit`` for :func:`planted_solution`: :func:`replace_once` in the lab's ``shaders/<shader>``."""
+    return lambda dest: replace_once(dest / "shaders" / shader, old, new)
+
+
+def misspelt(shader: str, needle: str, name: str):
+    """An ``edit`` that misspells the first ``name`` of the line ``needle`` in ``shaders/<shader>``
+    (``name_misspelt``: an undeclared identifier, so the shader does not compile)."""
+    return shader_edit(shader, needle, needle.replace(name, name + "_misspelt", 1))
+
+
+def shader_line(lab: str, shader: str, text: str) -> int:
+    """The 1-based line of the solution's ``shaders/<shader>`` in ``lab`` that contains ``text``."""
+    from geomlib.grading import impl as _impl
+
+    lines = (_impl.course_root() / "solutions" / lab / "shaders" / shader).read_text().splitlines()
+    return next(i for i, ln in enumerate(lines, start=1) if text in ln)
+
+
+@contextmanager
+def planted_lab(lab: str, edit, timeout: float | None = None) -> Iterator:
+    """A sandboxed :class:`~geomlib.grading.sandbox.LabProxy` on a :func:`planted_solution` of ``lab``
+    changed by ``edit``; the copy is removed on leaving."""
+    from geomlib.grading.sandbox import LabProxy
+
+    dest = planted_solution(lab, edit)
+    try:
+        yield LabProxy(lab, dest, timeout=timeout)
+    finally:
+        shutil.rmtree(dest.parent, ignore_errors=True)
+
+
+def failure_of(lab: str, edit, run: Callable, error: type[Exception], timeout: float | None = None) -> str:
+    """The message of the ``error`` that ``run(proxy)`` raises on a planted copy of ``lab`` changed by
+    ``edit`` (the test fails when it raises nothing)."""
+    with planted_lab(lab, edit, timeout) as proxy, pytest.raises(error) as e:
+        run(proxy)
+    return str(e.value)

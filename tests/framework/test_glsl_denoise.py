@@ -5,7 +5,6 @@ check with the stage named; a hang is named with its task; the stub is the solut
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import pytest
@@ -13,40 +12,24 @@ import pytest
 from geomlib.grading import shader_watch
 from geomlib.grading.cases import load_cases
 from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.sandbox import LabProxy
 from geomlib.grading.stubs import make_stub
 
-from .course import planted_solution
+from .course import failure_of, misspelt, shader_edit, shader_line
 
 COURSE = Path(__file__).resolve().parents[2]
 SHADER = "denoise.vert"
 
 
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
-def _planted(old: str, new: str) -> Path:
-    return planted_solution("denoise", lambda dest: _replace(dest / "shaders" / SHADER, old, new))
-
-
 def test_a_compile_error_names_the_shader_its_line_and_task():
     needle = "return p - lam * s * n;"
-    line = next(
-        i
-        for i, ln in enumerate((COURSE / "solutions/denoise/shaders" / SHADER).read_text().splitlines(), 1)
-        if needle in ln
-    )
-    dest = _planted(needle, needle.replace("lam", "lam_misspelt"))
     case = next(c for c in load_cases("denoise") if c.id == "map-uv-sphere-8bit")
-    try:
-        with pytest.raises(GradingFailure) as e:
-            LabProxy("denoise", dest).call("glsl_denoise_with_map", **case.inputs(), **case.params)
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    first = str(e.value).splitlines()[0]
+    msg = failure_of(
+        "denoise",
+        misspelt(SHADER, needle, "lam"),
+        lambda lab: lab.call("glsl_denoise_with_map", **case.inputs(), **case.params),
+        GradingFailure,
+    )
+    first, line = msg.splitlines()[0], shader_line("denoise", SHADER, needle)
     m = re.match(
         r"glsl_denoise_with_map: shaders/denoise\.vert \(Task 7: vertex denoising\) \(vertex shader\) "
         r"did not compile, line (\d+)",
@@ -66,13 +49,9 @@ def test_a_compile_error_names_the_shader_its_line_and_task():
 def test_nan_and_reads_outside_the_map_fail_the_shader_s_own_check(old, new, needle):
     from tests.graded.denoise.test_denoise import check_glsl_denoise
 
-    dest = _planted(old, new)
-    try:
-        with pytest.raises(Mismatch) as e:
-            check_glsl_denoise(LabProxy("denoise", dest), "map-uv-sphere-8bit")
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    msg = str(e.value)
+    msg = failure_of(
+        "denoise", shader_edit(SHADER, old, new), lambda lab: check_glsl_denoise(lab, "map-uv-sphere-8bit"), Mismatch
+    )
     assert "shaders/denoise.vert, the vertex stage" in msg and needle in msg, msg
 
 

@@ -6,7 +6,6 @@ their task is written and fail only their own tests."""
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import pytest
@@ -14,34 +13,12 @@ import pytest
 from geomlib.grading import shader_watch
 from geomlib.grading.cases import load_cases
 from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.sandbox import LabProxy
 from geomlib.grading.stubs import make_stub
 
-from .course import planted_solution
+from .course import failure_of, misspelt, shader_edit, shader_line
 
 COURSE = Path(__file__).resolve().parents[2]
 CASE = {c.id: c for c in load_cases("maps")}
-
-
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
-def _line_of(path: Path, text: str) -> int:
-    return next(i for i, ln in enumerate(path.read_text().splitlines(), start=1) if text in ln)
-
-
-def _call(edit, function: str, **kwargs):
-    """``function(**kwargs)`` on a copy of the maps solution changed by ``edit(folder)``; the GradingFailure."""
-    dest = planted_solution("maps", edit)
-    try:
-        with pytest.raises(GradingFailure) as e:
-            LabProxy("maps", dest).call(function, **kwargs)
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    return str(e.value)
 
 
 def _shade_inputs():
@@ -76,13 +53,9 @@ def _tbn_inputs():
     ],
 )
 def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, task):
-    path = COURSE / "solutions" / "maps" / "shaders" / shader
-    line = _line_of(path, needle)
-
-    def misspelt(dest: Path) -> None:  # an undeclared name: the driver names this very line
-        _replace(dest / "shaders" / shader, needle, needle.replace(typo, typo + "_misspelt", 1))
-
-    first = _call(misspelt, function, **inputs()).splitlines()[0]
+    line = shader_line("maps", shader, needle)
+    msg = failure_of("maps", misspelt(shader, needle, typo), lambda lab: lab.call(function, **inputs()), GradingFailure)
+    first = msg.splitlines()[0]  # an undeclared name: the driver names this very line
     head = rf"{function}: shaders/{re.escape(shader)} \({task}[^)]*\)( \(vertex shader\))? did not compile, line (\d+)"
     m = re.match(head, first)
     assert m, first
@@ -94,57 +67,36 @@ def _fail_of(edit, check: str, case_id: str) -> str:
     """The Mismatch message of the graded check ``check`` (test_maps) on a planted copy."""
     from tests.graded.maps import test_maps
 
-    dest = planted_solution("maps", edit)
-    try:
-        with pytest.raises(Mismatch) as e:
-            getattr(test_maps, check)(LabProxy("maps", dest), case_id)
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    return str(e.value)
+    return failure_of("maps", edit, lambda lab: getattr(test_maps, check)(lab, case_id), Mismatch)
 
 
 def test_nan_from_the_vertex_stage_is_named():
-    def nan(dest: Path) -> None:
-        _replace(
-            dest / "shaders" / "displace.vert", "return P + lam * d * n;", "return P + lam * d * n * sqrt(d - 9.0);"
-        )
-
+    nan = shader_edit("displace.vert", "return P + lam * d * n;", "return P + lam * d * n * sqrt(d - 9.0);")
     msg = _fail_of(nan, "check_glsl_displace", "displace-grid-wave")
     assert "shaders/displace.vert, the vertex stage" in msg and "NaN" in msg, msg
 
 
 def test_nan_from_the_fragment_stage_is_named():
-    def nan(dest: Path) -> None:
-        old = "return colour * (ambient + diffuse) + specular * spec;"
-        _replace(dest / "shaders" / "normalmap.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));")
-
+    old = "return colour * (ambient + diffuse) + specular * spec;"
+    nan = shader_edit("normalmap.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));")
     msg = _fail_of(nan, "check_glsl_shade", "shade-quad-plain")
     assert "shaders/normalmap.frag, the fragment stage" in msg and "NaN" in msg, msg
 
 
 def test_reads_outside_the_texture_fail_the_shader_s_own_check():
-    def outside(dest: Path) -> None:  # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
-        _replace(
-            dest / "shaders" / "displace.vert", "        x = clamp(x, 0, size.x - 1);\n", "        x = x + size.x;\n"
-        )
-
+    # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
+    outside = shader_edit("displace.vert", "        x = clamp(x, 0, size.x - 1);\n", "        x = x + size.x;\n")
     msg = _fail_of(outside, "check_glsl_displace", "displace-grid-wave")
     assert "shaders/displace.vert, the vertex stage" in msg and "differ by more than 1e-05" in msg, msg
 
 
 def test_a_wrong_stage_is_named_by_its_shader():
-    def wrong_normal(dest: Path) -> None:  # the model matrix instead of its inverse transpose
-        _replace(dest / "shaders" / "tbn.vert", "N = normalize(transpose(inverse(m)) * n);", "N = normalize(m * n);")
-
     from tests.graded.maps import test_maps
 
-    dest = planted_solution("maps", wrong_normal)
-    try:
-        with pytest.raises(Mismatch) as e:
-            test_maps.test_glsl_tbn_by_hand(LabProxy("maps", dest))
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    assert "shaders/tbn.vert, the vertex stage" in str(e.value) and ", N" in str(e.value), str(e.value)
+    # the model matrix instead of its inverse transpose
+    wrong_normal = shader_edit("tbn.vert", "N = normalize(transpose(inverse(m)) * n);", "N = normalize(m * n);")
+    msg = failure_of("maps", wrong_normal, test_maps.test_glsl_tbn_by_hand, Mismatch)
+    assert "shaders/tbn.vert, the vertex stage" in msg and ", N" in msg, msg
 
 
 @pytest.mark.parametrize("shader", ["tbn.vert", "normalmap.frag", "displace.vert"])

@@ -7,7 +7,6 @@ costs only its own task's tests; a hang is named with its task; the stubs are th
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -15,29 +14,14 @@ import pytest
 
 from geomlib.grading import shader_watch
 from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.sandbox import LabProxy
 from geomlib.grading.stubs import make_stub
 from tests.graded.shadows.support import ortho_light, small_scene
 
-from .course import planted_solution
+from .course import failure_of, misspelt, planted_lab, shader_edit, shader_line
 
 COURSE = Path(__file__).resolve().parents[2]
 SHADERS = COURSE / "solutions" / "shadows" / "shaders"
 TASK = {"depth.vert": 9, "depth.frag": 9, "shadow.frag": 10}
-
-
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
-def _edit(shader: str, old: str, new: str):
-    return lambda dest: _replace(dest / "shaders" / shader, old, new)
-
-
-def _line_of(shader: str, text: str) -> int:
-    return next(i for i, ln in enumerate((SHADERS / shader).read_text().splitlines(), start=1) if text in ln)
 
 
 def _depth_inputs():
@@ -62,14 +46,10 @@ def _shadow_inputs():
     ],
 )  # fmt: skip
 def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, stage):
-    line = _line_of(shader, needle)
-    dest = planted_solution("shadows", _edit(shader, needle, needle.replace(typo, typo + "_misspelt", 1)))
-    try:
-        with pytest.raises(GradingFailure) as e:
-            LabProxy("shadows", dest, timeout=180).call(function, **inputs())
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    first = str(e.value).splitlines()[0]
+    line = shader_line("shadows", shader, needle)
+    edit = misspelt(shader, needle, typo)
+    msg = failure_of("shadows", edit, lambda lab: lab.call(function, **inputs()), GradingFailure, timeout=180)
+    first = msg.splitlines()[0]
     m = re.match(
         rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage} did not compile, line (\d+)",
         first,
@@ -83,18 +63,12 @@ def _fail_of(edit, check: str, *args) -> str:
     """The Mismatch message of the graded check ``check`` (test_shadows_glsl) on a planted copy."""
     from tests.graded.shadows import test_shadows_glsl
 
-    dest = planted_solution("shadows", edit)
-    try:
-        with pytest.raises(Mismatch) as e:
-            getattr(test_shadows_glsl, check)(LabProxy("shadows", dest, timeout=180), *args)
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    return str(e.value)
+    return failure_of("shadows", edit, lambda lab: getattr(test_shadows_glsl, check)(lab, *args), Mismatch, timeout=180)
 
 
 def test_nan_from_the_shadow_pass_is_named():
     old = "return lit / float(pcf * pcf);"
-    msg = _fail_of(_edit("shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));"), "check_glsl_shadow",
+    msg = _fail_of(shader_edit("shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));"), "check_glsl_shadow",
                    "glsl-eye-spot-pcf3")  # fmt: skip
     assert "shaders/shadow.frag, the shadow pass's fragment stage" in msg and "NaN" in msg, msg
 
@@ -102,39 +76,34 @@ def test_nan_from_the_shadow_pass_is_named():
 def test_nan_from_the_depth_pass_is_named():
     old = "result = vec4(gl_FragCoord.z, 1.0, 0.0, 1.0);"
     new = "result = vec4(sqrt(-1.0 - gl_FragCoord.z), 1.0, 0.0, 1.0);"
-    msg = _fail_of(_edit("depth.frag", old, new), "check_glsl_depth", "depth-ortho-64")
+    msg = _fail_of(shader_edit("depth.frag", old, new), "check_glsl_depth", "depth-ortho-64")
     assert "the depth pass from the light" in msg and "NaN" in msg and "depth.frag" in msg, msg
 
 
 def test_reads_outside_the_map_fail_the_shader_s_own_check():
-    def outside(dest: Path) -> None:  # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
-        _replace(
-            dest / "shaders" / "shadow.frag",
-            "    col = clamp(col, 0, size - 1);\n    row = clamp(row, 0, size - 1);\n",
-            "",
-        )
-
+    # no clamp: texelFetch outside the map (undefined, 0 on llvmpipe)
+    outside = shader_edit("shadow.frag", "    col = clamp(col, 0, size - 1);\n    row = clamp(row, 0, size - 1);\n", "")
     msg = _fail_of(outside, "check_glsl_shadow", "hidden-glsl-eye-partial-nofix")
     assert "shaders/shadow.frag, the shadow pass's fragment stage" in msg and "differ by more than 1e-06" in msg, msg
 
 
 def test_a_wrong_vertex_stage_is_named():
     old = "gl_Position = lightSpaceMatrix * vec4(position, 1.0);"
-    msg = _fail_of(_edit("depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
+    msg = _fail_of(shader_edit("depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
                    "check_glsl_depth", "depth-ortho-64")  # fmt: skip
     assert "the vertex stage (depth.vert" in msg and "covered in one map and empty" in msg, msg
 
 
 def test_a_wrong_fragment_stage_is_named():
     old = "result = vec4(gl_FragCoord.z, 1.0, 0.0, 1.0);"
-    msg = _fail_of(_edit("depth.frag", old, "result = vec4(2.0 * gl_FragCoord.z - 1.0, 1.0, 0.0, 1.0);"),
+    msg = _fail_of(shader_edit("depth.frag", old, "result = vec4(2.0 * gl_FragCoord.z - 1.0, 1.0, 0.0, 1.0);"),
                    "check_glsl_depth", "depth-ortho-64")  # fmt: skip
     assert "the fragment stage (depth.frag) must write the window depth" in msg, msg
 
 
 def test_missing_culling_is_caught():
     old = "if ((cull == 1 && gl_FrontFacing) || (cull == 2 && !gl_FrontFacing)) {"
-    msg = _fail_of(_edit("depth.frag", old, "if (false) {"), "check_glsl_depth", "depth-front-culled")
+    msg = _fail_of(shader_edit("depth.frag", old, "if (false) {"), "check_glsl_depth", "depth-front-culled")
     assert 'cull="front"' in msg and "depth.frag" in msg, msg
 
 
@@ -142,14 +111,12 @@ def test_a_broken_shadow_shader_costs_only_its_own_tests():
     """shadow.frag that does not compile: the light pass's check still passes on the same copy."""
     from tests.graded.shadows import test_shadows_glsl
 
-    dest = planted_solution("shadows", _edit("shadow.frag", "behind = c.w <= 0.0;", "behind = c.w <= 0.0"))
-    try:
-        lab = LabProxy("shadows", dest, timeout=180)
+    with planted_lab(
+        "shadows", shader_edit("shadow.frag", "behind = c.w <= 0.0;", "behind = c.w <= 0.0"), timeout=180
+    ) as lab:
         test_shadows_glsl.check_glsl_depth(lab, "depth-ortho-64")
         with pytest.raises(GradingFailure, match=r"shaders/shadow.frag \(Task 10"):
             test_shadows_glsl.check_glsl_shadow(lab, "glsl-eye-ortho-defaults")
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
 
 
 @pytest.mark.parametrize("shader", ["depth.frag", "shadow.frag"])

@@ -6,7 +6,6 @@ task's tests; a hang is named with its task; the stubs are the solutions with ``
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -14,12 +13,10 @@ import pytest
 
 from geomlib.grading import shader_watch
 from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.sandbox import LabProxy
 from geomlib.grading.stubs import make_stub
 from tests.graded.shadows.support import small_scene
 
-from .course import planted_solution
-from .test_glsl_shadows import _edit, _line_of  # the same shaders folder: one set of edit helpers
+from .course import failure_of, misspelt, planted_lab, shader_edit, shader_line
 
 COURSE = Path(__file__).resolve().parents[2]
 SHADERS = COURSE / "solutions" / "shadows" / "shaders"
@@ -49,14 +46,10 @@ def _shadow_inputs():
     ],
 )  # fmt: skip
 def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, stage):
-    line = _line_of(shader, needle)
-    dest = planted_solution("shadows", _edit(shader, needle, needle.replace(typo, typo + "_misspelt", 1)))
-    try:
-        with pytest.raises(GradingFailure) as e:
-            LabProxy("shadows", dest, timeout=180).call(function, **inputs())
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    first = str(e.value).splitlines()[0]
+    line = shader_line("shadows", shader, needle)
+    edit = misspelt(shader, needle, typo)
+    msg = failure_of("shadows", edit, lambda lab: lab.call(function, **inputs()), GradingFailure, timeout=180)
+    first = msg.splitlines()[0]
     m = re.match(
         rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage} did not compile, line (\d+)",
         first,
@@ -70,32 +63,28 @@ def _fail_of(edit, check: str, *args) -> str:
     """The Mismatch message of the graded check ``check`` (test_shadows_cube_glsl) on a planted copy."""
     from tests.graded.shadows import test_shadows_cube_glsl
 
-    dest = planted_solution("shadows", edit)
-    try:
-        with pytest.raises(Mismatch) as e:
-            getattr(test_shadows_cube_glsl, check)(LabProxy("shadows", dest, timeout=180), *args)
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
-    return str(e.value)
+    return failure_of(
+        "shadows", edit, lambda lab: getattr(test_shadows_cube_glsl, check)(lab, *args), Mismatch, timeout=180
+    )
 
 
 def test_nan_from_the_cube_lookup_is_named():
     old = "return lit / float(pcf * pcf);"
-    msg = _fail_of(_edit("cube_shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));"), "check_glsl_cube_shadow",
-                   "glsl-cube-eye-pcf3")  # fmt: skip
+    nan = shader_edit("cube_shadow.frag", old, old[:-1] + " + sqrt(-1.0 - dot(P, P));")
+    msg = _fail_of(nan, "check_glsl_cube_shadow", "glsl-cube-eye-pcf3")
     assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "NaN" in msg, msg
 
 
 def test_nan_from_the_cube_pass_is_named():
     old = "result = vec4(length(world - lightPos) / far, 1.0, 0.0, 1.0);"
     new = "result = vec4(sqrt(-1.0 - length(world)), 1.0, 0.0, 1.0);"
-    msg = _fail_of(_edit("cube_depth.frag", old, new), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")
+    msg = _fail_of(shader_edit("cube_depth.frag", old, new), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")
     assert "the cube pass from the light" in msg and "NaN" in msg and "cube_depth.frag" in msg, msg
 
 
 def test_a_wrong_vertex_stage_is_named():
     old = "gl_Position = lightSpaceMatrix * vec4(position, 1.0);"
-    msg = _fail_of(_edit("cube_depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
+    msg = _fail_of(shader_edit("cube_depth.vert", old, "gl_Position = vec4(position, 1.0) * lightSpaceMatrix;"),
                    "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
     assert "the vertex stage (cube_depth.vert" in msg and "covered in one map and empty" in msg, msg
 
@@ -108,13 +97,13 @@ def test_a_wrong_vertex_stage_is_named():
 def test_a_wrong_fragment_stage_is_named(wrong):
     """Window depth instead of linear depth, the distance not divided by far, the distance to the origin."""
     old = "result = vec4(length(world - lightPos) / far, 1.0, 0.0, 1.0);"
-    msg = _fail_of(_edit("cube_depth.frag", old, f"result = vec4({wrong}, 1.0, 0.0, 1.0);"),
+    msg = _fail_of(shader_edit("cube_depth.frag", old, f"result = vec4({wrong}, 1.0, 0.0, 1.0);"),
                    "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
     assert "the fragment stage (cube_depth.frag) must write the linear depth" in msg, msg
 
 
 def test_a_wrong_world_position_from_the_vertex_stage_is_caught():
-    msg = _fail_of(_edit("cube_depth.vert", "world = position;", "world = gl_Position.xyz;"),
+    msg = _fail_of(shader_edit("cube_depth.vert", "world = position;", "world = gl_Position.xyz;"),
                    "check_glsl_cube_depth", "glsl-cube-linear-a-64-front")  # fmt: skip
     assert "cube_depth.frag) must write the linear depth" in msg and "`world`" in msg, msg
 
@@ -122,7 +111,7 @@ def test_a_wrong_world_position_from_the_vertex_stage_is_caught():
 def test_missing_culling_is_caught():
     old = "if ((cull == 1 && gl_FrontFacing) || (cull == 2 && !gl_FrontFacing)) {"
     msg = _fail_of(
-        _edit("cube_depth.frag", old, "if (false) {"), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front"
+        shader_edit("cube_depth.frag", old, "if (false) {"), "check_glsl_cube_depth", "glsl-cube-linear-a-64-front"
     )
     assert 'cull="front"' in msg and "cube_depth.frag" in msg, msg
 
@@ -140,7 +129,7 @@ def test_missing_culling_is_caught():
     ids=["mirrored-face", "flipped-face", "no-row-flip", "no-sign", "no-far-fix"],
 )  # fmt: skip
 def test_a_wrong_lookup_is_caught(old, new, case):
-    msg = _fail_of(_edit("cube_shadow.frag", old, new), "check_glsl_cube_shadow", case)
+    msg = _fail_of(shader_edit("cube_shadow.frag", old, new), "check_glsl_cube_shadow", case)
     assert "shaders/cube_shadow.frag, the cube lookup's fragment stage" in msg and "points differ" in msg, msg
 
 
@@ -190,7 +179,7 @@ def test_a_wrong_face_entry_is_caught_by_the_public_room_case(face, wrong):
 @pytest.mark.parametrize("old", ["if (ad.y > ad[a]) {", "if (ad.z > ad[a]) {"], ids=["x-y-tie-to-y", "z-tie-to-z"])
 def test_the_later_axis_on_a_face_tie_is_caught(old):
     """`>` turned `>=` in cube_face (the audit's mutants): points exactly on a cube edge read the later axis's face."""
-    msg = _fail_of(_edit("cube_shadow.frag", old, old.replace(">", ">=")), "check_glsl_cube_shadow",
+    msg = _fail_of(shader_edit("cube_shadow.frag", old, old.replace(">", ">=")), "check_glsl_cube_shadow",
                    "glsl-cube-ties-defaults")  # fmt: skip
     assert "exactly between two faces" in msg and "points differ" in msg, msg
 
@@ -200,7 +189,7 @@ def test_wrong_back_culling_is_caught_inside_the_room(code):
     """The audit's survivors `cull == 2` -> `cull == 4` / `cull == 0`: back culling dropped (the small scene's
     closed meshes show the same nearest faces either way); from inside the room the walls are back faces."""
     old = "(cull == 2 && !gl_FrontFacing)"
-    msg = _fail_of(_edit("cube_depth.frag", old, old.replace("2", code)), "check_glsl_cube_depth",
+    msg = _fail_of(shader_edit("cube_depth.frag", old, old.replace("2", code)), "check_glsl_cube_depth",
                    "glsl-cube-linear-room-48-back")  # fmt: skip
     assert 'cull="back"' in msg and "cube_depth.frag culls the wrong faces" in msg, msg
 
@@ -209,15 +198,11 @@ def test_a_broken_cube_lookup_costs_only_its_own_tests():
     """cube_shadow.frag that does not compile: the cube pass's check, and Task 10's, still pass on the same copy."""
     from tests.graded.shadows import test_shadows_cube_glsl, test_shadows_glsl
 
-    dest = planted_solution("shadows", _edit("cube_shadow.frag", "ma = ad[a];", "ma = ad[a]"))
-    try:
-        lab = LabProxy("shadows", dest, timeout=180)
+    with planted_lab("shadows", shader_edit("cube_shadow.frag", "ma = ad[a];", "ma = ad[a]"), timeout=180) as lab:
         test_shadows_cube_glsl.check_glsl_cube_depth(lab, "glsl-cube-linear-b-48-none")
         test_shadows_glsl.check_glsl_shadow(lab, "glsl-eye-ortho-defaults")
         with pytest.raises(GradingFailure, match=r"shaders/cube_shadow.frag \(Task 12"):
             test_shadows_cube_glsl.check_glsl_cube_shadow(lab, "glsl-cube-eye-defaults")
-    finally:
-        shutil.rmtree(dest.parent, ignore_errors=True)
 
 
 @pytest.mark.parametrize("shader", ["cube_depth.frag", "cube_shadow.frag"])

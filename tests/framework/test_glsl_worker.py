@@ -21,7 +21,7 @@ from geomlib.grading import sandbox
 from geomlib.grading.errors import GradingFailure, StudentTimeout
 from geomlib.grading.sandbox import LabProxy
 
-from .course import planted_solution
+from .course import planted_solution, replace_once
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")
 
@@ -58,12 +58,6 @@ def test_a_glsl_worker_inherits_pyopengl_and_never_imports_pyrender():
     assert pyrender == 0.0, "geomlib.gl imported pyrender (about 2 s of CPU in every GLSL call)"
 
 
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
 def _hanging_shadow_shader(dest: Path) -> None:
     """A loop in shadow.frag that runs for minutes (llvmpipe stops a fragment after 65535 turns in all,
     so each turn makes 1024 dependent texture reads: see test_planted_labs' relief shader)."""
@@ -73,7 +67,7 @@ def _hanging_shadow_shader(dest: Path) -> None:
     )
     old = "    float size = float(textureSize(shadow_map, 0).x);\n    bool behind;\n"
     new = f"    float spin = 0.0;\n    while (spin >= 0.0) {{\n{reads}    }}\n" + old.replace(".x);", ".x) + spin;")
-    _replace(dest / "shaders" / "shadow.frag", old, new)
+    replace_once(dest / "shaders" / "shadow.frag", old, new)
 
 
 def _zygote_threads() -> int:
@@ -85,7 +79,7 @@ def test_after_a_hung_and_a_broken_shader_the_next_glsl_call_is_graded_correctly
 
     hung = planted_solution("shadows", _hanging_shadow_shader)
     broken = planted_solution(
-        "shadows", lambda d: _replace(d / "shaders" / "depth.frag", "result = vec4(", "result = vec5(")
+        "shadows", lambda d: replace_once(d / "shaders" / "depth.frag", "result = vec4(", "result = vec5(")
     )
     good = planted_solution("shadows", lambda d: None)
     try:

@@ -22,7 +22,7 @@ import pytest
 
 from geomlib.grading.results import plain_text
 
-from .course import planted_solution
+from .course import planted_solution, replace_once
 
 pytestmark = [pytest.mark.slow, pytest.mark.skipif(sys.platform != "linux", reason="the sandbox is Linux-only")]
 
@@ -46,16 +46,10 @@ def _grade(impl: Path, lab: str, *extra: str, timeout: float = 600, env_extra: d
     return data
 
 
-def _replace(path: Path, old: str, new: str) -> None:
-    text = path.read_text()
-    assert text.count(old) == 1, f"{path.name}: {old!r} not found once"
-    path.write_text(text.replace(old, new))
-
-
 def test_sdf_zeros_for_shadows_and_occlusion_earn_nothing():
     def zeros(lab: Path) -> None:
         for fn in ("soft_shadow", "ambient_occlusion"):
-            _replace(
+            replace_once(
                 lab / "shadow.py",
                 f'    where = "{fn}"\n',
                 f'    where = "{fn}"\n    return np.zeros(len(np.asarray(P, dtype=np.float64)))  # planted\n',
@@ -86,12 +80,12 @@ def _hanging_relief_shader(lab: Path) -> None:
         f"        spin += texelFetch(height, ivec2(int(spin * 1e9) & 7, {i % 8}), 0).r * 1e-9;\n" for i in range(1024)
     )
     frag = lab / "shaders" / "relief.frag"
-    _replace(
+    replace_once(
         frag,
         "    float f_above = 0.0;\n",
         f"    float spin = 0.0;\n    while (spin >= 0.0) {{\n{reads}    }}\n    float f_above = 0.0;\n",
     )
-    _replace(frag, "scale * d, float(hit));", "scale * d, float(hit) + spin);")
+    replace_once(frag, "scale * d, float(hit));", "scale * d, float(hit) + spin);")
 
 
 def test_relief_hanging_shader_time_out_names_the_shader_the_task_and_the_cause():
