@@ -127,3 +127,31 @@ def test_a_task_run_after_a_fix_removes_that_tasks_pictures_and_keeps_the_others
     finally:
         shutil.rmtree(both, ignore_errors=True)
         shutil.rmtree(fixed1, ignore_errors=True)
+
+
+def test_a_picture_a_message_still_cites_stays_and_a_k_selection_removes_only_its_tests(tmp_path):
+    """A diagnosis reused from an earlier run (``geomlib.grading.diagnose`` caches probe outcomes in a
+    notebook's process) cites a picture drawn then: it stays while a message names it. A run that
+    ran some tests only (any deselection: ``--task``, ``--part``, ``-k``) removes their pictures only."""
+    import os
+
+    from geomlib.grading.grade import _remove_stale_pictures
+    from geomlib.grading.results import Record
+
+    folder = tmp_path / "feedback" / "lab"
+    folder.mkdir(parents=True)
+    names = ["loop-a.png", "loop-a--odd-a.png", "loop-b--odd-b.png", "odd-a.png", "test_x--V.png"]
+    for n in names:
+        (folder / n).write_bytes(b"\x89PNG")
+        os.utime(folder / n, (1e9, 1e9))
+
+    def record(nodeid, passed, message=""):
+        return Record(nodeid, "lab", "p", nodeid, 1.0, "visible", passed, message, 0.0)
+
+    cites = "loop_subdivide is off because loop_odd_matrix differs (see feedback/lab/loop-b--odd-b.png)"
+    records = [record("t.py::test_references[loop-a]", True), record("t.py::test_references[loop-b]", False, cites)]
+    ran = {"t.py::test_references[loop-a]": "loop-a", "t.py::test_references[loop-b]": "loop-b"}
+    _remove_stale_pictures(tmp_path / "feedback", records, before=2e9, ran=ran)
+    assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png", "odd-a.png", "test_x--V.png"]
+    _remove_stale_pictures(tmp_path / "feedback", records, before=2e9)  # whole labs ran
+    assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png"]
