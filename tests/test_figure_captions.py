@@ -13,6 +13,8 @@ means removing it here, and the test fails while a listed figure is already conv
 
 from __future__ import annotations
 
+import re
+
 from geomlib.labfigures import Claims
 
 #: Figures whose captions are still typed text with numbers in it, per lab (file names).
@@ -22,14 +24,21 @@ NOT_YET: dict[str, set[str]] = {
 }  # fmt: skip
 
 
+#: A measured count of one before a plural noun and verb ("1 texels are covered", "1 of 4,096 pixels
+#: differ"): the builder formats the count but must choose the words for it.
+_ONE_PLURAL = re.compile(r"(?<![\d.,])\b1 (?:of [\d,]+ )?[a-z]+s (?:are|were|have|differ|lie|stay)\b")
+
+
 def caption_problems(fig) -> list[str]:
-    """What is wrong with one figure record's caption (empty: every number in it was measured)."""
+    """What is wrong with one figure record's caption (empty: every number in it was measured, and
+    a count of one is not followed by plural words)."""
+    out = [f"{m.group(0)!r}: a count of one with plural words" for m in _ONE_PLURAL.finditer(fig.caption)]
     if fig.claims is None:
         digits = Claims.untyped(fig.caption)
-        return (
+        return out + (
             [f"caption typed with the numbers {digits}; format it from measured ones (Drawn.claimed)"] if digits else []
         )
-    return fig.claims.problems(fig.caption)
+    return out + fig.claims.problems(fig.caption)
 
 
 def test_a_typed_number_in_a_caption_is_caught():
@@ -55,3 +64,24 @@ class _Plain:
 def test_a_plain_caption_may_hold_no_numbers():
     assert caption_problems(_Plain("Task 3 not implemented yet; the other panels show: the input")) == []
     assert caption_problems(_Plain("Parallax is off by 23 texels")) != []
+
+
+class _Made:
+    def __init__(self, claims):
+        self.caption, self.claims = claims.caption(), claims
+
+
+def test_a_count_of_one_with_plural_words_is_caught():
+    """shadows_glsl.png said "1 texels are covered in one map only": the count was measured, the words typed."""
+    assert caption_problems(_Made(Claims("and {n:,} texels are covered in one map", {"n": 1}))) == [
+        "'1 texels are': a count of one with plural words"
+    ]
+    assert caption_problems(_Made(Claims("{n:,} of {t:,} pixels differ by more", {"n": 1, "t": 4096}))) != []
+    for n in (0, 2, 1024):
+        assert (
+            caption_problems(_Made(Claims("and {n:,} texels are covered, {n} of {t} pixels differ", {"n": n, "t": 9})))
+            == []
+        )
+    assert caption_problems(_Made(Claims("1.1 texels are off, 21 texels are, 1 texel is", {}))) == [
+        "numbers ['1.1', '21', '1'] typed into the caption template, not measured"
+    ]

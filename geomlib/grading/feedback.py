@@ -16,7 +16,7 @@ import textwrap
 
 import numpy as np
 
-from geomlib.grading.context import Context
+from geomlib.grading.context import Context, picture_stem, set_running_test
 from geomlib.grading.picture_run import (  # noqa: F401 - re-exported: the run's picture budget
     _ASYNC,
     _CAP,
@@ -541,24 +541,29 @@ def _file_safe(text: str) -> str:
 
 
 def begin_test(feedback_dir, lab: str, test_id: str) -> None:
-    """Pictures of failures from now on go to ``feedback_dir/lab/<test_id>-<output>.png`` (grading plugin)."""
+    """Pictures of failures from now on go to ``feedback_dir/lab/<test>--<output>.png`` and every
+    other picture's name starts with the test's too (grading plugin; ``test_id``: the test's name,
+    or its case's id for a reference test, see :func:`geomlib.grading.context.picture_name`)."""
     _TEST.clear()
-    _TEST.update(dir=feedback_dir, lab=lab, id=_file_safe(test_id) or "test", used=set())
+    stem = picture_stem(test_id)
+    _TEST.update(dir=feedback_dir, lab=lab, id=stem, used=set())
+    set_running_test(stem)
 
 
 def end_test() -> None:
     _TEST.clear()
+    set_running_test(None)
 
 
 def picture_context(label: str, name: str = "output") -> Context | None:
     """A :class:`Context` whose picture is this test's own, or None outside a graded test.
 
-    Each call reserves a new file name (``<test>-<name>.png``, then ``-2``, ``-3``, ...), so several
+    Each call reserves a new file name (``<test>--<name>.png``, then ``-2``, ``-3``, ...), so several
     failing comparisons in one test never overwrite each other's picture.
     """
     if not _TEST or _TEST.get("dir") is None:
         return None
-    stem = f"{_TEST['id']}-{_file_safe(name) or 'output'}"
+    stem = _file_safe(name) or "output"  # the Context puts the test's name first
     k, case_id = 1, stem
     while case_id in _TEST["used"]:
         k += 1

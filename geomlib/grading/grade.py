@@ -161,6 +161,7 @@ def grade(
     args += extra_args or []
     run = plugin.GradingRun(GradingSettings.build(impl=impl, feedback_dir=feedback_dir))
     selection = _Selection(task=task, part=part)
+    owners = _PictureOwners()
     _start_sandbox_early()
     t0 = time.time()
     captured = io.StringIO()
@@ -168,10 +169,10 @@ def grade(
 
     with feedback.pictures_for_run(pictures) as drawn, _no_plugin_autoload():
         if verbose:
-            code = pytest.main(args, plugins=[selection, run])
+            code = pytest.main(args, plugins=[selection, run, owners])
         else:
             with contextlib.redirect_stdout(captured), contextlib.redirect_stderr(captured):
-                code = pytest.main(args, plugins=[selection, run])
+                code = pytest.main(args, plugins=[selection, run, owners])
     elapsed = time.time() - t0
     records = list(run.records)
     if records_out is not None:
@@ -180,8 +181,7 @@ def grade(
         r.message = feedback.without_pictures(r.message, drawn.failed)
         if r.picture and feedback._relpath(r.picture) in drawn.failed:
             r.picture = None
-    if task is None and part is None:
-        _remove_stale_pictures(feedback_dir, {r.lab for r in records}, before=t0)
+    _remove_stale_pictures(feedback_dir, records, before=t0, ran=None if owners.whole else owners.stems)
     note = ""
     if code == 5 or (code == 0 and not records):
         what = f"task {task}" if task is not None else f'part "{part}"' if part else "these labs"
@@ -248,13 +248,43 @@ def _start_sandbox_early() -> None:
     threading.Thread(target=start, name="geomlib-zygote-start", daemon=True).start()
 
 
-def _remove_stale_pictures(feedback_dir, labs, *, before: float) -> None:
-    """Pictures a whole-lab run did not draw belong to tests that pass now (or no longer exist):
-    remove them, so ``feedback/<lab>/`` shows only today's failures."""
+class _PictureOwners:
+    """A pytest plugin: the tests that run, each with the name its feedback pictures start with
+    (:func:`geomlib.grading.context.picture_name`), and whether any test was left out."""
+
+    def __init__(self):
+        self.stems: dict[str, str] = {}  # nodeid -> picture stem
+        self.whole = True
+
+    def pytest_deselected(self, items):  # --task, --part, -k ...
+        if items:
+            self.whole = False
+
+    def pytest_collection_finish(self, session):
+        self.stems = {i.nodeid: plugin.picture_stem_of(i) for i in session.items}
+
+
+def _remove_stale_pictures(feedback_dir, records, *, before: float, ran: dict | None = None) -> None:
+    """Remove the pictures this run's tests did not draw or cite: their tests pass now (or no longer
+    exist), so ``feedback/<lab>/`` shows only today's failures. ``ran`` (nodeid -> picture stem):
+    only some tests ran (``--task``, ``--part``), and only their pictures go — a picture's name
+    starts with its test's, so another task's pictures stay. None: whole labs ran, every stale
+    picture goes."""
     if not feedback_dir:
         return
-    for lab in labs:
+    from geomlib.grading.context import picture_owner
+
+    cited, stems = set(), {}
+    for r in records:
+        for p in [r.picture or "", *_SEE.findall(r.message or "")]:
+            if p:
+                cited.add((Path(p).parent.name, Path(p).name))
+        if ran is not None and r.nodeid in ran:
+            stems.setdefault(r.lab, set()).add(ran[r.nodeid])
+    for lab in {r.lab for r in records}:
         for png in Path(feedback_dir, lab).glob("*.png"):
+            if (lab, png.name) in cited or (ran is not None and picture_owner(png.name) not in stems.get(lab, ())):
+                continue
             try:
                 if png.stat().st_mtime < before:
                     png.unlink()

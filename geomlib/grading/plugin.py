@@ -114,7 +114,7 @@ def feedback_dir(request) -> Path | None:
 @pytest.fixture(autouse=True)
 def _feedback_pictures_of_this_test(request):
     """Tell :mod:`geomlib.grading.feedback` where a graded test's failure pictures go, so
-    ``expect_close`` and a lab's own comparisons draw them (``feedback/<lab>/<test>-<output>.png``)."""
+    ``expect_close`` and a lab's own comparisons draw them (``feedback/<lab>/<test>--<output>.png``)."""
     from geomlib.grading import feedback
 
     name = lab_of(request.path)
@@ -122,11 +122,21 @@ def _feedback_pictures_of_this_test(request):
     if name is None or not folder:
         yield
         return
-    feedback.begin_test(Path(folder), name, request.node.name)
+    feedback.begin_test(Path(folder), name, picture_stem_of(request.node))
     try:
         yield
     finally:
         feedback.end_test()
+
+
+def picture_stem_of(item) -> str:
+    """How the feedback pictures of the graded test ``item`` are named: its case's id for a
+    reference test, else its name (:func:`geomlib.grading.context.picture_name`)."""
+    from geomlib.grading.context import picture_stem
+
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    return picture_stem(item.name, getattr(case, "id", None))
 
 
 @pytest.fixture

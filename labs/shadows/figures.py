@@ -357,6 +357,10 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
     both = (D_np < 1) & (D_gl < 1)
     ecov = np.abs(C_np - C_gl) > 1e-3
     page = panels(rows, caps, ncols=3, title="The shaders against the NumPy route (same scene, same light, same map)")
+    d_cov = int(cov.sum())
+    # Words that agree with a measured count ("1 texel is", "2 texels are"); the counts stay fields.
+    d_differ, p_differ = ("differs" if stats[key][0] == 1 else "differ" for key in ("dir", "pt"))
+    texels_are = "texel is" if d_cov == 1 else "texels are"
     return Drawn.claimed(
         page,
         "Each row renders the same view twice: left with the NumPy route (depth_map and shadow_visibility; "
@@ -364,14 +368,14 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
         "(depth.vert/.frag and shadow.frag; cube_depth.vert/.frag and cube_shadow.frag), right the difference "
         "of the two visibilities per pixel, in units of the graded tolerance {tol_vis:g} (a visibility runs from "
         "shadow to lit). Directional light: "
-        "{d_n:,} of {d_t:,} pixels differ by more than {tol_vis:g} (max {d_mx:.3g}); the {ms}² depth maps agree to "
-        "{d_depth:.2g} in window depth where both hold a surface, and {d_cov:,} texels are covered in one map "
-        "only. Point light: {p_n:,} of {p_t:,} pixels differ (max {p_mx:.3g}); the linear cube maps differ by "
-        "more than {tol_depth:g} (distance / far) in {p_cov:,} of {p_all:,} texels. What differs sits on texel "
-        "borders, where the GPU's rasterizer and the NumPy route round a tie differently (the handout's GLSL "
-        "section gives the tolerances).",
+        "{d_n:,} of {d_t:,} pixels " + d_differ + " by more than {tol_vis:g} (max {d_mx:.3g}); the {ms}² depth "
+        "maps agree to {d_depth:.2g} in window depth where both hold a surface, and {d_cov:,} " + texels_are + " "
+        "covered in one map only. Point light: {p_n:,} of {p_t:,} pixels " + p_differ + " (max {p_mx:.3g}); the "
+        "linear cube maps differ by more than {tol_depth:g} (distance / far) in {p_cov:,} of {p_all:,} texels. "
+        "What differs sits on texel borders, where the GPU's rasterizer and the NumPy route round a tie "
+        "differently (the handout's GLSL section gives the tolerances).",
         tol_vis=1e-6, tol_depth=1e-3, d_n=stats["dir"][0], d_t=stats["dir"][2], d_mx=stats["dir"][1], ms=ms,
-        d_depth=float(np.abs(D_np - D_gl)[both].max()), d_cov=int(cov.sum()),
+        d_depth=float(np.abs(D_np - D_gl)[both].max()), d_cov=d_cov,
         p_n=stats["pt"][0], p_t=stats["pt"][2], p_mx=stats["pt"][1], p_cov=int(ecov.sum()), p_all=ecov.size,
     )  # fmt: skip
 

@@ -11,7 +11,7 @@ without a picture: outputs on free-standing random vectors with no mesh or grid 
 Hand-written graded tests (``test_<lab>.py``): the grading plugin names each running graded test
 for :mod:`geomlib.grading.feedback`, so ``expect_close(..., mesh=(V, F))`` and a lab's own
 comparisons (subdivision's matrix rows, maps' texel maps) draw the failure as
-``feedback/<lab>/<test>-<output>.png``; planted errors in four labs make such tests fail with a
+``feedback/<lab>/<test>--<output>.png``; planted errors in four labs make such tests fail with a
 picture that exists, is not blank and is named in the message. What stays without a picture: scalar
 and short-list comparisons with no mesh or grid behind them (``loop_weight([3, 4, 6])``, a single
 quadric, ``sd_box`` at six points, counts), and checks of topology or statistics with no wrong
@@ -252,7 +252,7 @@ def test_hand_written_graded_tests_draw_their_failures(lab, tmp_path):
         seen = re.search(r"\(see (\S+\.png)\)", message)
         assert seen, f"{test} failed without a picture: {message}"
         picture = (root / seen.group(1)).resolve()
-        assert picture.parent == (pictures / lab).resolve() and picture.name.startswith(f"{test}-"), picture
+        assert picture.parent == (pictures / lab).resolve() and picture.name.startswith(f"{test}--"), picture
         assert picture.is_file() and _not_blank_png(picture), picture
 
 
@@ -263,10 +263,39 @@ def test_pictures_of_one_test_do_not_overwrite_each_other(tmp_path):
     finally:
         feedback.end_test()
     paths = [ctx.feedback_path() for ctx in (a, b, c)]
-    assert [p.name for p in paths] == ["test_x_warren_loop-S_odd.png", "test_x_warren_loop-S_odd-2.png",
-                                       "test_x_warren_loop-row_sums.png"]  # fmt: skip
+    assert [p.name for p in paths] == ["test_x_warren_loop--S_odd.png", "test_x_warren_loop--S_odd-2.png",
+                                       "test_x_warren_loop--row_sums.png"]  # fmt: skip
     assert all(p.parent == tmp_path / "subdivision" for p in paths)
     assert feedback.picture_context("S @ V") is None  # outside a graded test: no picture, no error
+
+
+def test_two_tests_that_draw_one_case_write_two_pictures_each_named_after_its_test(tmp_path):
+    """A composite's test diagnosing with a building block's case draws that case too: its picture
+    must not overwrite the case's own test's, and each name must say which test drew it, so a
+    ``--task`` run removes exactly its own tests' stale pictures."""
+    from geomlib.grading.context import Context, picture_owner
+
+    def odd_ant():
+        return Context(label="loop_odd_matrix", lab="subdivision", case_id="odd-ant", feedback_dir=tmp_path)
+
+    names = []
+    for test in ("odd-ant", "loop-ant-2-loop", "test_x[warren/loop]"):  # the case's reference test, two others
+        feedback.begin_test(tmp_path, "subdivision", test)
+        try:
+            ctx = odd_ant()
+        finally:
+            feedback.end_test()
+        names.append(ctx.feedback_path().name)
+    assert names == ["odd-ant.png", "loop-ant-2-loop--odd-ant.png", "test_x_warren_loop--odd-ant.png"]
+    assert [picture_owner(n) for n in names] == ["odd-ant", "loop-ant-2-loop", "test_x_warren_loop"]
+    assert odd_ant().feedback_path().name == "odd-ant.png"  # outside a graded test: the case's id, as before
+    # a case id, test name or output name with "--" or odd characters cannot make the owner ambiguous
+    feedback.begin_test(tmp_path, "subdivision", "test_y[a--b]")
+    try:
+        odd = feedback.picture_context("x", "S--odd").feedback_path().name
+    finally:
+        feedback.end_test()
+    assert odd == "test_y_a-b--S-odd.png" and picture_owner(odd) == "test_y_a-b"
 
 
 def test_expect_close_outside_a_graded_test_still_fails_with_its_message():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from .course import run_geomlib
 
 
@@ -61,3 +63,95 @@ def test_a_whole_lab_run_removes_pictures_of_tests_that_pass_now(sample_course, 
     other.write_text("mine")
     _report(sample_course, "--impl", "solutions", "--feedback", str(tmp_path / "feedback"))
     assert not stale.exists() and other.exists()
+
+
+def _planted_sample(sample_course, old: str, new: str) -> Path:
+    """A world-readable copy of the sample lab's solution (the sandbox may run it as ``nobody``) with
+    ``old`` replaced by ``new`` in ``ops.py``; returns the folder to pass as ``--impl``."""
+    import os
+    import shutil
+    import tempfile
+
+    base = Path(tempfile.mkdtemp(prefix="geomlib-stale-"))
+    shutil.copytree(
+        sample_course / "solutions" / "sample", base / "sample", ignore=shutil.ignore_patterns("__pycache__")
+    )
+    ops = base / "sample" / "ops.py"
+    assert old in ops.read_text()
+    ops.write_text(ops.read_text().replace(old, new))
+    for p in [base, *base.rglob("*")]:
+        os.chmod(p, 0o755 if p.is_dir() else 0o644)
+    return base
+
+
+def test_a_task_run_after_a_fix_removes_that_tasks_pictures_and_keeps_the_others(sample_course, tmp_path):
+    """Issue #26 item 5: ``grade --task 1`` after fixing Task 1 removes the pictures of Task 1's
+    tests (their names start with the test's) and keeps Task 2's, also a Task 2 test's picture of a
+    Task 1 case; ``--part`` does the same for its tests; a whole-lab run removes every stale one."""
+    import os
+    import shutil
+
+    from geomlib.grading.context import picture_owner
+
+    task1 = ("return c + s * (V - c)", "return c + s * (V - c) + 0.25")
+    task2 = ("M = 0.5 * (V[E[:, 0]] + V[E[:, 1]])", "M = 0.4 * (V[E[:, 0]] + V[E[:, 1]])")
+    both = _planted_sample(sample_course, *task1)
+    ops = both / "sample" / "ops.py"
+    ops.write_text(ops.read_text().replace(*task2))
+    fixed1 = _planted_sample(sample_course, *task2)
+    fb = tmp_path / "feedback"
+    env = {"GEOMLIB_NO_FEEDBACK_PICTURES": "", "GEOMLIB_MAX_FEEDBACK_PICTURES": ""}
+    try:
+        run_geomlib(sample_course, "grade", "--impl", str(both), "--feedback", str(fb), "--pictures", "all", env=env)
+        drawn = {p.name for p in (fb / "sample").glob("*.png")}
+        # one Task 2 test's picture of a Task 1 case (a composite diagnosing with it), and a stray one
+        for name in ("tet-mid--tet-scale.png", "an-old-test.png"):
+            (fb / "sample" / name).write_bytes(b"\x89PNG old picture")
+        for p in (fb / "sample").glob("*.png"):
+            os.utime(p, (1e9, 1e9))
+        ones = {
+            n for n in drawn if picture_owner(n) in ("tet-scale", "tet-scale-half", "test_scale_by_one_is_identity")
+        }
+        twos = {n for n in drawn if picture_owner(n) in ("tet-mid", "test_one_triangle_midpoints")}
+        assert "tet-scale.png" in ones and "tet-mid.png" in twos and ones | twos == drawn, drawn
+        assert "test_scale_by_one_is_identity--output.png" in ones, drawn
+
+        run_geomlib(sample_course, "grade", "--impl", str(fixed1), "--feedback", str(fb), "--task", "1", env=env)
+        left = {p.name for p in (fb / "sample").glob("*.png")}
+        assert left == twos | {"tet-mid--tet-scale.png", "an-old-test.png"}, (drawn, left)
+
+        run_geomlib(sample_course, "grade", "--impl", "solutions", "--feedback", str(fb), "--part", "midpoints")
+        assert {p.name for p in (fb / "sample").glob("*.png")} == {"an-old-test.png"}
+        run_geomlib(sample_course, "grade", "--impl", "solutions", "--feedback", str(fb))
+        assert not list((fb / "sample").glob("*.png"))
+    finally:
+        shutil.rmtree(both, ignore_errors=True)
+        shutil.rmtree(fixed1, ignore_errors=True)
+
+
+def test_a_picture_a_message_still_cites_stays_and_a_k_selection_removes_only_its_tests(tmp_path):
+    """A diagnosis reused from an earlier run (``geomlib.grading.diagnose`` caches probe outcomes in a
+    notebook's process) cites a picture drawn then: it stays while a message names it. A run that
+    ran some tests only (any deselection: ``--task``, ``--part``, ``-k``) removes their pictures only."""
+    import os
+
+    from geomlib.grading.grade import _remove_stale_pictures
+    from geomlib.grading.results import Record
+
+    folder = tmp_path / "feedback" / "lab"
+    folder.mkdir(parents=True)
+    names = ["loop-a.png", "loop-a--odd-a.png", "loop-b--odd-b.png", "odd-a.png", "test_x--V.png"]
+    for n in names:
+        (folder / n).write_bytes(b"\x89PNG")
+        os.utime(folder / n, (1e9, 1e9))
+
+    def record(nodeid, passed, message=""):
+        return Record(nodeid, "lab", "p", nodeid, 1.0, "visible", passed, message, 0.0)
+
+    cites = "loop_subdivide is off because loop_odd_matrix differs (see feedback/lab/loop-b--odd-b.png)"
+    records = [record("t.py::test_references[loop-a]", True), record("t.py::test_references[loop-b]", False, cites)]
+    ran = {"t.py::test_references[loop-a]": "loop-a", "t.py::test_references[loop-b]": "loop-b"}
+    _remove_stale_pictures(tmp_path / "feedback", records, before=2e9, ran=ran)
+    assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png", "odd-a.png", "test_x--V.png"]
+    _remove_stale_pictures(tmp_path / "feedback", records, before=2e9)  # whole labs ran
+    assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png"]
