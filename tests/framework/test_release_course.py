@@ -395,6 +395,26 @@ def test_a_submission_without_the_lab_is_told_what_to_upload(autograder):
     assert "notes.txt" in r["output"]
 
 
-# Batch regrading (`grade-all`) of the real course as root with the drop to the sandbox user: the
-# solutions, the stubs and a folder without the lab, graded once in
-# test_batch.py::test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user.
+def test_grade_all_on_the_real_course_as_nobody(autograder, base, points):
+    """Batch regrading with the autograder's environment (readable by the sandbox user), as root with the drop."""
+    subs = base / "subs"
+    shutil.copytree(ROOT / "solutions" / LAB, subs / "alice" / "labs" / LAB)
+    shutil.copytree(ROOT / "labs" / LAB, subs / "bob" / LAB)
+    (subs / "carol").mkdir()
+    subprocess.run(["chmod", "-R", "a+rX", str(subs)], check=True)
+    out = base / "regrade"
+    env = _env(GEOMLIB_ROOT=str(autograder / "source"))
+    if not IS_ROOT:
+        env["GEOMLIB_SANDBOX_USER"] = ""
+    py = autograder / "source" / ".venv" / "bin" / "python"
+    cmd = [str(py), "-m", "geomlib.cli", "grade-all", str(subs), "--lab", LAB, "--out", str(out), "--jobs", "2"]
+    p = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stdout + p.stderr
+    import csv
+
+    rows = {r["submission"]: r for r in csv.DictReader((out / "scores.csv").open())}
+    total = sum(p + h for p, h in points.values())
+    assert float(rows["alice"]["score"]) == float(rows["(max)"]["score"]) == total and rows["alice"]["status"] == "ok"
+    assert rows["bob"]["score"] == "0" and rows["carol"]["status"] == "no lab"
+    for who in ("alice", "bob", "carol"):
+        validate_results(json.loads((out / who / "results.json").read_text()))
