@@ -335,7 +335,7 @@ def fig_boundary(out: Path, lab, quick: bool) -> Drawn:
         "boundary vertices, green line: the input's outline). Without penalty quadrics a boundary vertex only "
         "feels the planes of its few faces, so it slides off the outline at little cost and the result cuts the "
         "corners: its boundary vertices lie up to {off_free:.2f}% of the bounding-box diagonal from the input's "
-        "outline. A plane through each boundary edge, perpendicular to its face and weighted heavily, keeps them "
+        "outline. A plane through each boundary edge, perpendicular to its face and weighted like the faces, keeps them "
         "within {off_kept:.2f}% of it.",
         share=target / len(F), target=target, off_free=off[False], off_kept=off[True],
     )  # fmt: skip
