@@ -193,3 +193,39 @@ def test_two_processes_filling_the_cache_at_once_leave_it_whole(course):
     assert not list((course.parent / "cache").rglob("*.tmp")), "a half-written file was left"
     third = grade(course, solution)
     assert (third["value"], third["misses"], third["hits"]) == (4.0, 0, 1), f"the filled cache did not serve: {third}"
+
+
+def test_as_root_with_a_sandbox_user_nothing_is_shared_and_grading_works():
+    """The autograder and grade-all run student code as ``nobody``, who can read neither the grading
+    user's cache nor (rightly) write into what the course's code later loads: each run compiles in its
+    private per-snapshot cache, as before, and the persistent cache is not even made."""
+    import tempfile
+
+    from .course import sandbox_python, sandbox_user_problem
+
+    if (why := sandbox_user_problem("nobody")) is not None:
+        pytest.skip(why)
+    python, extra = sandbox_python("nobody")
+    base = Path(tempfile.mkdtemp(prefix="geomlib-kcache-"))
+    try:
+        base.chmod(0o755)  # the sandbox user must read the course
+        root = base / "course"
+        for folder, text in (("labs", STUB), ("solutions", SOLUTION)):
+            (root / folder / "jitlab").mkdir(parents=True)
+            (root / folder / "jitlab" / "kernels.py").write_text(text)
+        env = {**os.environ, "GEOMLIB_ROOT": str(root), "GEOMLIB_KERNEL_CACHE": str(base / "cache")}
+        env.update(GEOMLIB_SANDBOX_USER="nobody", **extra)
+        env.pop("NUMBA_CACHE_DIR", None)
+        p = subprocess.run(
+            [python, "-c", GRADE, str(root / "solutions" / "jitlab")],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=600,
+        )
+        assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-3000:]
+        out = json.loads(p.stdout.strip().splitlines()[-1])
+        assert (out["value"], out["misses"]) == (4.0, 1), out
+        assert not (base / "cache").exists(), "a cache the sandbox user's workers would feed was made"
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
