@@ -55,12 +55,13 @@ import json
 import os
 import platform
 import shutil
-import stat
 import sys
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
+from geomlib.jit import _private  # a real folder of this user that no one else can write
 
 __all__ = ["Entry", "open_entry", "seed", "publish", "MAX_AGE_S"]
 
@@ -113,15 +114,6 @@ def entry_key(lab_name: str, lab_key: str, stubs_key: str) -> str:
     """The folder name of the entry for these bytes, this lab name and these library versions."""
     text = json.dumps([lab_name, lab_key, stubs_key, *_versions()])
     return hashlib.sha256(text.encode()).hexdigest()[:40]
-
-
-def _private(folder: Path) -> bool:
-    """A real folder (not a link) owned by the current user that no one else can write to."""
-    try:
-        info = folder.lstat()
-    except OSError:
-        return False
-    return stat.S_ISDIR(info.st_mode) and info.st_uid == os.geteuid() and not info.st_mode & 0o022
 
 
 @contextlib.contextmanager
