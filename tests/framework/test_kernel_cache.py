@@ -118,18 +118,6 @@ def cache_files(course: Path) -> dict[str, tuple]:
     return out
 
 
-def test_a_second_process_grading_the_same_course_code_compiles_nothing(course):
-    solution = course / "solutions" / "jitlab"
-    first = grade(course, solution)
-    assert (first["value"], first["misses"]) == (4.0, 1), first
-    kept = cache_files(course)
-    assert any(p.endswith(".nbc") for p in kept), f"nothing compiled was kept: {sorted(kept)}"
-    second = grade(course, solution)
-    assert second["value"] == 4.0
-    assert (second["misses"], second["hits"]) == (0, 1), f"the second process compiled again: {second}"
-    assert cache_files(course) == kept, "the second process wrote into the cache although it compiled nothing"
-
-
 def test_a_changed_constant_gets_its_own_compile_and_result_and_the_old_code_its_own_kernels(course):
     solution = course / "solutions" / "jitlab" / "kernels.py"
     assert grade(course, solution.parent)["value"] == 4.0
@@ -140,11 +128,6 @@ def test_a_changed_constant_gets_its_own_compile_and_result_and_the_old_code_its
     changed = grade(course, solution.parent)
     assert changed["value"] == 5.5, f"the kernel compiled for 2.0 * x ran: {changed}"
     assert changed["misses"] == 1, changed
-    # Copied elsewhere (a submission), the changed code compiles on its own and gives its own result.
-    copy = course.parent / "submission" / "jitlab"
-    shutil.copytree(solution.parent, copy)
-    copy.joinpath("kernels.py").write_text(text.replace("2.0 * x", "7.0 * x"))
-    assert grade(course, copy)["value"] == 11.5
     solution.write_text(text)
     back = grade(course, solution.parent)
     assert (back["value"], back["misses"], back["hits"]) == (4.0, 0, 1), f"the first version was not kept: {back}"
@@ -169,7 +152,10 @@ def test_a_submission_is_neither_served_from_nor_written_into_the_shared_cache(c
     assert (again["value"], again["misses"], again["hits"]) == (4.0, 0, 1), again
 
 
-def test_two_processes_filling_the_cache_at_once_leave_it_whole(course):
+def test_two_processes_fill_the_cache_at_once_and_a_third_compiles_nothing(course):
+    """numba writes each file by ``os.replace`` but extends an index by load-modify-save, unlocked:
+    the grader publishes under a lock, first index wins. A later process loads, compiles nothing and
+    writes nothing."""
     solution = course / "solutions" / "jitlab"
     env = {
         **os.environ,
@@ -187,12 +173,16 @@ def test_two_processes_filling_the_cache_at_once_leave_it_whole(course):
     for p in procs:
         out, err = p.communicate(timeout=600)
         assert p.returncode == 0, err.decode()[-3000:]
-        assert json.loads(out.decode().strip().splitlines()[-1])["value"] == 4.0
+        first = json.loads(out.decode().strip().splitlines()[-1])
+        assert (first["value"], first["misses"]) == (4.0, 1), first
     entries = [p for p in (course.parent / "cache").iterdir() if p.is_dir()]
     assert len(entries) == 1, f"one content, one entry: {entries}"
     assert not list((course.parent / "cache").rglob("*.tmp")), "a half-written file was left"
+    kept = cache_files(course)
+    assert any(p.endswith(".nbc") for p in kept), f"nothing compiled was kept: {sorted(kept)}"
     third = grade(course, solution)
-    assert (third["value"], third["misses"], third["hits"]) == (4.0, 0, 1), f"the filled cache did not serve: {third}"
+    assert (third["value"], third["misses"], third["hits"]) == (4.0, 0, 1), f"a later process compiled again: {third}"
+    assert cache_files(course) == kept, "a process that compiled nothing wrote into the cache"
 
 
 def test_as_root_with_a_sandbox_user_nothing_is_shared_and_grading_works():
