@@ -40,8 +40,8 @@ grading user's cache). Without either protection student code can write whatever
 can (its own ``~/.cache`` included): ``sandbox.status()`` says so, grade others' code as root or
 under Landlock.
 
-Where: ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib/kernels``, else
-``~/.cache/geomlib/kernels`` (:func:`geomlib.grading.settings.kernel_cache_dir`); ``off`` turns
+Where: ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib-kernels``, else
+``~/.cache/geomlib-kernels`` (:func:`geomlib.grading.settings.kernel_cache_dir`); ``off`` turns
 it off. Entries unused for :data:`MAX_AGE_S` are removed when a new one is made.
 """
 

@@ -38,7 +38,7 @@ VARIABLES: dict[str, str] = {
     "GEOMLIB_SANDBOX_HIDE": "extra folders (os.pathsep-separated) student code may not read",
     "GEOMLIB_LANDLOCK": "`0`: do not use Landlock (to test the protection of a kernel without it)",
     "GEOMLIB_SECCOMP": "`0`: do not install the network filter (to test what it blocks)",
-    "GEOMLIB_KERNEL_CACHE": "where the compiled kernels of the course's own `solutions/` and `labs/` are kept between grading runs (default `$XDG_CACHE_HOME/geomlib/kernels`, else `~/.cache/geomlib/kernels`); `off`: nowhere (each run compiles)",
+    "GEOMLIB_KERNEL_CACHE": "where the compiled kernels of the course's own `solutions/` and `labs/` are kept between grading runs (default `$XDG_CACHE_HOME/geomlib-kernels`, else `~/.cache/geomlib-kernels`); `off`: nowhere (each run compiles)",
     "GEOMLIB_STUBS": "the folder of the course's stubs (default `labs/` of the course), for shader-task messages",
     "GEOMLIB_AUTOGRADER_PYTHON": "the Python 3.11 `grade-all` builds the autograder's environment with",
     "GEOMLIB_AUTOGRADER_ROOT": "the autograder's folder in `setup.sh`/`run_autograder` (default `/autograder`)",
@@ -67,7 +67,7 @@ def env_float(name: str) -> float | None:
 def kernel_cache_dir() -> Path | None:
     """Where :mod:`geomlib.grading.kernelcache` keeps trusted compiled kernels (None: ``off``).
 
-    ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib/kernels``, else ``~/.cache/geomlib/kernels``
+    ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib-kernels``, else ``~/.cache/geomlib-kernels``
     (the XDG base-directory rule; read here, the one place the tooling reads the environment).
     """
     given = (env("GEOMLIB_KERNEL_CACHE") or "").strip()
@@ -77,7 +77,7 @@ def kernel_cache_dir() -> Path | None:
         return Path(given)
     xdg = os.environ.get("XDG_CACHE_HOME", "")
     base = Path(xdg) if os.path.isabs(xdg) else Path(os.path.expanduser("~")) / ".cache"
-    return base / "geomlib" / "kernels"
+    return base / "geomlib-kernels"
 
 
 def _picture_cap() -> int | None:
