@@ -26,7 +26,10 @@ Before a student's code runs, its lab folder is copied (plain files only, never 
 into a private read-only snapshot, and each module is merged with the course's stub so that given
 code stays the course's (see :mod:`geomlib.grading.worker`). A snapshot is known by the bytes it
 holds, checked at every call: a folder edited since (a notebook's ``check()`` run again, one process
-grading many copies) gets a new snapshot and a new numba cache, never the old code.
+grading many copies) gets a new snapshot and a new numba cache, never the old code. The course's
+own ``solutions/`` and ``labs/`` (trusted code) are the exception when workers run as the grading
+user: their snapshot and compiled kernels are kept between runs, by content, in a per-user cache
+that only the grader writes (:mod:`geomlib.grading.kernelcache`), so each version is compiled once.
 
 :class:`LabProxy` makes this look like a module: ``lab.loop_subdivide(V, F)`` runs the student's
 ``loop_subdivide`` in a worker and returns its result, or raises a
@@ -283,6 +286,10 @@ class _Snapshot:
     dest: Path
     #: digest of the course's stubs (``""``: none) -> the numba cache folder of this code
     jit: dict[str, Path] = field(default_factory=dict)
+    #: trusted code only: its entry in the persistent kernel cache (``dest`` is inside it, never
+    #: removed by this process), and what :func:`kernelcache.seed` put into its ``jit`` folder
+    shared: object | None = None
+    seeded: dict = field(default_factory=dict)
 
 
 class _Zygote:
@@ -400,7 +407,7 @@ class _Zygote:
         else:
             self.problems += info.get("problems", [])
 
-    def snapshot(self, lab_dir: Path, stubs: Path | None = None) -> tuple[Path, Path]:
+    def snapshot(self, lab_dir: Path, stubs: Path | None = None, *, trusted: bool = False) -> tuple[Path, Path]:
         """A private, read-only copy of a lab folder (plain files only, links never followed) and the
         numba cache folder of its workers.
 
@@ -408,22 +415,59 @@ class _Zygote:
         was made (even with its files' size and modification time put back) gets a new snapshot in a
         new folder and a new numba cache, and the old ones are removed. The cache is also per
         version of the course's ``stubs`` (given kernels are compiled with the submission's).
+
+        ``trusted``: the folder is the course's own (its ``solutions/`` or ``labs/``, graded with its
+        own stubs). Then, when the workers run as the grading user, the snapshot is the persistent
+        one of :mod:`geomlib.grading.kernelcache` (same bytes, same path in every process) and its
+        numba cache is seeded with what earlier processes compiled; see :meth:`publish`.
         """
         path = lab_dir.resolve()
         key = _folder_digest(path)
+        stubs_key = _folder_digest(stubs.resolve()) if stubs is not None else ""
         snap = self.snapshots.pop(str(path), None)
-        if snap is not None and snap.key != key:
+        if snap is not None and (snap.key != key or (snap.shared is not None and snap.shared.stubs_key != stubs_key)):
             self._drop(snap)
             snap = None
         if snap is None:
             self._evict()
-            dest = Path(tempfile.mkdtemp(prefix="lab-", dir=self.scratch_root)) / lab_dir.name
-            snap = _Snapshot(_copy_lab(path, dest), dest)
+            entry = self._shared_entry(path, key, stubs_key) if trusted else None
+            if entry is not None:
+                snap = _Snapshot(entry.lab_key, entry.src, shared=entry)
+            else:
+                dest = Path(tempfile.mkdtemp(prefix="lab-", dir=self.scratch_root)) / lab_dir.name
+                snap = _Snapshot(_copy_lab(path, dest), dest)
         self.snapshots[str(path)] = snap
-        stubs_key = _folder_digest(stubs.resolve()) if stubs is not None else ""
         if stubs_key not in snap.jit:
             snap.jit[stubs_key] = self._jit_folder()
+            if snap.shared is not None:
+                from geomlib.grading import kernelcache
+
+                snap.seeded = kernelcache.seed(snap.shared, snap.jit[stubs_key])
         return snap.dest, snap.jit[stubs_key]
+
+    def _shared_entry(self, path: Path, key: str, stubs_key: str):
+        """The persistent kernel-cache entry of trusted code, or None (off, unusable, or the workers
+        run as a sandbox user, who could not read the grading user's cache: each run compiles)."""
+        from geomlib.grading import kernelcache
+        from geomlib.grading.settings import kernel_cache_dir
+
+        cache = kernel_cache_dir()
+        if cache is None or self.user:
+            return None
+        return kernelcache.open_entry(cache, path, key, stubs_key, _copy_lab)
+
+    def publish(self, lab_dir: Path) -> None:
+        """Copy what the last call of the trusted ``lab_dir`` compiled into its persistent entry
+        (:func:`kernelcache.publish`); nothing for other code."""
+        snap = self.snapshots.get(str(Path(lab_dir).resolve()))
+        if snap is None or snap.shared is None:
+            return
+        from geomlib.grading import kernelcache
+
+        try:
+            kernelcache.publish(snap.shared, snap.jit[snap.shared.stubs_key], snap.seeded)
+        except OSError:
+            pass  # the next process compiles what was not kept
 
     def _jit_folder(self) -> Path:
         """A new numba cache folder that the workers (the sandbox user) can write."""
@@ -450,12 +494,13 @@ class _Zygote:
 
     @staticmethod
     def _drop(snap: _Snapshot) -> None:
-        for dirpath, _, _ in os.walk(snap.dest.parent):
-            try:
-                os.chmod(dirpath, 0o755)
-            except OSError:
-                pass
-        shutil.rmtree(snap.dest.parent, ignore_errors=True)
+        if snap.shared is None:  # a persistent snapshot (trusted code) is kept for later runs
+            for dirpath, _, _ in os.walk(snap.dest.parent):
+                try:
+                    os.chmod(dirpath, 0o755)
+                except OSError:
+                    pass
+            shutil.rmtree(snap.dest.parent, ignore_errors=True)
         for folder in snap.jit.values():
             shutil.rmtree(folder, ignore_errors=True)
 
@@ -525,8 +570,9 @@ class _Zygote:
         except Exception:  # noqa: BLE001
             self.proc.kill()
         for snap in self.snapshots.values():
-            for dirpath, _, _ in os.walk(snap.dest.parent):
-                os.chmod(dirpath, 0o755)
+            if snap.shared is None:  # a persistent snapshot is not in scratch_root: kept
+                for dirpath, _, _ in os.walk(snap.dest.parent):
+                    os.chmod(dirpath, 0o755)
         shutil.rmtree(self.scratch_root, ignore_errors=True)
 
 
@@ -639,6 +685,17 @@ def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
     return stubs
 
 
+def _trusted(lab: str, lab_dir: Path, stubs: Path | None) -> bool:
+    """Whether ``lab_dir`` is the course's own code (its solutions or stubs of ``lab``, as the
+    :class:`~geomlib.grading.course.Course` knows them) graded with the course's own stubs: the
+    only code whose compiled kernels are kept between runs (:mod:`geomlib.grading.kernelcache`)."""
+    from geomlib.grading.course import course
+
+    paths = course().lab(lab)
+    own = {paths.solution.resolve(), paths.stubs.resolve()}
+    return lab_dir.resolve() in own and (stubs is None or stubs.resolve() == paths.stubs.resolve())
+
+
 def _not_allowed(lab: str) -> dict[str, str]:
     """The lab's blacklist (:mod:`geomlib.grading.blacklist`), read once per run."""
     from geomlib.grading import blacklist, impl
@@ -702,7 +759,7 @@ def call(
         raise GraderError(f"grader problem (not your code): cannot pass the inputs of {function} ({e})") from None
     lab_dir = Path(lab_dir)
     stubs = _stubs_dir(lab, lab_dir)
-    snap, jit = z.snapshot(lab_dir, stubs)
+    snap, jit = z.snapshot(lab_dir, stubs, trusted=_trusted(lab, lab_dir, stubs))
     max_bytes = max(tolerances.RESULT_MIN_MB << 20, tolerances.RESULT_INPUT_FACTOR * _input_bytes(args, kwargs))
     req = z.request(
         {
@@ -720,6 +777,7 @@ def call(
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)
+    z.publish(lab_dir)
     if reply.get("shader"):
         from geomlib.grading import shader_watch
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from geomlib.grading.tolerances import PICTURE_TIME_S
 
-__all__ = ["VARIABLES", "GradingSettings", "env", "env_float", "markdown_table"]
+__all__ = ["VARIABLES", "GradingSettings", "env", "env_float", "kernel_cache_dir", "markdown_table"]
 
 #: Every ``GEOMLIB_*`` environment variable: what it does (one line each; docs/autograder.md lists them).
 VARIABLES: dict[str, str] = {
@@ -38,6 +38,7 @@ VARIABLES: dict[str, str] = {
     "GEOMLIB_SANDBOX_HIDE": "extra folders (os.pathsep-separated) student code may not read",
     "GEOMLIB_LANDLOCK": "`0`: do not use Landlock (to test the protection of a kernel without it)",
     "GEOMLIB_SECCOMP": "`0`: do not install the network filter (to test what it blocks)",
+    "GEOMLIB_KERNEL_CACHE": "where the compiled kernels of the course's own `solutions/` and `labs/` are kept between grading runs (default `$XDG_CACHE_HOME/geomlib-kernels`, else `~/.cache/geomlib-kernels`); `off`: nowhere (each run compiles)",
     "GEOMLIB_STUBS": "the folder of the course's stubs (default `labs/` of the course), for shader-task messages",
     "GEOMLIB_AUTOGRADER_PYTHON": "the Python 3.11 `grade-all` builds the autograder's environment with",
     "GEOMLIB_AUTOGRADER_ROOT": "the autograder's folder in `setup.sh`/`run_autograder` (default `/autograder`)",
@@ -61,6 +62,22 @@ def env_float(name: str) -> float | None:
     """A numeric variable: its value as a float, None when unset or empty."""
     value = env(name)
     return float(value) if value else None
+
+
+def kernel_cache_dir() -> Path | None:
+    """Where :mod:`geomlib.grading.kernelcache` keeps trusted compiled kernels (None: ``off``).
+
+    ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib-kernels``, else ``~/.cache/geomlib-kernels``
+    (the XDG base-directory rule; read here, the one place the tooling reads the environment).
+    """
+    given = (env("GEOMLIB_KERNEL_CACHE") or "").strip()
+    if given.lower() in ("off", "0", "no", "none"):
+        return None
+    if given:
+        return Path(given)
+    xdg = os.environ.get("XDG_CACHE_HOME", "")
+    base = Path(xdg) if os.path.isabs(xdg) else Path(os.path.expanduser("~")) / ".cache"
+    return base / "geomlib-kernels"
 
 
 def _picture_cap() -> int | None:
