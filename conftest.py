@@ -86,7 +86,7 @@ SPLIT_BY = {"tests/test_figures_reproduce.py": "lab"}
 #: order matters: the longest are handed out first and the short ones fill in. Units not listed are
 #: short and follow, in collection order.
 SECONDS: dict[str, float] = {
-    "tests/solutions/test_deterministic.py": 130,
+    "tests/solutions/test_deterministic.py": 105,
     "tests/framework/test_release_course.py": 80,
     "tests/test_notebooks.py::test_notebook_executes[remeshing]": 75,
     "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[remeshing]": 58,
