@@ -85,11 +85,10 @@ SPLIT_BY = {"tests/test_figures_reproduce.py": "lab"}
 #: 2026-11-27 (869 s; modules and tests below its 30 slowest estimated from the loaded run). Only the
 #: order matters: the longest are handed out first and the short ones fill in. Units not listed are
 #: short and follow, in collection order. Rescaled since by the CPU time measured before and after a
-#: change to the unit (cgroup, same load): test_course_object x0.62, test_release_course x0.92,
-#: test_batch's grade-all as root x1.08 (it took over test_release_course's grade-all).
+#: change to the unit (cgroup, same load): test_course_object x0.62, test_deterministic x0.8 (wall).
 SECONDS: dict[str, float] = {
-    "tests/solutions/test_deterministic.py": 130,
-    "tests/framework/test_release_course.py": 73,
+    "tests/solutions/test_deterministic.py": 105,
+    "tests/framework/test_release_course.py": 80,
     "tests/test_notebooks.py::test_notebook_executes[remeshing]": 75,
     "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[remeshing]": 58,
     "tests/test_notebooks.py::test_notebook_executes[shadows]": 51,
@@ -101,7 +100,7 @@ SECONDS: dict[str, float] = {
     "tests/framework/test_fresh_root.py": 29,
     "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[sdf]": 28,
     "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[maps]": 26,
-    "tests/framework/test_batch.py::test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user": 27,
+    "tests/framework/test_batch.py::test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user": 25,
     "tests/solutions/test_sdf.py": 25,
     "tests/test_notebooks.py::test_notebook_executes[denoise]": 24,
     "tests/test_notebooks.py::test_notebook_executes[subdivision]": 23,

@@ -28,6 +28,7 @@ import os
 import sys
 from functools import partial
 from pathlib import Path
+from types import FunctionType
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -68,6 +69,14 @@ def digest(value) -> str:
     return h.hexdigest()
 
 
+def probe_mesh():
+    """A fixed small random mesh ``(V, F)`` (float64, int64) for ``test_deterministic``'s cache probe."""
+    import numpy as np
+
+    rng = np.random.default_rng(24)
+    return rng.random((40, 3)), (np.arange(60)[:, None] + np.array([0, 1, 3])) % 40
+
+
 def runs(lab: str) -> dict:
     """``{run id: (inputs, function)}``: every run of the lab this script knows; it computes ``function(**inputs())``."""
     if str(ROOT) not in sys.path:
@@ -97,17 +106,32 @@ def runs(lab: str) -> dict:
     return out
 
 
-def _record_kernels(labs) -> dict[str, set[str]]:
-    """``{lab: names of the functions of its kernel module that get called}``, filled by a profile hook."""
-    sources = {importlib.util.find_spec(KERNEL_MODULES[lab]).origin: lab for lab in labs if lab in KERNEL_MODULES}
-    called: dict[str, set[str]] = {lab: set() for lab in sources.values()}
+def _record_kernels(labs) -> tuple[dict[str, set[str]], list]:
+    """``({lab: names of the functions of its kernel module that get called}, undo)``.
 
-    def hook(frame, event, arg):
-        if event == "call" and frame.f_code.co_filename in sources and frame.f_code.co_name != "<module>":
-            called[sources[frame.f_code.co_filename]].add(frame.f_code.co_name)
+    Only with ``NUMBA_DISABLE_JIT=1``, when the kernels are plain functions: each function of the
+    kernel module is replaced by one that notes its name and puts the function back, so only the
+    first call of each pays (a profile hook on every call, numpy's included, doubled the run's time).
+    The kernels call each other through the module's globals and the solutions reach them as
+    ``module.name``, so every first call goes through the replacement."""
+    called: dict[str, set[str]] = {}
+    undo = []
+    for lab in labs:
+        if lab not in KERNEL_MODULES:
+            continue
+        module = importlib.import_module(KERNEL_MODULES[lab])
+        called[lab] = names = set()
+        for name, f in list(vars(module).items()):
+            if isinstance(f, FunctionType) and f.__module__ == module.__name__:
 
-    sys.setprofile(hook)
-    return called
+                def first(*args, _name=name, _f=f, _names=names, _module=module, **kwargs):
+                    _names.add(_name)
+                    setattr(_module, _name, _f)
+                    return _f(*args, **kwargs)
+
+                setattr(module, name, first)
+                undo.append((module, name, f))
+    return called, undo
 
 
 def compute(wanted: list[str], record: bool = False) -> dict:
@@ -119,11 +143,12 @@ def compute(wanted: list[str], record: bool = False) -> dict:
         raise KeyError(f"kernel_digests: no run {unknown}; runs: {sorted(available)}")
     inputs = {w: available[w][0]() for w in wanted}
     input_digests = {w: digest(inputs[w]) for w in wanted}  # before the calls (in case one writes to them)
-    called = _record_kernels(labs) if record else {}
+    called, undo = _record_kernels(labs) if record else ({}, [])
     try:
         digests = {w: digest(available[w][1](**inputs[w])) for w in wanted}
     finally:
-        sys.setprofile(None)
+        for module, name, f in undo:
+            setattr(module, name, f)
     return {
         "digests": digests,
         "inputs": input_digests,
