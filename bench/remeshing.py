@@ -15,7 +15,8 @@ not a manifold, oriented triangle mesh is skipped with the reason) and per targe
 0.75x its mean edge, it runs ``isotropic_remesh(V, F, h)`` with its defaults and gpytoolbox's
 ``remesh_botsch`` (``--iterations``, boundary kept, same h), then prints one table over the whole
 set: faces, minimum angle, edge-length std / mean, Hausdorff distance to the input relative to
-its bbox diagonal (``geomlib.geometry.mesh_distance``) and time (best of 2), ours / gpytoolbox
+its bbox diagonal (``geomlib.geometry.mesh_distance``) and time (best of ``--repeat``, default 2; wall
+clock, or with ``--cpu`` each process's CPU time, steadier on a loaded machine), ours / gpytoolbox
 with the ratios, and a summary line of the targets (met / not met): minimum angle no worse on
 every case, Hausdorff <= 1.15x on every case and <= 1x in geometric mean, time <= 1x. Other
 tools (``--tools trueform CGAL``) are listed below it. It also reports the kernels' first-call
@@ -47,7 +48,8 @@ from solutions.remeshing.figures import quality as mesh_quality
 ROOT = Path(__file__).resolve().parents[1]
 
 # Each tool runs in the throwaway environment: it reads in.npz (V, F, h, its, feature_edges or the
-# feature angle) and writes out.npz (V, F, t = best time of 2, timed inside that process).
+# feature angle, the clock and the number of runs) and writes out.npz (V, F, t = best time of the
+# runs, timed inside that process).
 TOOL_SCRIPTS = {
     "gpytoolbox": r"""
 import sys, time, numpy as np
@@ -56,10 +58,11 @@ d = np.load(sys.argv[1])
 V, F, h, its = d["V"], d["F"].astype(np.int32), float(d["h"]), int(d["its"])
 fe = d["feature_edges"].reshape(-1, 2).astype(np.int32)
 best = np.inf
-for _ in range(2):
-    t = time.perf_counter()
+clock = time.process_time if int(d["cpu"]) else time.perf_counter
+for _ in range(int(d["repeat"])):
+    t = clock()
     U, G = remesh_botsch(V, F, i=its, h=h, feature_edges=fe if len(fe) else None, project=True)
-    best = min(best, time.perf_counter() - t)
+    best = min(best, clock() - t)
 np.savez(sys.argv[2], V=U, F=G, t=best)
 """,
     # trueform splits edges longer than target_length (not 4/3 of it) and relaxes 3 times per
@@ -70,10 +73,11 @@ import trueform as tf
 d = np.load(sys.argv[1])
 V, F, h, its, fa = d["V"], d["F"].astype(np.int32), float(d["h"]), int(d["its"]), float(d["feature_angle"])
 best = np.inf
-for _ in range(2):
-    t = time.perf_counter()
+clock = time.process_time if int(d["cpu"]) else time.perf_counter
+for _ in range(int(d["repeat"])):
+    t = clock()
     G, U = tf.isotropic_remeshed((F, V), h, iterations=its, feature_angle=fa)
-    best = min(best, time.perf_counter() - t)
+    best = min(best, clock() - t)
 np.savez(sys.argv[2], V=U, F=G, t=best)
 """,
     # CGAL's Python bindings (SWIG) take a Polyhedron_3, built from an OFF file; features are not
@@ -92,11 +96,12 @@ with open(os.path.join(tmp, "in.off"), "w") as f:
     np.savetxt(f, V, fmt="%.17g")
     np.savetxt(f, np.column_stack([np.full(len(F), 3), F]), fmt="%d")
 best = np.inf
-for _ in range(2):
+clock = time.process_time if int(d["cpu"]) else time.perf_counter
+for _ in range(int(d["repeat"])):
     P = Polyhedron_3(os.path.join(tmp, "in.off"))
-    t = time.perf_counter()
+    t = clock()
     PMP.isotropic_remeshing([f for f in P.facets()], h, P, its)
-    best = min(best, time.perf_counter() - t)
+    best = min(best, clock() - t)
 P.write_to_file(os.path.join(tmp, "out.off"))
 lines = open(os.path.join(tmp, "out.off")).read().split()
 n, m = int(lines[1]), int(lines[2])
@@ -144,13 +149,15 @@ def meshes(quick: bool, folder: Path, only: list[str] | None = None) -> tuple[li
         if only:  # in the order asked for (small meshes first keeps a loaded run's early rows)
             out.sort(key=lambda c: only.index(c[0]))
     else:
+        if not quick:
+            print(f"no folder {folder}: the built-in meshes instead (give the shared set with --meshes)")
         V, F = datasets.icosphere(4)
         out.append(("bumpy sphere", datasets.add_noise(V, 0.01, seed=0, direction="normal", F=F), F))
         out.append(("height field", *datasets.height_field(48)))
     return out, skipped
 
 
-def run_tool(tool, py, V, F, h, its, feature_angle):
+def run_tool(tool, py, V, F, h, its, feature_angle, cpu=False, repeat=2):
     """Run ``tool`` (a key of :data:`TOOL_SCRIPTS`) in the environment of ``py``: (V, F, time) or (None, why)."""
     with tempfile.TemporaryDirectory() as tmp:
         feat = np.zeros((0, 2), np.int64)
@@ -159,7 +166,7 @@ def run_tool(tool, py, V, F, h, its, feature_angle):
 
             feat = sharp_edges(V, F, feature_angle)
         fa = -1.0 if feature_angle is None else float(feature_angle)
-        np.savez(f"{tmp}/in.npz", V=V, F=F, h=h, its=its, feature_edges=feat, feature_angle=fa)
+        np.savez(f"{tmp}/in.npz", V=V, F=F, h=h, its=its, feature_edges=feat, feature_angle=fa, cpu=cpu, repeat=repeat)
         script = TOOL_SCRIPTS[tool]
         r = subprocess.run([py, "-c", script, f"{tmp}/in.npz", f"{tmp}/out.npz"], capture_output=True, text=True)
         if r.returncode:
@@ -232,6 +239,10 @@ def main() -> None:
     ap.add_argument("--gpy-python", default="/tmp/gpyvenv/bin/python")
     ap.add_argument("--tools", nargs="*", default=["gpytoolbox"], help=f"contenders among {list(TOOL_SCRIPTS)}")
     ap.add_argument("--json", type=Path, help="also write the cases here")
+    ap.add_argument("--repeat", type=int, default=2, help="runs per case and tool, the best time counts")
+    ap.add_argument(
+        "--cpu", action="store_true", help="time = CPU time of the process (time.process_time): steadier under load"
+    )
     ap.add_argument("--no-first-call", action="store_true", help="skip measuring the compile and cache-load cost")
     args = ap.parse_args()
     tools = [
@@ -243,6 +254,7 @@ def main() -> None:
     for t in args.tools:
         if t not in tools:
             print(f"{t} not found at {args.gpy_python}: its comparison is skipped (see the module docstring)")
+    clock = time.process_time if args.cpu else time.perf_counter
     costs = {} if args.no_first_call else first_call_costs()
     print(
         "first call of isotropic_remesh (tiny mesh, fresh process): "
@@ -259,13 +271,13 @@ def main() -> None:
         for factor in FACTORS:
             h = factor * mean_edge_length(V, F)
             best, res = np.inf, None
-            for _ in range(2):
-                t = time.perf_counter()
+            for _ in range(args.repeat):
+                t = clock()
                 res = isotropic_remesh(V, F, h, iterations=args.iterations)
-                best = min(best, time.perf_counter() - t)
+                best = min(best, clock() - t)
             ours = {"time": best, **quality(V, F, *res)}
             for tool in tools:
-                g, err = run_tool(tool, args.gpy_python, V, F, h, args.iterations, None)
+                g, err = run_tool(tool, args.gpy_python, V, F, h, args.iterations, None, args.cpu, args.repeat)
                 if g is None:
                     print(f"{name} at {factor}x: {tool}: {err}")
                     continue
@@ -274,7 +286,7 @@ def main() -> None:
                     cases.append({"mesh": name, "factor": factor, "h": h, "ours": ours, "gpy": q})
                 else:
                     others.append((name, factor, tool, q))
-            print(f"{name} at {factor}x (h = {h:.4g}) done", flush=True)
+            print(f"{name} at {factor}x (h = {h:.4g}) done, load {os.getloadavg()[0]:.1f}", flush=True)
             if cases and cases[-1]["mesh"] == name and cases[-1]["factor"] == factor:
                 print(table(cases[-1:]).splitlines()[2], flush=True)  # the row now: a run cut short keeps it
     cols = ("time", "faces", "min_angle", "below_30", "edge_cv", "valence6", "hausdorff")
@@ -287,7 +299,8 @@ def main() -> None:
         print(
             f"isotropic_remesh(V, F, h) (defaults) / gpytoolbox remesh_botsch ({args.iterations} iterations, "
             "boundary kept, same h); h in multiples of the input's mean edge; Hausdorff distance to the "
-            "input relative to its bounding-box diagonal; time best of 2"
+            f"input relative to its bounding-box diagonal; time ({'CPU' if args.cpu else 'wall'}) best of {args.repeat}; "
+            f"load average {', '.join(f'{x:.1f}' for x in os.getloadavg())}"
         )
         print(table(cases))
     if args.json:

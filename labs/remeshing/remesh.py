@@ -20,6 +20,7 @@ from .adaptive import adaptive_target_length
 from .stages import (
     SurfaceProjector,
     _closest_on_segments,
+    _collapse_all,
     _relax,
     _split_all,
     clean_slivers,
@@ -64,13 +65,13 @@ def isotropic_remesh(
 ):
     """Remesh a triangle mesh toward equilateral triangles with edges of about ``target_length``.
 
-    Each iteration: split edges longer than ``4/3 L``; collapse edges shorter than ``4/5 L``;
-    flip edges to bring valences toward 6 (4 on the boundary); ``relax_steps`` steps of tangential
-    relaxation; projection of the vertices back onto the input (feature-line and boundary vertices
-    onto the input's lines, the others onto its surface). After the last iteration,
-    :func:`~.stages.clean_slivers` flips or collapses away the faces with an angle below 30° where
-    that raises the smallest angle around them, then moves the vertices of faces below 40° toward
-    the centroid of their neighbours (on the surface) where that raises it.
+    Each iteration: split edges longer than ``1.4 L``; collapse edges shorter than ``0.7 L`` (none
+    touching the preserved boundary); flip edges to bring valences toward 6 (4 on the boundary);
+    ``relax_steps`` steps of tangential relaxation; projection of the vertices back onto the input
+    (feature-line and boundary vertices onto the input's lines, the others onto its surface). After
+    the last iteration, :func:`~.stages.clean_slivers` flips or collapses away the faces with an
+    angle below 30° where that raises the smallest angle around them, then moves the vertices of
+    faces below 40° toward the centroid of their neighbours (on the surface) where that raises it.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear
@@ -108,4 +109,4 @@ def isotropic_remesh(
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     L, field = _target_field(target_length, len(V0), bool(adaptive), V0, F0, where)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
-    raise NotImplementedError('Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat; then the given clean_slivers(S, project=project)')
+    raise NotImplementedError('Task 10 (the loop): split > 1.4 L, collapse < 0.7 L (the given _collapse_all(S)), flip, relax, project; repeat; then the given clean_slivers(S, project=project)')

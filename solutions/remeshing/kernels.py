@@ -45,6 +45,8 @@ RING = 256
 OK, LINK, FLIP, LONG, CONSTRAINED, VALENCE, FULL = 0, 1, 2, 3, 4, 5, 6
 #: A flip is refused when a new face's normal turns by more than 60° from either old face's
 #: (cos 60° = 0.5): flipping across a ridge would cut it off the surface (as gpytoolbox's remesher).
+#: A collapse is refused when a face around it turns by more than that (gpytoolbox's bound too;
+#: against ~78°, cos = 0.2, it keeps slivers out of coarse meshes: spot's cage 8.5° -> 36.3°).
 FLIP_COS = 0.5
 
 
@@ -294,7 +296,7 @@ def collapse_check(V, F, T, VH, val, cls, feat, h, p, high, hes, nb1, nb2):
             n1 = normal_at(p[0], p[1], p[2], V, x, y)
             l0 = np.sqrt(dot(n0, n0))
             l1 = np.sqrt(dot(n1, n1))
-            if l1 <= 1e-12 * (1.0 + l0) or dot(n0, n1) < 0.2 * l0 * l1:
+            if l1 <= 1e-12 * (1.0 + l0) or dot(n0, n1) < FLIP_COS * l0 * l1:
                 return FLIP
     return OK
     # END SOLUTION
@@ -438,7 +440,7 @@ def split_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low, start, stop)
     same pass would split the spokes of one vertex forever (each split leaves a spoke of about the
     triangle's height). Returns ``(splits, h)``; ``h < stop`` means the pass stopped for room.
     """
-    # BEGIN SOLUTION: Task 4 (split long edges): every edge with |e| > 4/3 L at its midpoint, one pass over the edges present at the start
+    # BEGIN SOLUTION: Task 4 (split long edges): every edge with |e| > high (1.4 L in the loop) at its midpoint, one pass over the edges present at the start
     done = 0
     for h in range(start, stop):
         if not falive[h // 3] or (T[h] >= 0 and h > T[h]):
@@ -463,7 +465,7 @@ def collapse_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, low):
     ``high``, ``low`` as in :func:`split_pass`: an edge is short below the smaller ``low`` of its
     ends, and the collapse may not create an edge longer than the smaller ``high`` of its ends.
     """
-    # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < 4/5 L, keep constrained vertices in place, midpoint (else an end) otherwise
+    # BEGIN SOLUTION: Task 5 (collapse short edges): |e| < low (0.7 L in the loop), keep constrained vertices in place, midpoint (else an end) otherwise
     hes = np.empty(RING, np.int64)
     nb1 = np.empty(RING, np.int64)
     nb2 = np.empty(RING, np.int64)

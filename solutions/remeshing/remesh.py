@@ -20,6 +20,7 @@ from .adaptive import adaptive_target_length
 from .stages import (
     SurfaceProjector,
     _closest_on_segments,
+    _collapse_all,
     _relax,
     _split_all,
     clean_slivers,
@@ -64,13 +65,13 @@ def isotropic_remesh(
 ):
     """Remesh a triangle mesh toward equilateral triangles with edges of about ``target_length``.
 
-    Each iteration: split edges longer than ``4/3 L``; collapse edges shorter than ``4/5 L``;
-    flip edges to bring valences toward 6 (4 on the boundary); ``relax_steps`` steps of tangential
-    relaxation; projection of the vertices back onto the input (feature-line and boundary vertices
-    onto the input's lines, the others onto its surface). After the last iteration,
-    :func:`~.stages.clean_slivers` flips or collapses away the faces with an angle below 30° where
-    that raises the smallest angle around them, then moves the vertices of faces below 40° toward
-    the centroid of their neighbours (on the surface) where that raises it.
+    Each iteration: split edges longer than ``1.4 L``; collapse edges shorter than ``0.7 L`` (none
+    touching the preserved boundary); flip edges to bring valences toward 6 (4 on the boundary);
+    ``relax_steps`` steps of tangential relaxation; projection of the vertices back onto the input
+    (feature-line and boundary vertices onto the input's lines, the others onto its surface). After
+    the last iteration, :func:`~.stages.clean_slivers` flips or collapses away the faces with an
+    angle below 30° where that raises the smallest angle around them, then moves the vertices of
+    faces below 40° toward the centroid of their neighbours (on the surface) where that raises it.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear
@@ -108,18 +109,18 @@ def isotropic_remesh(
     steps = check_int(relax_steps, "relax_steps", where=where, minimum=0)
     L, field = _target_field(target_length, len(V0), bool(adaptive), V0, F0, where)
     fe = None if feature_angle is None else sharp_edges(V0, F0, feature_angle)
-    # BEGIN SOLUTION: Task 10 (the loop): split > 4/3 L, collapse < 4/5 L, flip, relax, project; repeat; then the given clean_slivers(S, project=project)
+    # BEGIN SOLUTION: Task 10 (the loop): split > 1.4 L, collapse < 0.7 L (the given _collapse_all(S)), flip, relax, project; repeat; then the given clean_slivers(S, project=project)
     S = make_state(V0, F0, fe, preserve_boundary=preserve_boundary, where=where, H=H0)
     E0 = S.feature_edges()
     A0, B0 = V0[E0[:, 0]], V0[E0[:, 1]]
     project = SurfaceProjector(V0, F0)
     n0 = len(V0)
-    S.high[:n0] = 4.0 / 3.0 * (L if field is None else field)
-    S.low[:n0] = 4.0 / 5.0 * (L if field is None else field)
+    # high = 2 low: the halves of a split edge are not short (with 4/3 and 4/5 they are, 2/3 L)
+    S.high[:n0] = 1.4 * (L if field is None else field)
+    S.low[:n0] = 0.7 * (L if field is None else field)
     for _ in range(its):
         _split_all(S)
-        while K.collapse_pass(*S.args(), S.high, S.low):
-            pass
+        _collapse_all(S)
         S.compact()  # the collapses left dead rows: the next passes skip them
         for _ in range(3):
             if not K.flip_pass(*S.args()):
@@ -135,7 +136,7 @@ def isotropic_remesh(
         face, Vn[free] = project.closest(Vn[free])
         if field is not None:  # the target where the vertex now is
             h = project.interpolate(field, face, Vn[free])
-            S.high[:n][free], S.low[:n][free] = 4.0 / 3.0 * h, 4.0 / 5.0 * h
+            S.high[:n][free], S.low[:n][free] = 1.4 * h, 0.7 * h
         line = cls == 1
         if line.any() and len(E0):
             Vn[line] = _closest_on_segments(Vn[line], A0, B0)

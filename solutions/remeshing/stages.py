@@ -85,6 +85,31 @@ def _split_all(S: RemeshState) -> int:
         S.grow()
 
 
+def _collapse_all(S: RemeshState) -> int:
+    """The loop's collapse stage (given): collapse passes (:func:`.kernels.collapse_pass`) until one
+    collapses nothing, with no collapse touching a vertex of the preserved boundary; returns the collapses.
+
+    The collapse pass lets a free vertex merge into its boundary neighbour and the boundary itself
+    lose vertices (Task 5); in the loop each boundary collapse would cut a chord across the input's
+    boundary. gpytoolbox's remesher keeps its boundary vertices out of every collapse the same way.
+    The boundary is still split and its vertices still slide along it.
+    """
+    m = S.cnt[1]
+    h = np.flatnonzero((S.T[: 3 * m] < 0) & np.repeat(S.falive[:m], 3))
+    ends = np.unique(np.r_[S.F.ravel()[h], S.F[h // 3, (h % 3 + 1) % 3]])
+    ends = ends[S.cls[ends] > 0]  # the preserved boundary (a free boundary may move and collapse)
+    keep = S.low[ends].copy()
+    S.low[ends] = 0.0  # an edge is short below the smaller bound of its ends: never at these
+    total = 0
+    while True:
+        done = K.collapse_pass(*S.args(), S.high, S.low)
+        total += done
+        if not done:
+            break
+    S.low[ends] = keep
+    return total
+
+
 #: Faces with a smaller angle (degrees) are cleaned up at the end of the loop (:func:`clean_slivers`).
 SLIVER_ANGLE = 30.0
 

@@ -50,7 +50,7 @@ def projection_points(make, seed):
 # common thresholds (solution on all seven graded meshes: min angle 18.4-33.6°, share < 30° at most
 # 0.0065, edge std/mean at most 0.17, valence-6 share at least 0.73)
 QUALITY = {"min_angle": 12.0, "below_30": 0.02, "edge_cv": 0.25, "valence6": 0.65}
-LOOP_HINT = "split > 4/3 L, collapse < 4/5 L (checks!), flip for valence, relax in the tangent plane, project"
+LOOP_HINT = "split > 1.4 L, collapse < 0.7 L (checks!), flip for valence, relax in the tangent plane, project"
 
 # What a check needs from an earlier task is stored by `geomlib refs build` from the solution and
 # read back with `stored_input`, never computed here: the adaptive targets of the input.
