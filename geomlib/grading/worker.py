@@ -84,6 +84,11 @@ _STUB_STAT: dict = {}
 _STUB_CODE: dict = {}
 #: ``id(stub tree) -> (task names, given names)`` (:func:`merge_module`), for the trees in ``_TREES``.
 _STUB_NAMES: dict = {}
+#: ``id(stub tree) -> (tree, names it defines)`` (:func:`_defines`, asked of every stub file at every
+#: call) and ``id(stub task function) -> (function, its validation prefix, ast.dump of each of its
+#: statements)`` (:func:`_merged_task`); worked out in the zygote too (:func:`prepare_stubs`).
+_STUB_DEFINES: dict = {}
+_STUB_PREFIX: dict = {}
 
 
 def prepare_stubs(stubs_dir: str | None) -> None:
@@ -104,7 +109,9 @@ def prepare_stubs(stubs_dir: str | None) -> None:
         old = _TREES.pop((str(path), False), None)
         for stmt in getattr(old, "body", ()):  # their ids may be reused once the old tree is freed
             _STUB_CODE.pop(id(stmt), None)
+            _STUB_PREFIX.pop(id(stmt), None)
         _STUB_NAMES.pop(id(old), None)
+        _STUB_DEFINES.pop(id(old), None)
         _STUB_STAT[str(path)] = digest
         try:
             tree = _TREES[(str(path), False)] = ast.parse(data.decode("utf-8"), filename=str(path))
@@ -115,7 +122,10 @@ def prepare_stubs(stubs_dir: str | None) -> None:
             tasks,
             set().union(*(_bound_names(s) for s in tree.body)) - tasks if tree.body else set(),
         )
+        _stub_defines(tree)
         for stmt in tree.body:
+            if isinstance(stmt, ast.FunctionDef | ast.AsyncFunctionDef) and stmt.name in tasks:
+                _stub_prefix(stmt)
             try:
                 _STUB_CODE[id(stmt)] = compile(
                     ast.Module(body=[stmt], type_ignores=[]), str(path), "exec", flags=flags, dont_inherit=True
@@ -197,6 +207,20 @@ def _defines(tree: ast.Module, name: str) -> bool:
     return False
 
 
+def _stub_defines(tree: ast.Module) -> frozenset:
+    """The names a course stub defines (as :func:`_defines` counts them), worked out once per tree."""
+    known = _STUB_DEFINES.get(id(tree))
+    if known is None or known[0] is not tree:
+        names = frozenset(
+            n
+            for node in tree.body
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef | ast.Assign | ast.AnnAssign)
+            for n in ({node.name} if hasattr(node, "name") else _bound_names(node))
+        )
+        known = _STUB_DEFINES[id(tree)] = (tree, names)
+    return known[1]
+
+
 def _imports(tree: ast.Module, name: str) -> bool:
     return any(isinstance(n, ast.Import | ast.ImportFrom) and name in _bound_names(n) for n in tree.body)
 
@@ -204,13 +228,28 @@ def _imports(tree: ast.Module, name: str) -> bool:
 # ---------------------------------------------------------------------------------- merging
 
 
-def _relocate(node: ast.AST, line: int) -> ast.AST:
-    node = copy.deepcopy(node)
-    for sub in ast.walk(node):
-        if "lineno" in sub._attributes:
-            sub.lineno = sub.end_lineno = line
-            sub.col_offset = sub.end_col_offset = 0
-    return node
+def _relocate(node, line: int):
+    """A copy of ``node`` with every position at ``line``, column 0 (the stub's code merged into a
+    student's function reports that function's line). A plain recursive copy: ``copy.deepcopy``
+    of a syntax tree costs a few times more, and a worker merges every task of a module per call."""
+    if isinstance(node, list):
+        return [_relocate(x, line) for x in node]
+    if not isinstance(node, ast.AST):
+        return node  # str, int, None, a constant's value: not changed by anyone
+    new = node.__class__.__new__(node.__class__)
+    for name in node._fields:
+        try:
+            setattr(new, name, _relocate(getattr(node, name), line))
+        except AttributeError:  # an optional field left unset
+            pass
+    if "lineno" in node._attributes:
+        new.lineno = new.end_lineno = line
+        new.col_offset = new.end_col_offset = 0
+    else:
+        for name in node._attributes:
+            if hasattr(node, name):
+                setattr(new, name, getattr(node, name))
+    return new
 
 
 def _task_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
@@ -221,13 +260,22 @@ def _task_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
     return []
 
 
+def _stub_prefix(stub_fn: ast.FunctionDef) -> tuple[list[ast.stmt], list[str]]:
+    """:func:`_task_prefix` and the ``ast.dump`` of each of its statements, once per stub function."""
+    known = _STUB_PREFIX.get(id(stub_fn))
+    if known is None or known[0] is not stub_fn:
+        prefix = _task_prefix(stub_fn)
+        known = _STUB_PREFIX[id(stub_fn)] = (stub_fn, prefix, [ast.dump(s) for s in prefix])
+    return known[1], known[2]
+
+
 def _merged_task(stub_fn: ast.FunctionDef, student_fn: ast.FunctionDef) -> ast.FunctionDef:
     """The student's task function with the stub's signature and the stub's leading validation."""
     line = student_fn.lineno
-    prefix = _task_prefix(stub_fn)
+    prefix, dumps = _stub_prefix(stub_fn)
     body = list(student_fn.body)
     common = 0
-    while common < min(len(prefix), len(body)) and ast.dump(prefix[common]) == ast.dump(body[common]):
+    while common < min(len(prefix), len(body)) and dumps[common] == ast.dump(body[common]):
         common += 1
     missing = [_relocate(s, line) for s in prefix[common:]]
     fn = copy.copy(student_fn)
@@ -380,7 +428,7 @@ def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None
         return getattr(importlib.import_module(f"{pkg_name}.{stem}"), function, None)
 
     for stem, tree in stub_trees:
-        if _defines(tree, function):
+        if function in _stub_defines(tree):
             tasks = _STUB_NAMES[id(tree)][0] if id(tree) in _STUB_NAMES else task_names(tree)  # the zygote's
             if function in tasks and not _student_defines(lab_dir / f"{stem}.py", function):
                 # The student moved the task to a file of their own.
