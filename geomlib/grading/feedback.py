@@ -144,10 +144,10 @@ def _mesh_edges(F, limit: int = 6000) -> np.ndarray:
 
 def _error_cmap():
     """inferno without its palest yellow: the largest errors stay visible on a white page."""
+    from matplotlib import colormaps
     from matplotlib.colors import ListedColormap
-    from matplotlib.pyplot import get_cmap
 
-    return ListedColormap(get_cmap("inferno")(np.linspace(0.0, 0.82, 256)), name="inferno_dark")
+    return ListedColormap(colormaps["inferno"](np.linspace(0.0, 0.82, 256)), name="inferno_dark")
 
 
 def _three_panel_figure(title: str, captions, *, three_d: bool, flat: bool = False):
@@ -343,7 +343,8 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
         return None
 
     def draw():
-        from matplotlib.collections import LineCollection
+        from geomlib import plot
+        from geomlib.grading.scatter import Panel
 
         e, g = np.asarray(expected, float), np.asarray(got, float)
         err = _errors(e, g)
@@ -354,30 +355,25 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
             f"yours ({int(bad.sum())} of {len(e)} rows wrong)",
             f"difference: |{name} error| (max {err.max():.3g})",
         ]
-        fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=False)
         pts = np.vstack([e[:, :2], g[gf, :2]])
         pts = pts[np.isfinite(pts).all(axis=1)]
         lo, hi = (pts.min(axis=0), pts.max(axis=0)) if len(pts) else (np.zeros(2), np.ones(2))
         pad = 0.05 * max(float((hi - lo).max()), 1e-12)
         vmax = max(float(err.max()), 1e-12)
-        axes[0].scatter(e[:, 0], e[:, 1], s=10, c="#1f77b4", zorder=2)
-        axes[1].scatter(g[gf, 0], g[gf, 1], s=14, c="#ff7f0e", marker="x", zorder=3)
-        both = bad & gf
-        axes[2].scatter(e[~bad, 0], e[~bad, 1], s=6, c="0.75", zorder=1)
-        if both.any():
-            lines = LineCollection(np.stack([e[both, :2], g[both, :2]], axis=1), cmap=_error_cmap(), linewidths=1.5)
-            lines.set_array(err[both])
-            lines.set_clim(0.0, vmax)
-            axes[2].add_collection(lines)
-        hs = axes[2].scatter(e[bad, 0], e[bad, 1], s=12, c=err[bad], cmap=_error_cmap(), vmin=0.0, vmax=vmax, zorder=3)
-        fig.colorbar(hs, ax=axes[2], shrink=0.8, label=f"|{name} error|")
-        for ax in axes:
-            ax.set_xlim(lo[0] - pad, hi[0] + pad)
-            ax.set_ylim(lo[1] - pad, hi[1] + pad)
-            ax.set_aspect("equal", adjustable="box")
-            ax.set_xlabel(f"{name}[:, 0]")
-            ax.set_ylabel(f"{name}[:, 1]")
-        _save(fig, plt, path)
+        cmap = _error_cmap()
+        axes = [Panel(lo - pad, hi + pad, f"{name}[:, 0]", f"{name}[:, 1]") for _ in range(3)]
+        ef = np.isfinite(e[:, :2]).all(axis=1)
+        axes[0].dots(e[ef, :2], "#1f77b4", radius=1.8)
+        axes[1].crosses(g[gf, :2], "#ff7f0e")
+        both = bad & gf & ef
+        axes[2].dots(e[~bad & ef, :2], (0.75, 0.75, 0.75), radius=1.4)
+        colors = cmap(np.clip(err / vmax, 0.0, 1.0))
+        axes[2].segments(e[both, :2], g[both, :2], colors[both])
+        axes[2].dots(e[bad & ef, :2], colors[bad & ef], radius=2.0)
+        a, b, c = (ax.image() for ax in axes)
+        bar = plot.colorbar(0.0, vmax, cmap=cmap, label=f"|{name} error|", height=c.shape[0])
+        img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
+        plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
 

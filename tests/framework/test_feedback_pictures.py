@@ -365,6 +365,29 @@ def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, 
     assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
 
 
+def test_a_free_points_picture_needs_no_matplotlib_figure(tmp_path):
+    """Shadows' wrong (u, v, z) is the first picture of its --task 3: drawn with Pillow, not a
+    matplotlib figure (importing matplotlib.figure and a tight savefig cost about 0.5 s of the 3 s a
+    student waits for --task N). Three panels, as every kind (test above)."""
+    code = textwrap.dedent(
+        f"""
+        import sys
+        import numpy as np
+        from geomlib.grading import feedback
+        from geomlib.grading.checks import Context
+
+        feedback._drawn_in_time = lambda path, draw: (draw(), str(path))[1]
+        p = np.random.default_rng(0).random((50, 3))
+        ctx = Context(label="light_uvz", lab="kinds", case_id="uvz", feedback_dir={str(tmp_path)!r})
+        path = feedback.default_picture(ctx, {{}}, {{"uvz": p}}, {{"uvz": p + [0.05, 0, 0]}})
+        print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, out
+    assert out[1:] == ["[]"], f"the picture imported {out[1:]}"
+
+
 def _file(text: str) -> str:
     return re.sub(r"\W+", "_", text)
 
