@@ -284,6 +284,8 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, got=None, suf
     them; without it, each point's nearest vertex of ``V`` (the submitted mesh's closest offer)."""
     P = np.asarray(points, float).reshape(-1, 3)
     yours = "yours"
+    if got is None and not _picture_allowed():
+        got = P  # no picture this time (rows_picture counts it as held back): no nearest vertices either
     if got is None:
         Vf = np.asarray(V, float)
         yours = "the nearest vertex of the mesh to each"

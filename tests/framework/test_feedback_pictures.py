@@ -450,6 +450,27 @@ def test_a_run_draws_the_first_failures_picture_unless_asked_for_all(tmp_path, m
         feedback.pictures_for_run("some")
 
 
+def test_a_marked_picture_past_the_runs_cap_prepares_nothing(tmp_path, monkeypatch):
+    """shadows' ray-casting test marks the points where it disagrees; once the run's picture is drawn
+    (the first failure's), the next marked picture is only counted as held back: its nearest
+    vertices (a k-d tree, and scipy.spatial imported in the grader) are not looked up."""
+    import scipy.spatial
+
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES", raising=False)
+    looked_up = []
+    real = scipy.spatial.cKDTree
+    monkeypatch.setattr(scipy.spatial, "cKDTree", lambda *a, **k: (looked_up.append(1), real(*a, **k))[1])
+    V, F = OCTA_V, OCTA_F
+    feedback.begin_test(tmp_path, "shadows", "test_agrees_with_ray_casting")
+    try:
+        with feedback.pictures_for_run("none") as run:
+            assert feedback.marked_picture("disagree", V, F, V[:2] * 0.5, "points where the two disagree") is None
+    finally:
+        feedback.end_test()
+    assert run.held == 1 and not looked_up, (run.held, looked_up)
+
+
 def test_a_picture_that_fails_while_the_tests_go_on_leaves_no_dangling_path(tmp_path, monkeypatch):
     """Pictures are drawn in a child while the next tests run; one that fails (or runs out of time) is
     taken out of the messages that named it."""
