@@ -134,14 +134,20 @@ def prepare_stubs(stubs_dir: str | None) -> None:
                 pass
 
 
-def prepare_gl(*lab_folders: str | None) -> None:
+def prepare_gl(*lab_folders: str | None, function: str | None = None) -> None:
     """Import PyOpenGL on the headless platform, in the zygote, when the lab runs shaders (it has a
     ``shaders/`` folder): every worker of a GLSL call imported it (0.4 s of CPU) before this. No
     OpenGL context is created here: Mesa's rasteriser threads do not survive a fork (see
-    :func:`geomlib.render.context.inherited_context`), so each worker creates its own (about 15 ms)."""
+    :func:`geomlib.render.context.inherited_context`), so each worker creates its own (about 15 ms).
+
+    With ``function`` (the call's) and the lab's stubs first among ``lab_folders``: not before a
+    call whose stub module may use OpenGL (:func:`_may_use_gl`), so ``--task 3`` of shadows, which
+    runs no shader, does not pay the import (0.2 s of CPU at every start of the grader)."""
     from geomlib.gl import SHADER_FOLDER
 
     if "OpenGL.GL" in sys.modules or not any(f and os.path.isdir(os.path.join(f, SHADER_FOLDER)) for f in lab_folders):
+        return
+    if function and lab_folders[0] and not _may_use_gl(lab_folders[0], function):
         return
     from geomlib.render.context import backend
 
@@ -150,6 +156,42 @@ def prepare_gl(*lab_folders: str | None) -> None:
     importlib.import_module("OpenGL.arrays")
     if platform == "osmesa":
         importlib.import_module("OpenGL.osmesa")
+
+
+#: Modules whose import in a stub means OpenGL (shaders, or pyrender's renderer).
+_GL_MODULES = ("geomlib.gl", "geomlib.render", "OpenGL", "pyrender")
+
+
+def _may_use_gl(stubs_dir: str, function: str) -> bool:
+    """Whether the course's stub module that defines ``function`` imports one of :data:`_GL_MODULES`,
+    itself or through the lab's other stub modules it imports (relative imports, at any depth of
+    the file); True when that is not known (no parsed stub defines it: a submission's own file)."""
+    trees = {p.stem: _TREES.get((str(p), False)) for p in sorted(Path(stubs_dir).glob("*.py"))}
+    todo = [stem for stem, t in trees.items() if isinstance(t, ast.Module) and function in _stub_defines(t)]
+    if not todo:
+        return True
+
+    def gl(name: str) -> bool:
+        return any(name == m or name.startswith(m + ".") for m in _GL_MODULES)
+
+    seen = set()
+    while todo:
+        stem = todo.pop()
+        if stem in seen:
+            continue
+        seen.add(stem)
+        tree = trees.get(stem)
+        if not isinstance(tree, ast.Module):
+            return True
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import) and any(gl(a.name) for a in node.names):
+                return True
+            if isinstance(node, ast.ImportFrom):
+                if node.level:  # the lab's own modules: from .glsl import ..., from . import glsl
+                    todo += [node.module.split(".")[0]] if node.module else [a.name for a in node.names]
+                elif gl(node.module or "") or any(gl(f"{node.module}.{a.name}") for a in node.names):
+                    return True
+    return False
 
 
 def _is_plain_file(path: Path) -> bool:

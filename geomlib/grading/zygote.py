@@ -426,7 +426,8 @@ def serve(sock: socket.socket) -> None:
         except Exception:  # noqa: BLE001 - the workers import them themselves
             pass
         try:
-            _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"))  # PyOpenGL, once, for a lab with shaders
+            # PyOpenGL, once, for a lab with shaders, at its first call that may use them
+            _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"), function=req.get("function"))
         except Exception:  # noqa: BLE001 - the worker imports it itself (and reports what fails)
             pass
         try:

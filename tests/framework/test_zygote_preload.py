@@ -52,3 +52,44 @@ def test_a_worker_of_a_numba_lab_inherits_numba(tmp_path, stub_import):
 
 def test_without_known_stubs_everything_is_preloaded(tmp_path):
     assert _numba_in_worker(tmp_path, "none")
+
+
+GL_SCRIPT = """
+import os, sys
+from pathlib import Path
+from geomlib.grading.sandbox import LabProxy
+
+root = Path(sys.argv[1])
+stubs, lab = root / "stubs" / "gllab", root / "gllab"
+for folder in (stubs, lab):
+    (folder / "shaders").mkdir(parents=True)
+(stubs / "ops.py").write_text("def loaded():\\n    raise NotImplementedError('Task 1')\\n")
+(stubs / "glops.py").write_text(
+    "from geomlib import gl\\n\\n\\ndef gl_loaded():\\n    raise NotImplementedError('Task 2')\\n"
+)
+(stubs / "uses_glops.py").write_text(
+    "from .glops import gl_loaded\\n\\n\\ndef via():\\n    raise NotImplementedError('Task 3')\\n"
+)
+body = "import sys\\n\\n\\ndef {}():\\n    return ['OpenGL.GL' in sys.modules]\\n"  # before the stub's own imports
+(lab / "ops.py").write_text(body.format("loaded"))
+(lab / "glops.py").write_text(body.format("gl_loaded"))
+(lab / "uses_glops.py").write_text(body.format("via"))
+os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
+first = sys.argv[2]
+proxy = LabProxy("gllab", lab, timeout=120)
+print(getattr(proxy, first)()[0], proxy.loaded()[0])
+"""
+
+
+@pytest.mark.parametrize("first", ["loaded", "gl_loaded", "via"])
+def test_pyopengl_is_preloaded_at_the_first_call_that_may_use_it(tmp_path, first):
+    """A lab with shaders/: the zygote imports PyOpenGL (0.2 s of CPU) before the first call whose
+    stub module imports geomlib.gl, itself or through the lab's modules it imports, and from then on
+    for every call; not for calls before that (shadows' --task 3 runs no shader)."""
+    p = subprocess.run(
+        [sys.executable, "-c", GL_SCRIPT, str(tmp_path), first], capture_output=True, text=True, timeout=300
+    )
+    assert p.returncode == 0, p.stderr[-2000:]
+    at_first, after = p.stdout.split()[-2:]
+    expected = "False" if first == "loaded" else "True"
+    assert (at_first, after) == (expected, expected), (first, at_first, after)
