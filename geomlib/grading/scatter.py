@@ -29,38 +29,45 @@ class Panel:
     """One panel: a data rectangle ``lo``..``hi`` (equal scale on both axes) with a frame, ticks and
     axis labels; draw markers and segments in data coordinates, then :meth:`image`."""
 
-    def __init__(self, lo, hi, xlabel: str, ylabel: str):
+    def __init__(self, lo, hi, xlabel: str = "", ylabel: str = "", *, axes: bool = True):
         from PIL import Image, ImageDraw
 
         self.lo, self.hi = np.asarray(lo, float), np.asarray(hi, float)
         span = np.maximum(self.hi - self.lo, 1e-300)
         self.scale = SIDE / float(span.max())  # pixels per unit, the same along x and y
         self.w, self.h = (span * self.scale).round().astype(int)
-        self.xlabel, self.ylabel = xlabel, ylabel
+        self.xlabel, self.ylabel, self.axes = xlabel, ylabel, axes
         k = _SUPER
-        self.size = (_LEFT + self.w + _RIGHT, _TOP + self.h + _BOTTOM)
+        self.margins = (_LEFT, _BOTTOM, _TOP, _RIGHT) if axes else (8, 8, 8, 8)
+        left, bottom, top, right = self.margins
+        self.size = (left + self.w + right, top + self.h + bottom)
         self.img = Image.new("RGB", (self.size[0] * k, self.size[1] * k), (255, 255, 255))
         self.draw = ImageDraw.Draw(self.img)
 
     def _px(self, xy) -> np.ndarray:
         """Data ``(n, 2)`` to pixel centres of the large canvas."""
         xy = np.asarray(xy, float).reshape(-1, 2)
-        x = _LEFT + (xy[:, 0] - self.lo[0]) * self.scale
-        y = _TOP + self.h - (xy[:, 1] - self.lo[1]) * self.scale
+        left, _, top, _ = self.margins
+        x = left + (xy[:, 0] - self.lo[0]) * self.scale
+        y = top + self.h - (xy[:, 1] - self.lo[1]) * self.scale
         return np.stack([x, y], axis=1) * _SUPER
 
-    def dots(self, xy, colors, radius: float = 2.0) -> None:
-        """Filled discs of ``radius`` pixels; ``colors``: one colour, or one per point."""
+    def dots(self, xy, colors, radius: float = 2.0, edge=None) -> None:
+        """Filled discs of ``radius`` pixels; ``colors``: one colour, or one per point; ``edge``: the
+        colour of a thin outline (none by default)."""
         r = radius * _SUPER
+        outline = rgb(edge) if edge is not None else None
         for (x, y), c in zip(self._px(xy), self._colors(colors, len(np.asarray(xy).reshape(-1, 2))), strict=True):
-            self.draw.ellipse([x - r, y - r, x + r, y + r], fill=c)
+            self.draw.ellipse([x - r, y - r, x + r, y + r], fill=c, outline=outline, width=1 if outline else 0)
 
-    def crosses(self, xy, color, radius: float = 2.6, width: float = 1.2) -> None:
+    def crosses(self, xy, color, radius: float = 2.6, width: float = 1.2, edge=None) -> None:
+        """``x`` markers; with ``edge``, drawn over a wider cross of that colour (a filled X)."""
         r, lw = radius * _SUPER, max(1, round(width * _SUPER))
-        c = rgb(color)
+        layers = ([(rgb(edge), lw + 2)] if edge is not None else []) + [(rgb(color), lw)]
         for x, y in self._px(xy):
-            self.draw.line([(x - r, y - r), (x + r, y + r)], fill=c, width=lw)
-            self.draw.line([(x - r, y + r), (x + r, y - r)], fill=c, width=lw)
+            for c, w in layers:
+                self.draw.line([(x - r, y - r), (x + r, y + r)], fill=c, width=w)
+                self.draw.line([(x - r, y + r), (x + r, y - r)], fill=c, width=w)
 
     def segments(self, a, b, colors, width: float = 1.5) -> None:
         lw = max(1, round(width * _SUPER))
@@ -81,6 +88,8 @@ class Panel:
 
         from geomlib import plot
 
+        if not self.axes:
+            return np.asarray(self.img.resize(self.size, Image.Resampling.LANCZOS), dtype=np.uint8).copy()
         k, ink = _SUPER, (40, 40, 40)
         font = plot._font(11 * k)
         x0, y0, x1, y1 = _LEFT * k, _TOP * k, (_LEFT + self.w) * k, (_TOP + self.h) * k
@@ -107,3 +116,12 @@ class Panel:
         self.img.paste(label, (2 * k, int((y0 + y1) / 2 - label.size[1] / 2)))
         small = self.img.resize(self.size, Image.Resampling.LANCZOS)
         return np.asarray(small, dtype=np.uint8).copy()
+
+
+def view(elev: float, azim: float) -> np.ndarray:
+    """``(3, 2)``: 3D points ``@ view(...)`` are their screen ``(x, y)`` in an orthographic view from
+    ``elev`` degrees above the xy-plane and ``azim`` degrees around z (matplotlib's 3D angles)."""
+    e, a = np.radians(elev), np.radians(azim)
+    right = [-np.sin(a), np.cos(a), 0.0]
+    up = [-np.sin(e) * np.cos(a), -np.sin(e) * np.sin(a), np.cos(e)]
+    return np.array([right, up]).T

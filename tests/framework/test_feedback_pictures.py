@@ -365,21 +365,25 @@ def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, 
     assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
 
 
-def test_a_free_points_picture_needs_no_matplotlib_figure(tmp_path):
-    """Shadows' wrong (u, v, z) is the first picture of its --task 3: drawn with Pillow, not a
-    matplotlib figure (importing matplotlib.figure and a tight savefig cost about 0.5 s of the 3 s a
-    student waits for --task N). Three panels, as every kind (test above)."""
+@pytest.mark.parametrize("kind", ["free points", "rows inside a solid"])
+def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
+    """The first picture of shadows' --task 3 (wrong (u, v, z): free points) and of subdivision's
+    --task 1 (wrong matrix rows on a mesh) are drawn with Pillow, not a matplotlib figure (importing
+    matplotlib.figure, a 3D axes and a tight savefig cost 0.5-0.8 s of the 3 s a student waits for
+    --task N). Three panels, as every kind (test above)."""
     code = textwrap.dedent(
         f"""
         import sys
-        import numpy as np
+        from pathlib import Path
+        sys.path.insert(0, {str(Path(__file__).resolve().parents[2])!r})
+        from tests.framework.test_feedback_pictures import _kinds
         from geomlib.grading import feedback
         from geomlib.grading.checks import Context
 
         feedback._drawn_in_time = lambda path, draw: (draw(), str(path))[1]
-        p = np.random.default_rng(0).random((50, 3))
-        ctx = Context(label="light_uvz", lab="kinds", case_id="uvz", feedback_dir={str(tmp_path)!r})
-        path = feedback.default_picture(ctx, {{}}, {{"uvz": p}}, {{"uvz": p + [0.05, 0, 0]}})
+        name, inputs, expected, got = next(k for k in _kinds() if k[0] == {kind!r})
+        ctx = Context(label=name, lab="kinds", case_id="k", feedback_dir={str(tmp_path)!r})
+        path = feedback.default_picture(ctx, inputs, expected, got)
         print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
         """
     )
