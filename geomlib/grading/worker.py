@@ -85,8 +85,8 @@ _STUB_CODE: dict = {}
 #: ``id(stub tree) -> (task names, given names)`` (:func:`merge_module`), for the trees in ``_TREES``.
 _STUB_NAMES: dict = {}
 #: ``id(stub tree) -> (tree, names it defines)`` (:func:`_defines`, asked of every stub file at every
-#: call) and ``id(stub task function) -> (function, its validation prefix, ast.dump of each of its
-#: statements)`` (:func:`_merged_task`); worked out in the zygote too (:func:`prepare_stubs`).
+#: call) and ``id(stub task function) -> (function, its validation prefix)`` (:func:`_merged_task`);
+#: worked out in the zygote too (:func:`prepare_stubs`).
 _STUB_DEFINES: dict = {}
 _STUB_PREFIX: dict = {}
 
@@ -302,22 +302,33 @@ def _task_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
     return []
 
 
-def _stub_prefix(stub_fn: ast.FunctionDef) -> tuple[list[ast.stmt], list[str]]:
-    """:func:`_task_prefix` and the ``ast.dump`` of each of its statements, once per stub function."""
+def _stub_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
+    """:func:`_task_prefix`, once per stub function."""
     known = _STUB_PREFIX.get(id(stub_fn))
     if known is None or known[0] is not stub_fn:
-        prefix = _task_prefix(stub_fn)
-        known = _STUB_PREFIX[id(stub_fn)] = (stub_fn, prefix, [ast.dump(s) for s in prefix])
-    return known[1], known[2]
+        known = _STUB_PREFIX[id(stub_fn)] = (stub_fn, _task_prefix(stub_fn))
+    return known[1]
+
+
+def _same(a, b) -> bool:
+    """Whether two syntax trees are the same code (``ast.dump(a) == ast.dump(b)``: fields compared,
+    positions not), stopping at the first difference instead of writing both trees out."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, ast.AST):
+        return all(_same(getattr(a, f, None), getattr(b, f, None)) for f in a._fields)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return a is b or repr(a) == repr(b)  # a constant, compared as ast.dump writes it (1 is not 1.0)
 
 
 def _merged_task(stub_fn: ast.FunctionDef, student_fn: ast.FunctionDef) -> ast.FunctionDef:
     """The student's task function with the stub's signature and the stub's leading validation."""
     line = student_fn.lineno
-    prefix, dumps = _stub_prefix(stub_fn)
+    prefix = _stub_prefix(stub_fn)
     body = list(student_fn.body)
     common = 0
-    while common < min(len(prefix), len(body)) and dumps[common] == ast.dump(body[common]):
+    while common < min(len(prefix), len(body)) and _same(prefix[common], body[common]):
         common += 1
     missing = [_relocate(s, line) for s in prefix[common:]]
     fn = copy.copy(student_fn)

@@ -198,3 +198,31 @@ def test_relocated_stub_code_is_the_deep_copy_moved_to_one_line():
                     assert b is not node
                     n += 1
     assert n > 1000
+
+
+def test_a_stub_statement_and_a_submissions_are_the_same_code_as_ast_dump_says():
+    """The merge keeps a task's validation prefix when the submission starts with the same statements;
+    worker._same decides it without writing both trees out (ast.dump did, for every statement of every
+    task at every call): the same answer as comparing dumps, on every stub prefix and task start
+    against the solution's first statements."""
+    import ast
+
+    from geomlib.grading.course import course
+
+    pairs = same = 0
+    for lab in course().labs:
+        paths = course().lab(lab)
+        for stub_path in sorted(paths.stubs.glob("*.py")):
+            solution = paths.solution / stub_path.name
+            if not solution.is_file():
+                continue
+            theirs = {f.name: f for f in ast.parse(solution.read_text()).body if isinstance(f, ast.FunctionDef)}
+            for fn in ast.parse(stub_path.read_text()).body:
+                if not isinstance(fn, ast.FunctionDef) or fn.name not in theirs:
+                    continue
+                for a in worker._task_prefix(fn) + fn.body[:3]:
+                    for b in theirs[fn.name].body[:6]:
+                        assert worker._same(a, b) == (ast.dump(a) == ast.dump(b)), (stub_path, fn.name, ast.dump(a))
+                        pairs += 1
+                        same += worker._same(a, b)
+    assert pairs > 5000 and 0 < same < pairs, (pairs, same)
