@@ -102,3 +102,24 @@ def test_pyopengl_is_preloaded_at_the_first_call_that_may_use_it(tmp_path, first
     at_first, after = p.stdout.split()[-2:]
     expected = "False" if first == "loaded" else "True"
     assert (at_first, after) == (expected, expected), (first, at_first, after)
+
+
+def test_whether_a_call_may_use_opengl_is_worked_out_once(tmp_path, monkeypatch):
+    """The zygote asks at every call of a lab with shaders/ until PyOpenGL is loaded (for all of
+    shadows' --task 3, which runs no shader): the stubs are walked once per function, not per call
+    (4-12 ms each)."""
+    from geomlib.grading import worker
+
+    stubs = tmp_path / "gllab"
+    stubs.mkdir()
+    (stubs / "ops.py").write_text("from . import glops\n\n\ndef plain():\n    raise NotImplementedError('Task 1')\n")
+    (stubs / "glops.py").write_text(
+        "from geomlib import gl\n\n\ndef drawn():\n    raise NotImplementedError('Task 2')\n"
+    )
+    worker.prepare_stubs(str(stubs))
+    assert worker._may_use_gl(str(stubs), "plain") and worker._may_use_gl(str(stubs), "drawn")
+    walked = []
+    real = worker.ast.walk
+    monkeypatch.setattr(worker.ast, "walk", lambda node: (walked.append(node), real(node))[1])
+    assert worker._may_use_gl(str(stubs), "plain") and worker._may_use_gl(str(stubs), "drawn")
+    assert not walked, "the stubs were walked again"
