@@ -271,6 +271,8 @@ def panels(
 def _cmap(name: str, where: str):
     import matplotlib
 
+    if isinstance(name, matplotlib.colors.Colormap):  # a map of one's own (a cut inferno)
+        return name
     if not isinstance(name, str) or name not in matplotlib.colormaps:
         some = ", ".join(sorted(n for n in matplotlib.colormaps if not n.endswith("_r"))[:12])
         raise MeshError(f"{where}: unknown colour map {name!r}; use a matplotlib name such as {some}, ...")
@@ -368,8 +370,8 @@ def colorbar(
     ----------
     vmin, vmax : float
         Range of the colour map (as passed to :func:`heat_colors` / :func:`heatmap_image`).
-    cmap : str
-        Matplotlib colour map name.
+    cmap : str or matplotlib Colormap
+        Matplotlib colour map name (or the map itself).
     label : str, optional
         Quantity and unit, written above the bar.
     height : int

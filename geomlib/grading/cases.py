@@ -195,6 +195,10 @@ def run_case(lab, case: Case, *, feedback_dir: Path | None = None, diagnose_comp
     kwargs = {**case.inputs(), **case.params}
     result = lab.call(case.function, **kwargs)
     got = case.name_outputs(result)
+    if diagnose_composites and not case.hidden:
+        from geomlib.grading import diagnose
+
+        diagnose.remember_outputs(lab, case, got)  # a composite's diagnosis may probe this case again
     expected = load_reference(lab.name, case)  # loaded only after the student's call has returned
     ctx = Context(label=case.label, lab=lab.name, case_id=case.id, feedback_dir=feedback_dir)
     try:

@@ -208,9 +208,14 @@ def _course(root: Path, stamp: float) -> Course:
 def course_root() -> Path:
     """The folder holding ``geomlib/``, ``labs/``, ``tests/`` (override with ``GEOMLIB_ROOT``)."""
     root = env("GEOMLIB_ROOT")
-    if root:
-        return Path(root).resolve()
-    return Path(__file__).resolve().parents[2]
+    return _resolved(root) if root else _resolved(__file__).parents[2]
+
+
+@functools.lru_cache(maxsize=64)
+def _resolved(path: str) -> Path:
+    """``Path(path).resolve()``, once per path: a grading run asks for the course a few hundred
+    times (every test's lab, every call's stubs)."""
+    return Path(path).resolve()
 
 
 def course(root: str | Path | None = None) -> Course:

@@ -12,7 +12,6 @@ limit (:func:`_drawn_in_time`), so a huge wrong mesh costs seconds, not the run.
 from __future__ import annotations
 
 import re
-import textwrap
 
 import numpy as np
 
@@ -144,38 +143,10 @@ def _mesh_edges(F, limit: int = 6000) -> np.ndarray:
 
 def _error_cmap():
     """inferno without its palest yellow: the largest errors stay visible on a white page."""
+    from matplotlib import colormaps
     from matplotlib.colors import ListedColormap
-    from matplotlib.pyplot import get_cmap
 
-    return ListedColormap(get_cmap("inferno")(np.linspace(0.0, 0.82, 256)), name="inferno_dark")
-
-
-def _three_panel_figure(title: str, captions, *, three_d: bool, flat: bool = False):
-    """A matplotlib figure of three panels (expected | yours | difference) sharing one view."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(14.4, 4.6), dpi=80)
-    axes = []
-    for k, caption in enumerate(captions):
-        if three_d:
-            ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
-            ax.view_init(elev=90, azim=-90) if flat else ax.view_init(elev=24, azim=-58)
-            ax.set_axis_off()
-        else:
-            ax = fig.add_subplot(1, 3, k + 1)
-        ax.set_title(textwrap.fill(caption, 48), fontsize=10)
-        axes.append(ax)
-    fig.suptitle(title, fontsize=11)
-    return fig, plt, axes
-
-
-def _save(fig, plt, path) -> None:
-    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.04, top=0.86, wspace=0.04)
-    fig.savefig(path, bbox_inches="tight", pad_inches=0.15)
-    plt.close(fig)
+    return ListedColormap(colormaps["inferno"](np.linspace(0.0, 0.82, 256)), name="inferno_dark")
 
 
 def _errors(e: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -217,8 +188,10 @@ def rows_picture(
         return None
 
     def draw():
-        from matplotlib.collections import LineCollection  # noqa: F401 - matplotlib is imported in the child
-        from mpl_toolkits.mplot3d.art3d import Line3DCollection
+        from matplotlib import colormaps
+
+        from geomlib import plot
+        from geomlib.grading.scatter import Panel, view
 
         W = np.asarray(V, float)
         P = np.asarray(expected, float).reshape(-1, 3)
@@ -241,39 +214,37 @@ def rows_picture(
             yours or ("yours" if values is None else "yours (colour: your value)"),
             f"difference: |error| per row (max {vmax:.3g})",
         ]
-        fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=True, flat=flat)
-        size = 60 if n <= 50 else 16 if n <= 500 else 6
+        # One orthographic view for the three panels (matplotlib's 3D angles: from above for a flat mesh).
+        to2 = view(90, -90) if flat else view(24, -58)
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        c2 = corners @ to2
+        pad = 0.08 * max(float(np.ptp(c2, axis=0).max()), 1e-12)
+        axes = [Panel(c2.min(axis=0) - pad, c2.max(axis=0) + pad, axes=False) for _ in range(3)]
+        r = 0.55 * np.sqrt(60 if n <= 50 else 16 if n <= 500 else 6)
+        cmap = _error_cmap()
         if values is not None:
             ve, vg = (np.asarray(x, float).ravel() for x in values)
             both = np.concatenate([ve[np.isfinite(ve)], vg[np.isfinite(vg)]]) if n else np.zeros(1)
             vlo, vhi = (float(both.min()), float(both.max())) if both.size else (0.0, 1.0)
-        for k, ax in enumerate(axes):
-            ax.add_collection3d(Line3DCollection(W[E], colors="0.35", linewidths=0.5, alpha=0.4, zorder=1))
-            if k == 0:
-                colour = {"c": "#1f77b4"} if values is None else {"c": ve, "cmap": "viridis", "vmin": vlo, "vmax": vhi}
-                ax.scatter(*P.T, s=size, depthshade=False, zorder=3, edgecolors="white", linewidths=0.4, **colour)
-            elif k == 1:
-                if values is None:
-                    ax.scatter(*Gc[ok].T, s=size * 1.3, c="#ff7f0e", marker="X", depthshade=False, zorder=3,
-                               edgecolors="black", linewidths=0.3)  # fmt: skip
-                else:
-                    sc = ax.scatter(*P.T, s=size, c=np.nan_to_num(vg, nan=vhi), cmap="viridis", vmin=vlo, vmax=vhi,
-                                    depthshade=False, zorder=3, edgecolors="white", linewidths=0.4)  # fmt: skip
-                    fig.colorbar(sc, ax=ax, shrink=0.6, pad=0.0, label="value (expected | yours)")
-            else:
-                if values is None:
-                    seg = Line3DCollection(np.stack([P, Gc], axis=1), cmap=_error_cmap(), linewidths=1.6, zorder=2)
-                    seg.set_array(e)
-                    seg.set_clim(0.0, vmax)
-                    ax.add_collection3d(seg)
-                hs = ax.scatter(*P.T, s=size, c=e, cmap=_error_cmap(), vmin=0.0, vmax=vmax, depthshade=False, zorder=3,
-                                edgecolors="0.5", linewidths=0.3)  # fmt: skip
-                fig.colorbar(hs, ax=ax, shrink=0.6, pad=0.0, label="|error|")
-            ax.set_xlim(box_lo[0], box_hi[0])
-            ax.set_ylim(box_lo[1], box_hi[1])
-            ax.set_zlim(box_lo[2], box_hi[2])
-            ax.set_box_aspect(np.maximum(box_hi - box_lo, 0.05 * span), zoom=1.35)
-        _save(fig, plt, path)
+            span_v = vhi - vlo if vhi > vlo else 1.0
+            viridis = colormaps["viridis"]
+        for ax in axes:  # the see-through wireframe: markers inside a solid stay visible
+            ax.segments(W[E[:, 0]] @ to2, W[E[:, 1]] @ to2, (0.74, 0.74, 0.74), width=0.7)
+        P2, G2 = P @ to2, Gc @ to2
+        if values is None:
+            axes[0].dots(P2, "#1f77b4", radius=r, edge=(1.0, 1.0, 1.0))
+            axes[1].crosses(G2[ok], "#ff7f0e", radius=1.3 * r, width=max(1.0, 0.45 * r), edge=(0, 0, 0))
+            axes[2].segments(P2, G2, cmap(np.clip(e / vmax, 0.0, 1.0)), width=1.6)
+        else:
+            axes[0].dots(P2, viridis(np.clip((ve - vlo) / span_v, 0.0, 1.0)), radius=r, edge=(1.0, 1.0, 1.0))
+            vg_ = np.nan_to_num(vg, nan=vhi)
+            axes[1].dots(P2, viridis(np.clip((vg_ - vlo) / span_v, 0.0, 1.0)), radius=r, edge=(1.0, 1.0, 1.0))
+        axes[2].dots(P2, cmap(np.clip(e / vmax, 0.0, 1.0)), radius=r, edge=(0.5, 0.5, 0.5))
+        a, b, c = (ax.image() for ax in axes)
+        if values is not None:
+            b = _beside(b, plot.colorbar(vlo, vhi, cmap="viridis", label="value (expected | yours)", height=b.shape[0]))
+        c = _beside(c, plot.colorbar(0.0, vmax, cmap=cmap, label="|error|", height=c.shape[0]))
+        plot.save_png(path, plot.panels([a, b, c], captions, title=ctx.label))
 
     return _drawn_in_time(path, draw)
 
@@ -284,6 +255,8 @@ def highlight_picture(ctx: Context, V, F, points, caption: str, *, got=None, suf
     them; without it, each point's nearest vertex of ``V`` (the submitted mesh's closest offer)."""
     P = np.asarray(points, float).reshape(-1, 3)
     yours = "yours"
+    if got is None and not _picture_allowed():
+        got = P  # no picture this time (rows_picture counts it as held back): no nearest vertices either
     if got is None:
         Vf = np.asarray(V, float)
         yours = "the nearest vertex of the mesh to each"
@@ -343,7 +316,8 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
         return None
 
     def draw():
-        from matplotlib.collections import LineCollection
+        from geomlib import plot
+        from geomlib.grading.scatter import Panel
 
         e, g = np.asarray(expected, float), np.asarray(got, float)
         err = _errors(e, g)
@@ -354,30 +328,25 @@ def points_picture(ctx: Context, expected: np.ndarray, got: np.ndarray, name: st
             f"yours ({int(bad.sum())} of {len(e)} rows wrong)",
             f"difference: |{name} error| (max {err.max():.3g})",
         ]
-        fig, plt, axes = _three_panel_figure(ctx.label, captions, three_d=False)
         pts = np.vstack([e[:, :2], g[gf, :2]])
         pts = pts[np.isfinite(pts).all(axis=1)]
         lo, hi = (pts.min(axis=0), pts.max(axis=0)) if len(pts) else (np.zeros(2), np.ones(2))
         pad = 0.05 * max(float((hi - lo).max()), 1e-12)
         vmax = max(float(err.max()), 1e-12)
-        axes[0].scatter(e[:, 0], e[:, 1], s=10, c="#1f77b4", zorder=2)
-        axes[1].scatter(g[gf, 0], g[gf, 1], s=14, c="#ff7f0e", marker="x", zorder=3)
-        both = bad & gf
-        axes[2].scatter(e[~bad, 0], e[~bad, 1], s=6, c="0.75", zorder=1)
-        if both.any():
-            lines = LineCollection(np.stack([e[both, :2], g[both, :2]], axis=1), cmap=_error_cmap(), linewidths=1.5)
-            lines.set_array(err[both])
-            lines.set_clim(0.0, vmax)
-            axes[2].add_collection(lines)
-        hs = axes[2].scatter(e[bad, 0], e[bad, 1], s=12, c=err[bad], cmap=_error_cmap(), vmin=0.0, vmax=vmax, zorder=3)
-        fig.colorbar(hs, ax=axes[2], shrink=0.8, label=f"|{name} error|")
-        for ax in axes:
-            ax.set_xlim(lo[0] - pad, hi[0] + pad)
-            ax.set_ylim(lo[1] - pad, hi[1] + pad)
-            ax.set_aspect("equal", adjustable="box")
-            ax.set_xlabel(f"{name}[:, 0]")
-            ax.set_ylabel(f"{name}[:, 1]")
-        _save(fig, plt, path)
+        cmap = _error_cmap()
+        axes = [Panel(lo - pad, hi + pad, f"{name}[:, 0]", f"{name}[:, 1]") for _ in range(3)]
+        ef = np.isfinite(e[:, :2]).all(axis=1)
+        axes[0].dots(e[ef, :2], "#1f77b4", radius=1.8)
+        axes[1].crosses(g[gf, :2], "#ff7f0e")
+        both = bad & gf & ef
+        axes[2].dots(e[~bad & ef, :2], (0.75, 0.75, 0.75), radius=1.4)
+        colors = cmap(np.clip(err / vmax, 0.0, 1.0))
+        axes[2].segments(e[both, :2], g[both, :2], colors[both])
+        axes[2].dots(e[bad & ef, :2], colors[bad & ef], radius=2.0)
+        a, b, c = (ax.image() for ax in axes)
+        bar = plot.colorbar(0.0, vmax, cmap=cmap, label=f"|{name} error|", height=c.shape[0])
+        img = plot.panels([a, b, _beside(c, bar)], captions, title=ctx.label)
+        plot.save_png(path, img)
 
     return _drawn_in_time(path, draw)
 

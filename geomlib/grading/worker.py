@@ -84,6 +84,11 @@ _STUB_STAT: dict = {}
 _STUB_CODE: dict = {}
 #: ``id(stub tree) -> (task names, given names)`` (:func:`merge_module`), for the trees in ``_TREES``.
 _STUB_NAMES: dict = {}
+#: ``id(stub tree) -> (tree, names it defines)`` (:func:`_defines`, asked of every stub file at every
+#: call) and ``id(stub task function) -> (function, its validation prefix)`` (:func:`_merged_task`);
+#: worked out in the zygote too (:func:`prepare_stubs`).
+_STUB_DEFINES: dict = {}
+_STUB_PREFIX: dict = {}
 
 
 def prepare_stubs(stubs_dir: str | None) -> None:
@@ -104,7 +109,9 @@ def prepare_stubs(stubs_dir: str | None) -> None:
         old = _TREES.pop((str(path), False), None)
         for stmt in getattr(old, "body", ()):  # their ids may be reused once the old tree is freed
             _STUB_CODE.pop(id(stmt), None)
+            _STUB_PREFIX.pop(id(stmt), None)
         _STUB_NAMES.pop(id(old), None)
+        _STUB_DEFINES.pop(id(old), None)
         _STUB_STAT[str(path)] = digest
         try:
             tree = _TREES[(str(path), False)] = ast.parse(data.decode("utf-8"), filename=str(path))
@@ -115,7 +122,10 @@ def prepare_stubs(stubs_dir: str | None) -> None:
             tasks,
             set().union(*(_bound_names(s) for s in tree.body)) - tasks if tree.body else set(),
         )
+        _stub_defines(tree)
         for stmt in tree.body:
+            if isinstance(stmt, ast.FunctionDef | ast.AsyncFunctionDef) and stmt.name in tasks:
+                _stub_prefix(stmt)
             try:
                 _STUB_CODE[id(stmt)] = compile(
                     ast.Module(body=[stmt], type_ignores=[]), str(path), "exec", flags=flags, dont_inherit=True
@@ -124,14 +134,20 @@ def prepare_stubs(stubs_dir: str | None) -> None:
                 pass
 
 
-def prepare_gl(*lab_folders: str | None) -> None:
+def prepare_gl(*lab_folders: str | None, function: str | None = None) -> None:
     """Import PyOpenGL on the headless platform, in the zygote, when the lab runs shaders (it has a
     ``shaders/`` folder): every worker of a GLSL call imported it (0.4 s of CPU) before this. No
     OpenGL context is created here: Mesa's rasteriser threads do not survive a fork (see
-    :func:`geomlib.render.context.inherited_context`), so each worker creates its own (about 15 ms)."""
+    :func:`geomlib.render.context.inherited_context`), so each worker creates its own (about 15 ms).
+
+    With ``function`` (the call's) and the lab's stubs first among ``lab_folders``: not before a
+    call whose stub module may use OpenGL (:func:`_may_use_gl`), so ``--task 3`` of shadows, which
+    runs no shader, does not pay the import (0.2 s of CPU at every start of the grader)."""
     from geomlib.gl import SHADER_FOLDER
 
     if "OpenGL.GL" in sys.modules or not any(f and os.path.isdir(os.path.join(f, SHADER_FOLDER)) for f in lab_folders):
+        return
+    if function and lab_folders[0] and not _may_use_gl(lab_folders[0], function):
         return
     from geomlib.render.context import backend
 
@@ -140,6 +156,56 @@ def prepare_gl(*lab_folders: str | None) -> None:
     importlib.import_module("OpenGL.arrays")
     if platform == "osmesa":
         importlib.import_module("OpenGL.osmesa")
+
+
+#: Modules whose import in a stub means OpenGL (shaders, or pyrender's renderer).
+_GL_MODULES = ("geomlib.gl", "geomlib.render", "OpenGL", "pyrender")
+
+
+def _may_use_gl(stubs_dir: str, function: str) -> bool:
+    """Whether the course's stub module that defines ``function`` imports one of :data:`_GL_MODULES`,
+    itself or through the lab's other stub modules it imports (relative imports, at any depth of
+    the file); True when that is not known (no parsed stub defines it: a submission's own file)."""
+    trees = {p.stem: _TREES.get((str(p), False)) for p in sorted(Path(stubs_dir).glob("*.py"))}
+    key = (stubs_dir, function)
+    version = tuple(map(id, trees.values()))  # the trees of this version of the stubs (prepare_stubs)
+    known = _GL_USE.get(key)
+    if known is not None and known[0] == version and all(t is not None for t in trees.values()):
+        return known[1]  # asked at every call until OpenGL is loaded: 4-12 ms of walking the stubs each
+    _GL_USE[key] = (version, _walk_for_gl(trees, function))
+    return _GL_USE[key][1]
+
+
+#: :func:`_may_use_gl` by (stubs folder, function): (ids of the stub trees, the answer).
+_GL_USE: dict = {}
+
+
+def _walk_for_gl(trees: dict, function: str) -> bool:
+    todo = [stem for stem, t in trees.items() if isinstance(t, ast.Module) and function in _stub_defines(t)]
+    if not todo:
+        return True
+
+    def gl(name: str) -> bool:
+        return any(name == m or name.startswith(m + ".") for m in _GL_MODULES)
+
+    seen = set()
+    while todo:
+        stem = todo.pop()
+        if stem in seen:
+            continue
+        seen.add(stem)
+        tree = trees.get(stem)
+        if not isinstance(tree, ast.Module):
+            return True
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import) and any(gl(a.name) for a in node.names):
+                return True
+            if isinstance(node, ast.ImportFrom):
+                if node.level:  # the lab's own modules: from .glsl import ..., from . import glsl
+                    todo += [node.module.split(".")[0]] if node.module else [a.name for a in node.names]
+                elif gl(node.module or "") or any(gl(f"{node.module}.{a.name}") for a in node.names):
+                    return True
+    return False
 
 
 def _is_plain_file(path: Path) -> bool:
@@ -197,6 +263,20 @@ def _defines(tree: ast.Module, name: str) -> bool:
     return False
 
 
+def _stub_defines(tree: ast.Module) -> frozenset:
+    """The names a course stub defines (as :func:`_defines` counts them), worked out once per tree."""
+    known = _STUB_DEFINES.get(id(tree))
+    if known is None or known[0] is not tree:
+        names = frozenset(
+            n
+            for node in tree.body
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef | ast.Assign | ast.AnnAssign)
+            for n in ({node.name} if hasattr(node, "name") else _bound_names(node))
+        )
+        known = _STUB_DEFINES[id(tree)] = (tree, names)
+    return known[1]
+
+
 def _imports(tree: ast.Module, name: str) -> bool:
     return any(isinstance(n, ast.Import | ast.ImportFrom) and name in _bound_names(n) for n in tree.body)
 
@@ -204,13 +284,28 @@ def _imports(tree: ast.Module, name: str) -> bool:
 # ---------------------------------------------------------------------------------- merging
 
 
-def _relocate(node: ast.AST, line: int) -> ast.AST:
-    node = copy.deepcopy(node)
-    for sub in ast.walk(node):
-        if "lineno" in sub._attributes:
-            sub.lineno = sub.end_lineno = line
-            sub.col_offset = sub.end_col_offset = 0
-    return node
+def _relocate(node, line: int):
+    """A copy of ``node`` with every position at ``line``, column 0 (the stub's code merged into a
+    student's function reports that function's line). A plain recursive copy: ``copy.deepcopy``
+    of a syntax tree costs a few times more, and a worker merges every task of a module per call."""
+    if isinstance(node, list):
+        return [_relocate(x, line) for x in node]
+    if not isinstance(node, ast.AST):
+        return node  # str, int, None, a constant's value: not changed by anyone
+    new = node.__class__.__new__(node.__class__)
+    for name in node._fields:
+        try:
+            setattr(new, name, _relocate(getattr(node, name), line))
+        except AttributeError:  # an optional field left unset
+            pass
+    if "lineno" in node._attributes:
+        new.lineno = new.end_lineno = line
+        new.col_offset = new.end_col_offset = 0
+    else:
+        for name in node._attributes:
+            if hasattr(node, name):
+                setattr(new, name, getattr(node, name))
+    return new
 
 
 def _task_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
@@ -221,13 +316,33 @@ def _task_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
     return []
 
 
+def _stub_prefix(stub_fn: ast.FunctionDef) -> list[ast.stmt]:
+    """:func:`_task_prefix`, once per stub function."""
+    known = _STUB_PREFIX.get(id(stub_fn))
+    if known is None or known[0] is not stub_fn:
+        known = _STUB_PREFIX[id(stub_fn)] = (stub_fn, _task_prefix(stub_fn))
+    return known[1]
+
+
+def _same(a, b) -> bool:
+    """Whether two syntax trees are the same code (``ast.dump(a) == ast.dump(b)``: fields compared,
+    positions not), stopping at the first difference instead of writing both trees out."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, ast.AST):
+        return all(_same(getattr(a, f, None), getattr(b, f, None)) for f in a._fields)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return a is b or repr(a) == repr(b)  # a constant, compared as ast.dump writes it (1 is not 1.0)
+
+
 def _merged_task(stub_fn: ast.FunctionDef, student_fn: ast.FunctionDef) -> ast.FunctionDef:
     """The student's task function with the stub's signature and the stub's leading validation."""
     line = student_fn.lineno
-    prefix = _task_prefix(stub_fn)
+    prefix = _stub_prefix(stub_fn)
     body = list(student_fn.body)
     common = 0
-    while common < min(len(prefix), len(body)) and ast.dump(prefix[common]) == ast.dump(body[common]):
+    while common < min(len(prefix), len(body)) and _same(prefix[common], body[common]):
         common += 1
     missing = [_relocate(s, line) for s in prefix[common:]]
     fn = copy.copy(student_fn)
@@ -380,7 +495,7 @@ def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None
         return getattr(importlib.import_module(f"{pkg_name}.{stem}"), function, None)
 
     for stem, tree in stub_trees:
-        if _defines(tree, function):
+        if function in _stub_defines(tree):
             tasks = _STUB_NAMES[id(tree)][0] if id(tree) in _STUB_NAMES else task_names(tree)  # the zygote's
             if function in tasks and not _student_defines(lab_dir / f"{stem}.py", function):
                 # The student moved the task to a file of their own.

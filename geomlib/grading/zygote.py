@@ -51,8 +51,6 @@ PRELOAD = (
     "numpy",
     "scipy.sparse",
     "scipy.sparse.linalg",
-    "scipy.spatial",
-    "scipy.ndimage",
     "igl",
     "geomlib.validate",
     "geomlib.topology",
@@ -64,7 +62,7 @@ PRELOAD = (
 )
 
 #: Imported by the zygote before the first call of a lab whose course stubs import them (or of a
-#: lab without known stubs), not for the others: 0.3 s of CPU at every start of the grader
+#: lab without known stubs), not for the others: 0.4 s of CPU at every start of the grader
 #: (``geomlib grade --task N``) and a larger process to fork. Module -> what in a stub's import
 #: means the lab uses it.
 PRELOAD_IF_USED = {
@@ -72,6 +70,9 @@ PRELOAD_IF_USED = {
     # second of CPU, which every worker of those labs paid per call (their stubs too).
     "numba": ("numba", "geomlib.jit"),
     "scipy.fft": ("scipy.fft",),  # vdm's transport: 0.1 s per call otherwise
+    # 0.08 and 0.05 s of CPU; geomlib.textures looks points up in a k-d tree (maps).
+    "scipy.spatial": ("scipy.spatial", "geomlib.textures"),
+    "scipy.ndimage": ("scipy.ndimage",),
 }
 
 #: Processes (threads) a worker may add to what its user already runs.
@@ -426,7 +427,8 @@ def serve(sock: socket.socket) -> None:
         except Exception:  # noqa: BLE001 - the workers import them themselves
             pass
         try:
-            _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"))  # PyOpenGL, once, for a lab with shaders
+            # PyOpenGL, once, for a lab with shaders, at its first call that may use them
+            _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"), function=req.get("function"))
         except Exception:  # noqa: BLE001 - the worker imports it itself (and reports what fails)
             pass
         try:

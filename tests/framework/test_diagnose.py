@@ -203,3 +203,27 @@ def test_declared_task_tables_match_the_solutions(lab):
     assert declared.titles == derived.titles
     for f, blocks in declared.composites.items():
         assert derived.composites.get(f) is not None and set(blocks) == set(derived.composites[f]), f
+
+
+def test_a_probe_graded_earlier_in_the_run_is_not_called_again(monkeypatch):
+    """``--task 3`` of shadows grades light_uvz on "uvz-ortho", then render_with_shadows, whose
+    diagnosis probes light_uvz on "uvz-ortho" again: the probe takes the graded call's outputs (one
+    sandboxed call less per such probe, same message)."""
+    from geomlib.grading import diagnose
+
+    folder = _plant("shadows", "lookup", PLANTS["shadows-depth-comparison"][2])
+    monkeypatch.setattr(diagnose, "_CACHE", {})
+    monkeypatch.setattr(diagnose, "_OUTPUTS", {})
+    calls = []
+    lab = LabProxy("shadows", folder)
+    real = lab.call
+    monkeypatch.setattr(lab, "call", lambda function, *a, **k: (calls.append(function), real(function, *a, **k))[1])
+    cases = {c.id: c for c in load_cases("shadows")}
+    try:
+        for case_id in ("uvz-ortho", "render-small"):
+            with pytest.raises(Mismatch) as e:
+                run_case(lab, cases[case_id], feedback_dir=None)
+    finally:
+        shutil.rmtree(folder.parent, ignore_errors=True)
+    assert "render_with_shadows is off because light_uvz (Task 3:" in str(e.value)
+    assert calls.count("light_uvz") == 1, calls

@@ -394,6 +394,33 @@ def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, 
     assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
 
 
+@pytest.mark.parametrize("kind", ["free points", "rows inside a solid"])
+def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
+    """The first picture of shadows' --task 3 (wrong (u, v, z): free points) and of subdivision's
+    --task 1 (wrong matrix rows on a mesh) are drawn with Pillow, not a matplotlib figure (importing
+    matplotlib.figure, a 3D axes and a tight savefig cost 0.5-0.8 s of the 3 s a student waits for
+    --task N). Three panels, as every kind (test above)."""
+    code = textwrap.dedent(
+        f"""
+        import sys
+        from pathlib import Path
+        sys.path.insert(0, {str(Path(__file__).resolve().parents[2])!r})
+        from tests.framework.test_feedback_pictures import _kinds
+        from geomlib.grading import feedback
+        from geomlib.grading.checks import Context
+
+        feedback._drawn_in_time = lambda path, draw: (draw(), str(path))[1]
+        name, inputs, expected, got = next(k for k in _kinds() if k[0] == {kind!r})
+        ctx = Context(label=name, lab="kinds", case_id="k", feedback_dir={str(tmp_path)!r})
+        path = feedback.default_picture(ctx, inputs, expected, got)
+        print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
+        """
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, out
+    assert out[1:] == ["[]"], f"the picture imported {out[1:]}"
+
+
 def _file(text: str) -> str:
     return re.sub(r"\W+", "_", text)
 
@@ -454,6 +481,27 @@ def test_a_run_draws_the_first_failures_picture_unless_asked_for_all(tmp_path, m
         assert run.held == 3 - drawn and not run.failed, (mode, run.held, run.failed)
     with pytest.raises(ValueError, match="pictures='some'"):
         feedback.pictures_for_run("some")
+
+
+def test_a_marked_picture_past_the_runs_cap_prepares_nothing(tmp_path, monkeypatch):
+    """shadows' ray-casting test marks the points where it disagrees; once the run's picture is drawn
+    (the first failure's), the next marked picture is only counted as held back: its nearest
+    vertices (a k-d tree, and scipy.spatial imported in the grader) are not looked up."""
+    import scipy.spatial
+
+    monkeypatch.delenv("GEOMLIB_NO_FEEDBACK_PICTURES", raising=False)
+    monkeypatch.delenv("GEOMLIB_MAX_FEEDBACK_PICTURES", raising=False)
+    looked_up = []
+    real = scipy.spatial.cKDTree
+    monkeypatch.setattr(scipy.spatial, "cKDTree", lambda *a, **k: (looked_up.append(1), real(*a, **k))[1])
+    V, F = OCTA_V, OCTA_F
+    feedback.begin_test(tmp_path, "shadows", "test_agrees_with_ray_casting")
+    try:
+        with feedback.pictures_for_run("none") as run:
+            assert feedback.marked_picture("disagree", V, F, V[:2] * 0.5, "points where the two disagree") is None
+    finally:
+        feedback.end_test()
+    assert run.held == 1 and not looked_up, (run.held, looked_up)
 
 
 def test_a_picture_that_fails_while_the_tests_go_on_leaves_no_dangling_path(tmp_path, monkeypatch):

@@ -44,7 +44,14 @@ def _write(folder, text):
 
 @pytest.fixture
 def fresh_cache():
-    caches = (worker._TREES, worker._STUB_STAT, worker._STUB_CODE, worker._STUB_NAMES)
+    caches = (
+        worker._TREES,
+        worker._STUB_STAT,
+        worker._STUB_CODE,
+        worker._STUB_NAMES,
+        worker._STUB_DEFINES,
+        worker._STUB_PREFIX,
+    )
     saved = [dict(d) for d in caches]
     for d in caches:
         d.clear()
@@ -113,3 +120,109 @@ def test_a_stub_changed_with_its_size_and_mtime_kept_is_read_again(tmp_path, mon
     os.utime(stub, ns=(st.st_atime_ns, st.st_mtime_ns))
     assert (stub.stat().st_size, stub.stat().st_mtime_ns) == (st.st_size, st.st_mtime_ns)
     assert lab.task(2) == 11, "the zygote ran the stub's code as it was before the change"
+
+
+VALIDATED_STUB = '''
+def checked(x):
+    """Given validation."""
+    if x < 0:
+        raise ValueError("task: x must be >= 0")
+    return x
+
+
+def task(x):
+    """Task 1."""
+    x = checked(x)
+    raise NotImplementedError("Task 1 (the task)")
+'''
+
+NO_VALIDATION = """
+
+
+def task(x):
+    return 2 * x
+"""
+
+
+def test_the_stubs_validation_prefix_is_worked_out_in_the_zygote(tmp_path, fresh_cache, monkeypatch):
+    """A worker merges every task of a module at every call; the stub's side of it (the validation
+    prefix of each task and its ``ast.dump``) comes worked out from the zygote (prepare_stubs), so a
+    worker does not walk the stub's functions again. The merge is the same: a submission that drops
+    the validation still runs it, reported at its own ``def`` line."""
+    stubs, student = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy"
+    _write(stubs, VALIDATED_STUB)
+    _write(student, NO_VALIDATION)
+    worker.prepare_stubs(str(stubs))
+
+    def walked(_fn):
+        raise AssertionError("the worker walked the stub's function for its prefix again")
+
+    monkeypatch.setattr(worker, "_task_prefix", walked)
+    try:
+        fn = worker.find_function(student, "toy", "task", stubs)
+        assert fn(3) == 6
+        with pytest.raises(ValueError, match="x must be >= 0") as e:
+            fn(-1)
+        assert e.traceback[-2].lineno + 1 == 4  # the check runs at the submission's `def task` line
+    finally:
+        for name in [m for m in sys.modules if m.startswith("_graded_toy")]:
+            del sys.modules[name]
+        sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, worker._LabFinder)]
+
+
+def test_relocated_stub_code_is_the_deep_copy_moved_to_one_line():
+    """worker._relocate (a plain recursive copy, cheaper than copy.deepcopy) gives the same tree, with
+    the same positions, as a deep copy with every position moved, for every statement of every stub."""
+    import ast
+    import copy
+
+    from geomlib.grading.course import course
+
+    def deep(node, line):
+        node = copy.deepcopy(node)
+        for sub in ast.walk(node):
+            if "lineno" in sub._attributes:
+                sub.lineno = sub.end_lineno = line
+                sub.col_offset = sub.end_col_offset = 0
+        return node
+
+    n = 0
+    for lab in course().labs:
+        for path in sorted(course().lab(lab).stubs.glob("*.py")):
+            for fn in ast.parse(path.read_text()).body:
+                if not isinstance(fn, ast.FunctionDef):
+                    continue
+                for node in [fn.args, *fn.decorator_list, *([fn.returns] if fn.returns else []), *fn.body]:
+                    a, b = deep(node, 7), worker._relocate(node, 7)
+                    assert ast.dump(a, include_attributes=True) == ast.dump(b, include_attributes=True), (path, fn.name)
+                    assert b is not node
+                    n += 1
+    assert n > 1000
+
+
+def test_a_stub_statement_and_a_submissions_are_the_same_code_as_ast_dump_says():
+    """The merge keeps a task's validation prefix when the submission starts with the same statements;
+    worker._same decides it without writing both trees out (ast.dump did, for every statement of every
+    task at every call): the same answer as comparing dumps, on every stub prefix and task start
+    against the solution's first statements."""
+    import ast
+
+    from geomlib.grading.course import course
+
+    pairs = same = 0
+    for lab in course().labs:
+        paths = course().lab(lab)
+        for stub_path in sorted(paths.stubs.glob("*.py")):
+            solution = paths.solution / stub_path.name
+            if not solution.is_file():
+                continue
+            theirs = {f.name: f for f in ast.parse(solution.read_text()).body if isinstance(f, ast.FunctionDef)}
+            for fn in ast.parse(stub_path.read_text()).body:
+                if not isinstance(fn, ast.FunctionDef) or fn.name not in theirs:
+                    continue
+                for a in worker._task_prefix(fn) + fn.body[:3]:
+                    for b in theirs[fn.name].body[:6]:
+                        assert worker._same(a, b) == (ast.dump(a) == ast.dump(b)), (stub_path, fn.name, ast.dump(a))
+                        pairs += 1
+                        same += worker._same(a, b)
+    assert pairs > 5000 and 0 < same < pairs, (pairs, same)

@@ -16,7 +16,7 @@ import os, sys
 from pathlib import Path
 from geomlib.grading.sandbox import LabProxy
 
-root, stub_import = Path(sys.argv[1]), sys.argv[2]
+root, stub_import, module = Path(sys.argv[1]), sys.argv[2], (sys.argv[3:] or ["numba"])[0]
 stubs, lab = root / "stubs" / "prelab", root / "prelab"
 stubs.mkdir(parents=True)
 lab.mkdir()
@@ -25,7 +25,7 @@ given = stub_import + "\\n" if stub_import not in ("", "none") else ""
 # numba loaded before the lab's package: by the zygote (the stub's own import runs in the worker, after).
 (lab / "ops.py").write_text(
     "import sys\\n\\ndef loaded():\\n    names = list(sys.modules)\\n"
-    "    return ['numba' in names and names.index('numba') < names.index('_graded_prelab')]\\n"
+    f"    return [{module!r} in names and names.index({module!r}) < names.index('_graded_prelab')]\\n"
 )
 if stub_import != "none":
     os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
@@ -33,9 +33,9 @@ print(LabProxy("prelab", lab, timeout=120).loaded()[0])
 """
 
 
-def _numba_in_worker(tmp_path, stub_import: str) -> bool:
+def _numba_in_worker(tmp_path, stub_import: str, module: str = "numba") -> bool:
     p = subprocess.run(
-        [sys.executable, "-c", SCRIPT, str(tmp_path), stub_import], capture_output=True, text=True, timeout=300
+        [sys.executable, "-c", SCRIPT, str(tmp_path), stub_import, module], capture_output=True, text=True, timeout=300
     )
     assert p.returncode == 0, p.stderr[-2000:]
     return p.stdout.split()[-1] == "True"
@@ -52,3 +52,74 @@ def test_a_worker_of_a_numba_lab_inherits_numba(tmp_path, stub_import):
 
 def test_without_known_stubs_everything_is_preloaded(tmp_path):
     assert _numba_in_worker(tmp_path, "none")
+
+
+@pytest.mark.parametrize("module", ["scipy.spatial", "scipy.ndimage"])
+def test_scipy_spatial_and_ndimage_are_preloaded_for_the_labs_that_use_them(tmp_path, module):
+    """Like numba: 0.08 and 0.05 s of CPU at every start of the zygote, for subdivision too, whose
+    stubs use neither; a lab whose stubs import them (vdm, sdf, shadows' truth) still has them in
+    every worker."""
+    assert not _numba_in_worker(tmp_path / "no", "", module), f"the zygote imported {module} for a lab without it"
+    assert _numba_in_worker(tmp_path / "yes", f"import {module}", module), f"a worker imported {module} itself"
+
+
+GL_SCRIPT = """
+import os, sys
+from pathlib import Path
+from geomlib.grading.sandbox import LabProxy
+
+root = Path(sys.argv[1])
+stubs, lab = root / "stubs" / "gllab", root / "gllab"
+for folder in (stubs, lab):
+    (folder / "shaders").mkdir(parents=True)
+(stubs / "ops.py").write_text("def loaded():\\n    raise NotImplementedError('Task 1')\\n")
+(stubs / "glops.py").write_text(
+    "from geomlib import gl\\n\\n\\ndef gl_loaded():\\n    raise NotImplementedError('Task 2')\\n"
+)
+(stubs / "uses_glops.py").write_text(
+    "from .glops import gl_loaded\\n\\n\\ndef via():\\n    raise NotImplementedError('Task 3')\\n"
+)
+body = "import sys\\n\\n\\ndef {}():\\n    return ['OpenGL.GL' in sys.modules]\\n"  # before the stub's own imports
+(lab / "ops.py").write_text(body.format("loaded"))
+(lab / "glops.py").write_text(body.format("gl_loaded"))
+(lab / "uses_glops.py").write_text(body.format("via"))
+os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
+first = sys.argv[2]
+proxy = LabProxy("gllab", lab, timeout=120)
+print(getattr(proxy, first)()[0], proxy.loaded()[0])
+"""
+
+
+@pytest.mark.parametrize("first", ["loaded", "gl_loaded", "via"])
+def test_pyopengl_is_preloaded_at_the_first_call_that_may_use_it(tmp_path, first):
+    """A lab with shaders/: the zygote imports PyOpenGL (0.2 s of CPU) before the first call whose
+    stub module imports geomlib.gl, itself or through the lab's modules it imports, and from then on
+    for every call; not for calls before that (shadows' --task 3 runs no shader)."""
+    p = subprocess.run(
+        [sys.executable, "-c", GL_SCRIPT, str(tmp_path), first], capture_output=True, text=True, timeout=300
+    )
+    assert p.returncode == 0, p.stderr[-2000:]
+    at_first, after = p.stdout.split()[-2:]
+    expected = "False" if first == "loaded" else "True"
+    assert (at_first, after) == (expected, expected), (first, at_first, after)
+
+
+def test_whether_a_call_may_use_opengl_is_worked_out_once(tmp_path, monkeypatch):
+    """The zygote asks at every call of a lab with shaders/ until PyOpenGL is loaded (for all of
+    shadows' --task 3, which runs no shader): the stubs are walked once per function, not per call
+    (4-12 ms each)."""
+    from geomlib.grading import worker
+
+    stubs = tmp_path / "gllab"
+    stubs.mkdir()
+    (stubs / "ops.py").write_text("from . import glops\n\n\ndef plain():\n    raise NotImplementedError('Task 1')\n")
+    (stubs / "glops.py").write_text(
+        "from geomlib import gl\n\n\ndef drawn():\n    raise NotImplementedError('Task 2')\n"
+    )
+    worker.prepare_stubs(str(stubs))
+    assert worker._may_use_gl(str(stubs), "plain") and worker._may_use_gl(str(stubs), "drawn")
+    walked = []
+    real = worker.ast.walk
+    monkeypatch.setattr(worker.ast, "walk", lambda node: (walked.append(node), real(node))[1])
+    assert worker._may_use_gl(str(stubs), "plain") and worker._may_use_gl(str(stubs), "drawn")
+    assert not walked, "the stubs were walked again"
