@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib import topology
+from geomlib.errors import MeshError
 
 from . import kernels as K
 
@@ -128,9 +129,31 @@ def make_state(
 
 
 def state_mesh(S: RemeshState) -> tuple[np.ndarray, np.ndarray]:
-    """The state's mesh as compact ``(V, F)``: removed vertices dropped, indices renumbered."""
+    """The state's mesh as compact ``(V, F)``: removed vertices dropped, indices renumbered.
+
+    Raises
+    ------
+    MeshError
+        When the kernels' valence count ``val`` disagrees with the mesh at a vertex: the local
+        operations keep it by hand (split, collapse and flip each add or remove edges), and a wrong
+        count steers later checks and flips without breaking the mesh, so it is caught here.
+    """
     F = S.faces()
-    used = np.zeros(S.cnt[0], bool)
+    n = int(S.cnt[0])
+    used = np.zeros(n, bool)
     used[F.ravel()] = True
+    a, b = F.ravel(), F[:, [1, 2, 0]].ravel()
+    key = np.unique(np.minimum(a, b) * n + np.maximum(a, b))
+    edges_at = np.bincount(np.r_[key // n, key % n], minlength=n)
+    wrong = np.flatnonzero(used & (edges_at != S.val[:n]))
+    if len(wrong):
+        v = int(wrong[0])
+        more = len(wrong) - 1
+        others = f"; {more} more {'vertex disagrees' if more == 1 else 'vertices disagree'}" if more else ""
+        raise MeshError(
+            f"the local operations' valence count val[{v}] is {int(S.val[v])}, but {int(edges_at[v])} edges meet "
+            f"at vertex {v}{others}: each operation must keep val[v] = the number of edges at v (Task 1 edge "
+            "split, Task 2 edge collapse, Task 3 edge flip)"
+        )
     new = np.cumsum(used) - 1
     return S.V[: S.cnt[0]][used].copy(), new[F]

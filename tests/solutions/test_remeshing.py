@@ -233,3 +233,24 @@ def test_sliver_clean_up_raises_the_smallest_angle():
     assert edits >= 2 and after > 4 * before and after > 15.0, (edits, before, after)
     kept = (np.abs(U[:, None, :] - V[None, :, :]).sum(axis=2) == 0).any(axis=1)
     assert kept.all(), "the clean-up moved a vertex"
+
+
+def test_a_wrong_valence_count_is_named_when_the_mesh_is_returned():
+    """The kernels keep each vertex's valence by hand; a wrong count (an operation that forgot one
+    edge) leaves a valid mesh, so state_mesh compares it with the faces and names the vertex."""
+    import pytest
+
+    from geomlib.errors import MeshError
+
+    V, F = datasets.icosphere(1)
+    S = M.make_state(V, F)
+    M.state_mesh(S)  # the counts of a fresh state agree
+    k = int(S.val[7])
+    S.val[7] += 1
+    with pytest.raises(
+        MeshError, match=rf"val\[7\] is {k + 1}, but {k} edges meet at vertex 7: .*Task 2 edge collapse"
+    ):
+        M.state_mesh(S)
+    S.val[9] -= 1
+    with pytest.raises(MeshError, match=r"val\[7\] .*; 1 more vertex disagrees"):
+        M.state_mesh(S)
