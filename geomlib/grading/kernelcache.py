@@ -63,7 +63,7 @@ from pathlib import Path
 
 from geomlib.jit import _private  # a real folder of this user that no one else can write
 
-__all__ = ["Entry", "open_entry", "seed", "publish", "MAX_AGE_S"]
+__all__ = ["Entry", "open_entry", "seed", "publish", "remove_tree", "MAX_AGE_S"]
 
 #: Entries not used for this long are removed when a new entry is made (none is ever in use that long).
 MAX_AGE_S = 14 * 24 * 3600
@@ -126,7 +126,8 @@ def _locked(path: Path):
         os.close(fd)
 
 
-def _remove(folder: Path) -> None:
+def remove_tree(folder: Path) -> None:
+    """Remove ``folder`` and everything in it, read-only folders included (snapshots are 0o555)."""
     for dirpath, _, _ in os.walk(folder):
         with contextlib.suppress(OSError):
             os.chmod(dirpath, 0o700)
@@ -143,7 +144,7 @@ def _evict(cache: Path) -> None:
                 continue
             new = child.name.startswith(".new-")
             if child.is_dir() and age > (_STALE_NEW_S if new else MAX_AGE_S):
-                _remove(child)
+                remove_tree(child)
 
 
 def open_entry(cache: Path, lab_dir: Path, lab_key: str, stubs_key: str, copy) -> Entry | None:
@@ -174,7 +175,7 @@ def open_entry(cache: Path, lab_dir: Path, lab_key: str, stubs_key: str, copy) -
         try:
             os.rename(tmp, root)
         except OSError:  # another process made it first: the same bytes, use theirs
-            _remove(tmp)
+            remove_tree(tmp)
         with contextlib.suppress(OSError):
             _evict(cache)
     if not (root / "src" / name).is_dir() or not _private(root / "numba"):

@@ -494,13 +494,10 @@ class _Zygote:
 
     @staticmethod
     def _drop(snap: _Snapshot) -> None:
+        from geomlib.grading.kernelcache import remove_tree
+
         if snap.shared is None:  # a persistent snapshot (trusted code) is kept for later runs
-            for dirpath, _, _ in os.walk(snap.dest.parent):
-                try:
-                    os.chmod(dirpath, 0o755)
-                except OSError:
-                    pass
-            shutil.rmtree(snap.dest.parent, ignore_errors=True)
+            remove_tree(snap.dest.parent)
         for folder in snap.jit.values():
             shutil.rmtree(folder, ignore_errors=True)
 
@@ -569,11 +566,9 @@ class _Zygote:
             self.proc.wait(10)
         except Exception:  # noqa: BLE001
             self.proc.kill()
-        for snap in self.snapshots.values():
-            if snap.shared is None:  # a persistent snapshot is not in scratch_root: kept
-                for dirpath, _, _ in os.walk(snap.dest.parent):
-                    os.chmod(dirpath, 0o755)
-        shutil.rmtree(self.scratch_root, ignore_errors=True)
+        from geomlib.grading.kernelcache import remove_tree
+
+        remove_tree(self.scratch_root)  # the private snapshots; a persistent one is not in it: kept
 
 
 def _read_frame(fd: int, deadline: float, max_bytes: int | None) -> tuple[bytes | None, str]:
