@@ -33,7 +33,7 @@ import time
 from pathlib import Path
 
 from geomlib.grading import tasks as _tasks
-from geomlib.grading.errors import GradingFailure, Mismatch, NotImplementedYet
+from geomlib.grading.errors import GradingFailure, Mismatch, NotImplementedYet, see_picture
 
 __all__ = ["enrich", "explain", "probes_for"]
 
@@ -139,7 +139,7 @@ def _run_probe(lab, probe, mod, feedback_dir):
                     where = ""
             pic = e.feedback or _picture(mod, probe.function, ctx, inputs, expected, got)
             msg = e.message + (f" — {probe.hint}" if probe.hint else "")
-            out = (f"differs{where}", msg + (f" (see {pic})" if pic else ""))
+            out = (f"differs{where}", msg + see_picture(pic))
     except NotImplementedYet:
         out = ("is not implemented yet", "")
     except GradingFailure as e:

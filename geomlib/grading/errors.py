@@ -6,6 +6,16 @@ plugin shows only their message, never a traceback of the grader.
 
 from __future__ import annotations
 
+import re
+
+#: Finds the reference :func:`see_picture` writes, its group the picture's path (with the space before it).
+SEE_PICTURE = re.compile(r" ?\(see ([^()]+?\.png)\)")
+
+
+def see_picture(path: str | None) -> str:
+    """How a message points at its feedback picture: ``" (see PATH)"``, or ``""`` without one."""
+    return f" (see {path})" if path else ""
+
 
 class GradingFailure(AssertionError):
     """A graded test failed for a reason the message explains.
@@ -24,7 +34,7 @@ class GradingFailure(AssertionError):
         self.feedback = feedback
 
     def __str__(self) -> str:
-        return self.message + (f" (see {self.feedback})" if self.feedback else "")
+        return self.message + see_picture(self.feedback)
 
 
 class Mismatch(GradingFailure):

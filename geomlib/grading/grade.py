@@ -21,6 +21,7 @@ from pathlib import Path
 from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.course import course
+from geomlib.grading.errors import SEE_PICTURE
 from geomlib.grading.results import build_results, write_results
 from geomlib.grading.settings import GradingSettings, env
 from geomlib.taskref import find_task, task_at_start
@@ -276,7 +277,7 @@ def _remove_stale_pictures(feedback_dir, records, *, before: float, ran: dict | 
 
     cited, stems = set(), {}
     for r in records:
-        for p in [r.picture or "", *_SEE.findall(r.message or "")]:
+        for p in [r.picture or "", *SEE_PICTURE.findall(r.message or "")]:
             if p:
                 cited.add((Path(p).parent.name, Path(p).name))
         if ran is not None and r.nodeid in ran:
@@ -299,7 +300,6 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
     return (keep or lines)[-limit:]
 
 
-_SEE = re.compile(r"\(see ([^()]+?\.png)\)")
 #: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
 _ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to ")
 
@@ -346,7 +346,7 @@ def report_lines(
     seen: set[str] = set()
     for r in failed:
         msg = " ".join(r.message.split())  # one line, whatever the message
-        for pic in _SEE.findall(msg):
+        for pic in SEE_PICTURE.findall(msg):
             if pic not in pictures:
                 pictures.append(pic)
         if r.not_implemented:

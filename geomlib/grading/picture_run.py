@@ -103,8 +103,10 @@ def _finish_pending(keep: int = 0) -> set:
 
 def without_pictures(message: str, paths) -> str:
     """``message`` without its ``(see PATH)`` for each of ``paths`` (pictures that were not drawn)."""
+    from geomlib.grading.errors import see_picture
+
     for p in paths:
-        message = message.replace(f" (see {p})", "")
+        message = message.replace(see_picture(p), "")
     return message
 
 

@@ -18,6 +18,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from geomlib.grading.errors import SEE_PICTURE
 from geomlib.grading.sandbox import clean_text
 
 __all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results", "markdown_text", "plain_text"]
@@ -164,13 +165,10 @@ def embedded_picture(path: str | Path) -> str | None:
     return f'<img alt="feedback picture" style="max-width: 100%" src="data:image/png;base64,{base64.b64encode(data).decode()}">'
 
 
-_SEE = re.compile(r" ?\(see ([^()]+?\.png)\)")
-
-
 def _without_paths(message: str, embedded: str | None) -> str:
     """The message without "(see feedback/....png)": the student cannot open the grader's files.
     The embedded picture becomes "(picture below)"."""
-    return _SEE.sub(lambda m: " (picture below)" if embedded and m.group(1) == embedded else "", message)
+    return SEE_PICTURE.sub(lambda m: " (picture below)" if embedded and m.group(1) == embedded else "", message)
 
 
 def _test_output(r: Record) -> dict:
