@@ -231,3 +231,25 @@ def failure_of(lab: str, edit, run: Callable, error: type[Exception], timeout: f
     with planted_lab(lab, edit, timeout) as proxy, pytest.raises(error) as e:
         run(proxy)
     return str(e.value)
+
+
+#: A lab's stub ``kernels.py`` with one numba task kernel (``scale``, "Task 1") and one given kernel
+#: that calls it (``driver``): the given kernel's machine code holds the submission's. Tests append
+#: the given function that calls ``driver``.
+NUMBA_TASK_AND_GIVEN_KERNEL = """from numba import njit
+
+from geomlib.jit import use_cache_folder
+
+use_cache_folder(__name__, __file__)
+
+
+@njit(cache=True)
+def scale(x):
+    \"\"\"Task 1: twice x.\"\"\"
+    raise NotImplementedError("Task 1 (scale)")
+
+
+@njit(cache=True)
+def driver(x):
+    return scale(x) + 1.0
+"""

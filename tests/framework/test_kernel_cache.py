@@ -22,32 +22,20 @@ from pathlib import Path
 
 import pytest
 
-STUB = '''"""A lab with one task kernel and one given kernel that calls it."""
+from .course import NUMBA_TASK_AND_GIVEN_KERNEL
 
-import numpy as np
-from numba import njit
-
-from geomlib.jit import use_cache_folder
-
-use_cache_folder(__name__, __file__)
-
-
-@njit(cache=True)
-def scale(x):
-    """Task 1: twice x."""
-    raise NotImplementedError("Task 1 (scale)")
-
-
-@njit(cache=True)
-def driver(x):
-    return scale(x) + 1.0
-
+STUB = (
+    '"""A lab with one task kernel and one given kernel that calls it."""\n\nimport numpy as np\n'
+    + NUMBA_TASK_AND_GIVEN_KERNEL
+    + '''
 
 def probe(x):
     """Given: driver(x), then numba's cache misses and hits of the given kernel in this worker."""
     v = driver(x)
     return np.array([v, sum(driver.stats.cache_misses.values()), sum(driver.stats.cache_hits.values())])
 '''
+)
+
 SOLUTION = STUB.replace('    raise NotImplementedError("Task 1 (scale)")', "    return 2.0 * x")
 
 #: One grading process: ``probe(1.5)`` of the lab folder argv[1], then what it wants to know.

@@ -20,6 +20,8 @@ import pytest
 from geomlib.grading import impl as _impl
 from geomlib.grading.sandbox import LabProxy
 
+from .course import NUMBA_TASK_AND_GIVEN_KERNEL
+
 ROOT = _impl.course_root()
 
 
@@ -155,29 +157,17 @@ def test_a_kernel_changed_with_its_size_and_mtime_kept_is_compiled_again(tmp_pat
     assert lab.f(1.5) == 3.0
 
 
-STUB_KERNELS = '''
-from numba import njit
-
-from geomlib.jit import use_cache_folder
-
-use_cache_folder(__name__, __file__)
-
-
-@njit(cache=True)
-def scale(x):
-    """Task 1."""
-    raise NotImplementedError("Task 1 (scale)")
-
-
-@njit(cache=True)
-def driver(x):
-    return scale(x) + 1.0
-
+STUB_KERNELS = (
+    "\n"
+    + NUMBA_TASK_AND_GIVEN_KERNEL
+    + '''
 
 def run(x):
     """Given: calls the given kernel, which calls the student's."""
     return driver(x)
 '''
+)
+
 
 STUDENT_KERNELS = """
 from numba import njit
