@@ -34,7 +34,7 @@ import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["cache_folder", "use_cache_folder"]
+__all__ = ["cache_folder", "use_cache_folder", "is_private_folder"]
 
 
 def _writable(folder: Path) -> bool:
@@ -48,7 +48,7 @@ def _writable(folder: Path) -> bool:
     return True
 
 
-def _private(folder: Path) -> bool:
+def is_private_folder(folder: Path) -> bool:
     """A real folder (not a link) owned by the current user that no one else can write to."""
     try:
         info = folder.lstat()
@@ -64,7 +64,7 @@ def _private_temp_root(root: Path) -> Path:
         folder.mkdir(mode=0o700, exist_ok=True)
     except OSError:
         pass
-    if not (_private(folder) and _writable(folder)):
+    if not (is_private_folder(folder) and _writable(folder)):
         folder = Path(tempfile.mkdtemp(prefix="geomlib-numba-cache-", dir=root))
     return folder
 

@@ -61,7 +61,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from geomlib.jit import _private  # a real folder of this user that no one else can write
+from geomlib.jit import is_private_folder
 
 __all__ = ["Entry", "open_entry", "seed", "publish", "remove_tree", "MAX_AGE_S"]
 
@@ -159,7 +159,7 @@ def open_entry(cache: Path, lab_dir: Path, lab_key: str, stubs_key: str, copy) -
         cache.mkdir(mode=0o700, parents=True, exist_ok=True)
     except OSError:
         return None
-    if not _private(cache):
+    if not is_private_folder(cache):
         return None
     name = lab_dir.name
     root = cache / entry_key(name, lab_key, stubs_key)
@@ -178,7 +178,7 @@ def open_entry(cache: Path, lab_dir: Path, lab_key: str, stubs_key: str, copy) -
             remove_tree(tmp)
         with contextlib.suppress(OSError):
             _evict(cache)
-    if not (root / "src" / name).is_dir() or not _private(root / "numba"):
+    if not (root / "src" / name).is_dir() or not is_private_folder(root / "numba"):
         return None
     with contextlib.suppress(OSError):
         os.utime(root)  # its last use, for the eviction of old entries
