@@ -317,10 +317,11 @@ def fig_boundary(out: Path, lab, quick: bool) -> Drawn:
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True)
     imgs = [render(V, F, highlight_lines=outline, **kw)]
     caps = [f"input: {len(F)} faces, its outline in green"]
-    off = {}
+    off, faces = {}, {}
     for keep in (False, True):
         U, G = qem_simplify(V, F, target, preserve_boundary=keep)
         U, G = np.asarray(U), np.asarray(G)
+        faces[keep] = len(G)
         loop = topology.boundary_loops(G)[0]
         off[keep] = 100 * float(_outline_distance(U[loop], A, B).max()) / diag
         imgs.append(render(U, G, highlight_points=loop, highlight_lines=outline, **kw))
@@ -331,13 +332,14 @@ def fig_boundary(out: Path, lab, quick: bool) -> Drawn:
     img = panels(imgs, caps, title="Boundary penalty quadrics keep the outline")
     return Drawn.claimed(
         img,
-        "An open height field simplified to {share:.0%} of its faces ({target} faces; red dots: the result's "
+        "An open height field simplified to {share:.0%} of its faces (a target of {target}: {faces} faces come out, "
+        "each collapse removing two; red dots: the result's "
         "boundary vertices, green line: the input's outline). Without penalty quadrics a boundary vertex only "
         "feels the planes of its few faces, so it slides off the outline at little cost and the result cuts the "
         "corners: its boundary vertices lie up to {off_free:.2f}% of the bounding-box diagonal from the input's "
         "outline. A plane through each boundary edge, perpendicular to its face and weighted like the faces, keeps them "
         "within {off_kept:.2f}% of it.",
-        share=target / len(F), target=target, off_free=off[False], off_kept=off[True],
+        share=target / len(F), target=target, faces=faces[True], off_free=off[False], off_kept=off[True],
     )  # fmt: skip
 
 
