@@ -345,6 +345,8 @@ def sandbox_interpreter(user: str, log=print) -> str:
     log(f"the sandbox user cannot run {sys.executable}; making {venv} as the autograder's setup.sh does")
     env = {**os.environ, "UV_PROJECT_ENVIRONMENT": str(venv)}
     env.pop("VIRTUAL_ENV", None)
+    # Bytecode compiled now (the sandbox user cannot write it), unless uv's own UV_COMPILE_BYTECODE=0 says not to.
+    env.setdefault("UV_COMPILE_BYTECODE", "1")
     base = setting("GEOMLIB_AUTOGRADER_PYTHON") or next((c for c in PYTHON_CANDIDATES if os.access(c, os.X_OK)), "")
     try:
         if not base:
@@ -355,7 +357,7 @@ def sandbox_interpreter(user: str, log=print) -> str:
             ).stdout.strip()
             subprocess.run(["chmod", "-R", "a+rX", env["UV_PYTHON_INSTALL_DIR"]], check=True)
         subprocess.run(
-            [*_uv(), "sync", "--frozen", "--no-dev", "--group", "grading", "--compile-bytecode", "--python", base,
+            [*_uv(), "sync", "--frozen", "--no-dev", "--group", "grading", "--python", base,
              "--no-python-downloads", "--quiet"],
             cwd=root, env=env, check=True, capture_output=True, text=True,
         )  # fmt: skip

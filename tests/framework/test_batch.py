@@ -138,7 +138,11 @@ def test_a_sandbox_user_that_cannot_run_the_grader_stops_grade_all_with_one_line
 @pytest.mark.skipif(os.geteuid() != 0, reason="the sandbox user is used as root only")
 def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user(tmp_path):
     """docs/autograder.md: `uv run geomlib grade-all ...` in the course, as root, with the `.venv` that
-    `./run` or `uv sync` made (its Python may live under /root, which the sandbox user cannot open)."""
+    `./run` or `uv sync` made (its Python may live under /root, which the sandbox user cannot open).
+
+    UV_COMPILE_BYTECODE=0: the `.venv-sandbox` grade-all makes is synced without compiling its bytecode
+    (about 15 s of CPU that no outcome here depends on; the autograder's setup.sh, which makes the same
+    environment the same way, compiles it in test_release_course.py, which checks that it did)."""
     import subprocess
     import tempfile
 
@@ -153,7 +157,8 @@ def test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandb
         p = subprocess.run(
             [str(venv_python), "-m", "geomlib.cli", "grade-all", str(subs), "--lab", "subdivision",
              "--out", str(subs / "out"), "--jobs", "1"],
-            cwd=course, env={**env, "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}, capture_output=True, text=True, timeout=900,
+            cwd=course, env={**env, "GEOMLIB_NO_FEEDBACK_PICTURES": "1", "UV_COMPILE_BYTECODE": "0"},
+            capture_output=True, text=True, timeout=900,
         )  # fmt: skip
         assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
         results = json.loads((subs / "out" / "stubs-student" / "results.json").read_text())

@@ -41,7 +41,12 @@ def test_run_figures_in_a_fresh_clone_as_root_with_the_system_python(fresh):
     clone, home, out = fresh / "clone", fresh / "home", fresh / "figures"
     home.mkdir()
     subprocess.run(["git", "clone", "--quiet", str(ROOT), str(clone)], check=True, timeout=300)
-    env = clean_env(home, UV_CACHE_DIR=str(cache), GEOMLIB_UV_WHEEL=str(wheel))
+    # UV_COMPILE_BYTECODE=0: ./run's bytecode compile of the whole locked environment (about 20 s of
+    # CPU; no outcome of this test depends on it) is the same line on the same lock that set up the
+    # environment running this suite (CI's `./run tests`); setup.sh's compile is checked in
+    # test_release_course.py. (test_fresh_student.py's symbolic links into the shared uv cache
+    # compile nothing: uv skips linked files.)
+    env = clean_env(home, UV_CACHE_DIR=str(cache), GEOMLIB_UV_WHEEL=str(wheel), UV_COMPILE_BYTECODE="0")
     t0 = time.monotonic()
     p = subprocess.run(
         [*env_i(env), "./run", "figures", "--lab", "subdivision", "--out", str(out)],
