@@ -171,3 +171,33 @@ def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
         link = tmp_path / ".local" / "bin" / "uv"
         assert link.is_symlink() and link.resolve() == (private / "uv").resolve(), (job, p.stderr)
         assert ("not on your PATH yet" in p.stderr) == says, (job, p.stderr)
+
+
+def test_the_set_up_of_a_one_lab_bundle_names_its_lab(tmp_path):
+    """The student bundle of one lab: `./run setup`'s last line is a command the student can paste
+    (it said `--lab LAB` whatever the bundle held); with several labs it stays `LAB`."""
+    bash = shutil.which("bash")
+    for labs, expected in ((("subdivision",), "--lab subdivision"), (("maps", "sdf"), "--lab LAB")):
+        course = tmp_path / "-".join(labs)
+        (course / "geomlib" / "grading").mkdir(parents=True)
+        shutil.copy2(ROOT / "run", course / "run")
+        shutil.copy2(ROOT / "geomlib" / "grading" / "bootstrap.py", course / "geomlib" / "grading" / "bootstrap.py")
+        for lab in labs:
+            (course / "labs" / lab).mkdir(parents=True)
+            (course / "labs" / lab / "README.md").write_text(f"# {lab}\n")
+        (course / "uv").write_text(f"#!{bash}\nexit 0")
+        (course / "uv").chmod(0o755)
+        (course / "lib").mkdir()
+        (course / "lib" / "libOSMesa.so.8").write_text("")
+        env = {
+            "PATH": f"{Path(shutil.which('python3')).parent}:/usr/bin:/bin",
+            "HOME": str(course),
+            "GEOMLIB_LIB_DIRS": str(course / "lib"),
+            "GEOMLIB_UV": str(course / "uv"),
+        }
+        p = subprocess.run([str(course / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+        last = p.stderr.strip().splitlines()[-1]
+        assert last.startswith("[setup] ready") and last.endswith(f"uv run geomlib grade --impl labs {expected}"), (
+            p.stderr
+        )
