@@ -845,9 +845,10 @@ def _outcome(function: str, reply: dict, timeout: float, memory_mb: int, max_byt
         raise NotImplementedYet(f"{function}: not implemented yet{task}")
     if kind == "exception":
         mro = [clean_text(m, 200) for m in info.get("mro", [])[:20]] if isinstance(info.get("mro"), list) else []
-        raise StudentError(
-            _format_student_exception(function, info) + tail, clean_text(info.get("type", "?"), 200), mro, message
-        )
+        text = _format_student_exception(function, info)
+        if tail and not text.endswith("."):  # "... is not defined. Your code printed: ..."
+            text += "."
+        raise StudentError(text + tail, clean_text(info.get("type", "?"), 200), mro, message)
     if kind == "memory":
         raise StudentCrash(f"{function} ran out of memory (limit {memory_mb} MiB).{tail}")
     if kind == "exit":

@@ -142,3 +142,62 @@ def test_a_supported_system_python_is_used_as_it_is(tmp_path):
     p, calls = _run_with_fake_uv(tmp_path, python_found=True, install_ok=True)
     assert p.returncode == 0, p.stderr
     assert not [c for c in calls if c.startswith("uv python install")] and "Python" not in p.stderr, calls
+
+
+def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
+    """docs/instructors.md's commands are `uv run geomlib ...` after `./run figures` or `./run tests`:
+    every job, not only `setup`, links the uv it found into ~/.local/bin and says so once when that
+    folder is off the PATH (a uv outside the PATH, as the private copy is)."""
+    fake, tools, libs, private = (tmp_path / d for d in ("fake", "tools", "lib", "private"))
+    for d in (fake, tools, libs, private):
+        d.mkdir()
+    for t in (*TOOLS, "python3", "mkdir", "ln"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
+    bash = shutil.which("bash")
+    (fake / "id").write_text(f"#!{bash}\necho 0")
+    (private / "uv").write_text(f"#!{bash}\nexit 0")  # the private copy: not on the PATH
+    for f in (fake / "id", private / "uv"):
+        f.chmod(0o755)
+    env = {
+        "PATH": f"{fake}:{tools}",
+        "HOME": str(tmp_path),
+        "GEOMLIB_LIB_DIRS": str(libs),
+        "GEOMLIB_UV": str(private / "uv"),
+    }
+    for job, says in (("figures", True), ("figures", False), ("setup", True)):
+        p = subprocess.run([str(ROOT / "run"), job], env=env, capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+        link = tmp_path / ".local" / "bin" / "uv"
+        assert link.is_symlink() and link.resolve() == (private / "uv").resolve(), (job, p.stderr)
+        assert ("not on your PATH yet" in p.stderr) == says, (job, p.stderr)
+
+
+def test_the_set_up_of_a_one_lab_bundle_names_its_lab(tmp_path):
+    """The student bundle of one lab: `./run setup`'s last line is a command the student can paste
+    (it said `--lab LAB` whatever the bundle held); with several labs it stays `LAB`."""
+    bash = shutil.which("bash")
+    for labs, expected in ((("subdivision",), "--lab subdivision"), (("maps", "sdf"), "--lab LAB")):
+        course = tmp_path / "-".join(labs)
+        (course / "geomlib" / "grading").mkdir(parents=True)
+        shutil.copy2(ROOT / "run", course / "run")
+        shutil.copy2(ROOT / "geomlib" / "grading" / "bootstrap.py", course / "geomlib" / "grading" / "bootstrap.py")
+        for lab in labs:
+            (course / "labs" / lab).mkdir(parents=True)
+            (course / "labs" / lab / "README.md").write_text(f"# {lab}\n")
+        (course / "uv").write_text(f"#!{bash}\nexit 0")
+        (course / "uv").chmod(0o755)
+        (course / "lib").mkdir()
+        (course / "lib" / "libOSMesa.so.8").write_text("")
+        env = {
+            "PATH": f"{Path(shutil.which('python3')).parent}:/usr/bin:/bin",
+            "HOME": str(course),
+            "GEOMLIB_LIB_DIRS": str(course / "lib"),
+            "GEOMLIB_UV": str(course / "uv"),
+        }
+        p = subprocess.run([str(course / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+        last = p.stderr.strip().splitlines()[-1]
+        assert last.startswith("[setup] ready") and last.endswith(f"uv run geomlib grade --impl labs {expected}"), (
+            p.stderr
+        )

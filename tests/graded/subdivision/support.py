@@ -144,7 +144,9 @@ def matrix_mismatch(name: str, expected, got, *, atol: float = tol.EXACT, what_r
     )
     sums = G.sum(axis=1)
     if np.abs(sums - 1).max() > 1e-9:
-        k = int(np.argmax(np.abs(sums - 1)))
+        # The row shown above when its sum is off too (the largest deviation picked another row
+        # for a last-bit difference: "row 0: ... (row 1 sums to 0.85)").
+        k = r if abs(sums[r] - 1) > 1e-9 else int(np.argmax(np.abs(sums - 1)))
         msg += f" (row {k} sums to {sums[k]:.6g}; subdivision weights of a row always sum to 1)"
     return msg
 
