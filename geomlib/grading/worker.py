@@ -176,27 +176,33 @@ def _may_use_gl(stubs_dir: str, function: str) -> bool:
     """Whether the course's stub module that defines ``function`` imports one of :data:`_GL_MODULES`,
     itself or through the lab's other stub modules it imports (relative imports, at any depth of
     the file); True when that is not known (no parsed stub defines it: a submission's own file)."""
+    return may_import(stubs_dir, function, _GL_MODULES)
+
+
+def may_import(stubs_dir: str, function: str, modules: tuple[str, ...]) -> bool:
+    """:func:`_may_use_gl` for any ``modules`` (names or prefixes of dotted names): whether a call of
+    ``function`` may import one of them, from the stubs the zygote parsed (:func:`prepare_stubs`)."""
     trees = {p.stem: _TREES.get((str(p), False)) for p in sorted(Path(stubs_dir).glob("*.py"))}
-    key = (stubs_dir, function)
+    key = (stubs_dir, function, modules)
     version = tuple(map(id, trees.values()))  # the trees of this version of the stubs (prepare_stubs)
     known = _GL_USE.get(key)
     if known is not None and known[0] == version and all(t is not None for t in trees.values()):
         return known[1]  # asked at every call until OpenGL is loaded: 4-12 ms of walking the stubs each
-    _GL_USE[key] = (version, _walk_for_gl(trees, function))
+    _GL_USE[key] = (version, _walk_for(trees, function, modules))
     return _GL_USE[key][1]
 
 
-#: :func:`_may_use_gl` by (stubs folder, function): (ids of the stub trees, the answer).
+#: :func:`may_import` by (stubs folder, function, modules): (ids of the stub trees, the answer).
 _GL_USE: dict = {}
 
 
-def _walk_for_gl(trees: dict, function: str) -> bool:
+def _walk_for(trees: dict, function: str, modules: tuple[str, ...]) -> bool:
     todo = [stem for stem, t in trees.items() if isinstance(t, ast.Module) and function in _stub_defines(t)]
     if not todo:
         return True
 
     def gl(name: str) -> bool:
-        return any(name == m or name.startswith(m + ".") for m in _GL_MODULES)
+        return any(name == m or name.startswith(m + ".") for m in modules)
 
     seen = set()
     while todo:
