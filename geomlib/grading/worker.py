@@ -33,6 +33,7 @@ import importlib
 import importlib.abc
 import importlib.util
 import json
+import marshal
 import os
 import re
 import resource
@@ -159,6 +160,10 @@ def prepare_gl(*lab_folders: str | None, function: str | None = None) -> None:
     platform = backend()  # PYOPENGL_PLATFORM before PyOpenGL's import (inherited by the workers)
     importlib.import_module("OpenGL.GL")
     importlib.import_module("OpenGL.arrays")
+    # PyOpenGL's array handlers, which it imports at a worker's first GL call (numpy arrays,
+    # ctypes arrays and pointers, lists, bytes): ~17 ms of CPU per GLSL call otherwise.
+    for handler in ("numpymodule", "ctypesarrays", "ctypespointers", "lists", "strings"):
+        importlib.import_module(f"OpenGL.arrays.{handler}")
     if platform == "osmesa":
         importlib.import_module("OpenGL.osmesa")
 
@@ -171,27 +176,33 @@ def _may_use_gl(stubs_dir: str, function: str) -> bool:
     """Whether the course's stub module that defines ``function`` imports one of :data:`_GL_MODULES`,
     itself or through the lab's other stub modules it imports (relative imports, at any depth of
     the file); True when that is not known (no parsed stub defines it: a submission's own file)."""
+    return may_import(stubs_dir, function, _GL_MODULES)
+
+
+def may_import(stubs_dir: str, function: str, modules: tuple[str, ...]) -> bool:
+    """:func:`_may_use_gl` for any ``modules`` (names or prefixes of dotted names): whether a call of
+    ``function`` may import one of them, from the stubs the zygote parsed (:func:`prepare_stubs`)."""
     trees = {p.stem: _TREES.get((str(p), False)) for p in sorted(Path(stubs_dir).glob("*.py"))}
-    key = (stubs_dir, function)
+    key = (stubs_dir, function, modules)
     version = tuple(map(id, trees.values()))  # the trees of this version of the stubs (prepare_stubs)
     known = _GL_USE.get(key)
     if known is not None and known[0] == version and all(t is not None for t in trees.values()):
         return known[1]  # asked at every call until OpenGL is loaded: 4-12 ms of walking the stubs each
-    _GL_USE[key] = (version, _walk_for_gl(trees, function))
+    _GL_USE[key] = (version, _walk_for(trees, function, modules))
     return _GL_USE[key][1]
 
 
-#: :func:`_may_use_gl` by (stubs folder, function): (ids of the stub trees, the answer).
+#: :func:`may_import` by (stubs folder, function, modules): (ids of the stub trees, the answer).
 _GL_USE: dict = {}
 
 
-def _walk_for_gl(trees: dict, function: str) -> bool:
+def _walk_for(trees: dict, function: str, modules: tuple[str, ...]) -> bool:
     todo = [stem for stem, t in trees.items() if isinstance(t, ast.Module) and function in _stub_defines(t)]
     if not todo:
         return True
 
     def gl(name: str) -> bool:
-        return any(name == m or name.startswith(m + ".") for m in _GL_MODULES)
+        return any(name == m or name.startswith(m + ".") for m in modules)
 
     seen = set()
     while todo:
@@ -413,6 +424,83 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
     return pieces
 
 
+#: The folder where the workers of one snapshot keep the submission's compiled pieces of each merged
+#: module (:func:`merged_code`): the snapshot's own cache folder (``jit_cache``, set by the zygote
+#: before the call), or None. Every worker of a call used to parse and compile the same modules again
+#: (about 25 ms of CPU per GLSL call of shadows, 2 s of a whole-lab run).
+CODE_CACHE: list = [None]
+
+
+def _code_cache_file(stub_path: Path, student_path: Path | None) -> Path | None:
+    """Where the compiled merge of these two files is kept, named by their bytes (an edited file is a
+    new name), or None: no cache folder, no submission file, or a stub the zygote did not prepare."""
+    folder, digest = CODE_CACHE[0], _STUB_STAT.get(str(stub_path))
+    if folder is None or digest is None or student_path is None or not _is_plain_file(student_path):
+        return None
+    try:
+        text = _read_source(student_path)
+    except OSError:
+        return None
+    key = hashlib.sha256(f"{sys.version}\0{stub_path}\0{digest}\0{student_path}\0{text}".encode()).hexdigest()
+    return Path(folder) / f"merged-{key[:40]}.marshal"
+
+
+def merged_code(stub_path: Path, student_path: Path | None) -> list[tuple[types.CodeType, bool]]:
+    """``(code, given)`` of each statement of the merged module (:func:`merge_module`), in order.
+
+    The given statements are always the zygote's compiled stub statements (never read from the
+    cache, so nothing a submission writes there runs as given code, see :mod:`blacklist`); the
+    submission's pieces are compiled once per snapshot and kept in :data:`CODE_CACHE`, which only
+    the workers of that snapshot (the same code) write and read.
+    """
+    stub = _parsed(stub_path, student=False)
+    flags = __future__.annotations.compiler_flag
+
+    def stub_code(stmt):
+        code = _STUB_CODE.get(id(stmt))
+        if code is None:
+            code = compile(
+                ast.Module(body=[stmt], type_ignores=[]), str(stub_path), "exec", flags=flags, dont_inherit=True
+            )
+        return code
+
+    where = _code_cache_file(stub_path, student_path)
+    if where is not None:
+        try:
+            kept = marshal.loads(where.read_bytes())
+            out = [
+                (stub_code(stub.body[k]), True) if type(k) is int and 0 <= k < len(stub.body) else (k, False)
+                for k in kept
+            ]
+            if all(isinstance(code, types.CodeType) for code, _ in out):
+                return out
+        except (OSError, ValueError, EOFError, TypeError):
+            pass  # not kept yet (or unreadable): merge and compile
+    position = {id(stmt): k for k, stmt in enumerate(stub.body)}
+    out, kept = [], []
+    for stmt, filename in merge_module(stub_path, student_path):
+        if filename == str(stub_path):
+            out.append((stub_code(stmt), True))
+            k = position.get(id(stmt))
+            if k is None:  # a stub statement the merge changed (a syntax error's stub): not kept
+                kept = None
+            elif kept is not None:
+                kept.append(k)
+        else:
+            code = compile(ast.Module(body=[stmt], type_ignores=[]), filename, "exec", flags=flags, dont_inherit=True)
+            out.append((code, False))
+            if kept is not None:
+                kept.append(code)
+    if where is not None and kept is not None:
+        tmp = where.with_name(f"{where.name}.{os.getpid()}")
+        try:
+            tmp.write_bytes(marshal.dumps(kept))
+            os.replace(tmp, where)
+        except (OSError, ValueError):
+            pass  # a read-only or full folder: the next worker compiles again
+    return out
+
+
 class _MergedLoader(importlib.abc.Loader):
     def __init__(self, stub_path: Path, student_path: Path | None):
         self.stub_path, self.student_path = stub_path, student_path
@@ -421,16 +509,10 @@ class _MergedLoader(importlib.abc.Loader):
         return None
 
     def exec_module(self, module):
-        pieces = merge_module(self.stub_path, self.student_path)
-        flags = __future__.annotations.compiler_flag
+        pieces = merged_code(self.stub_path, self.student_path)
         module.__file__ = str(self.student_path if self.student_path is not None else self.stub_path)
-        for stmt, filename in pieces:
-            code = _STUB_CODE.get(id(stmt)) if filename == str(self.stub_path) else None
-            if code is None:
-                code = compile(
-                    ast.Module(body=[stmt], type_ignores=[]), filename, "exec", flags=flags, dont_inherit=True
-                )
-            if filename == str(self.stub_path):
+        for code, given in pieces:
+            if given:
                 blacklist.given(code)  # given code may call what the lab forbids the student
             exec(code, module.__dict__)
 

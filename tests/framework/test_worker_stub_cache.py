@@ -226,3 +226,92 @@ def test_a_stub_statement_and_a_submissions_are_the_same_code_as_ast_dump_says()
                         pairs += 1
                         same += worker._same(a, b)
     assert pairs > 5000 and 0 < same < pairs, (pairs, same)
+
+
+def _unload(lab: str) -> None:
+    for name in [m for m in sys.modules if m.startswith(f"_graded_{lab}")]:
+        del sys.modules[name]
+    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, worker._LabFinder)]
+
+
+def _next_worker() -> None:
+    """What a new worker of the same zygote starts with: the stubs' trees, not the submission's."""
+    for key in [k for k in worker._TREES if k[1]]:
+        del worker._TREES[key]
+
+
+def test_the_workers_of_a_snapshot_compile_its_merged_modules_once(tmp_path, fresh_cache, monkeypatch):
+    """The first worker keeps the submission's compiled pieces in the snapshot's cache folder; the next
+    worker runs them without merging or compiling again, with the zygote's stub code as given code."""
+    stubs, student, cache = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy", tmp_path / "cache"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, STUDENT)
+    cache.mkdir()
+    worker.prepare_stubs(str(stubs))
+    monkeypatch.setattr(worker, "CODE_CACHE", [str(cache)])
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 7
+        assert len(list(cache.glob("merged-*.marshal"))) == 1
+    finally:
+        _unload("toy")
+    _next_worker()
+
+    def merged(*_):
+        raise AssertionError("the next worker merged and compiled the module again")
+
+    monkeypatch.setattr(worker, "merge_module", merged)
+    try:
+        fn = worker.find_function(student, "toy", "task", stubs)
+        assert fn(2) == 7  # the course's helper (3 * 2) + 1, as before
+        helper = sys.modules[fn.__module__].given_helper
+        tree = worker._parsed(stubs / "ops.py", student=False)
+        stmt = next(s for s in tree.body if getattr(s, "name", "") == "given_helper")
+        assert helper.__code__ in worker._STUB_CODE[id(stmt)].co_consts  # the zygote's code, not the cache's
+        assert id(helper.__code__) in blacklist._GIVEN
+        assert id(fn.__code__) not in blacklist._GIVEN
+    finally:
+        _unload("toy")
+
+
+def test_an_edited_submission_file_is_not_served_from_the_cache(tmp_path, fresh_cache, monkeypatch):
+    stubs, student, cache = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy", tmp_path / "cache"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, STUDENT)
+    cache.mkdir()
+    worker.prepare_stubs(str(stubs))
+    monkeypatch.setattr(worker, "CODE_CACHE", [str(cache)])
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 7
+    finally:
+        _unload("toy")
+    _next_worker()
+    st = (student / "ops.py").stat()
+    _write(student, STUDENT.replace("+ 1", "+ 2"))
+    os.utime(student / "ops.py", ns=(st.st_atime_ns, st.st_mtime_ns))
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 8, "the cache ran the code before the edit"
+    finally:
+        _unload("toy")
+
+
+def test_code_a_submission_writes_into_the_cache_never_runs_as_given_code(tmp_path, fresh_cache, monkeypatch):
+    """The cache folder is writable by the submission's workers: an entry forged there runs as the
+    submission's own code (the blacklist applies), and the stub's statements are always the zygote's."""
+    import marshal
+
+    stubs, student, cache = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy", tmp_path / "cache"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, STUDENT)
+    cache.mkdir()
+    worker.prepare_stubs(str(stubs))
+    monkeypatch.setattr(worker, "CODE_CACHE", [str(cache)])
+    forged = compile("def given_helper(x):\n    return -1\n\n\ndef task(x):\n    return given_helper(x)\n", "f", "exec")
+    where = worker._code_cache_file(stubs / "ops.py", student / "ops.py")
+    where.write_bytes(marshal.dumps([forged]))
+    try:
+        fn = worker.find_function(student, "toy", "task", stubs)
+        assert fn(2) == -1  # the forged entry ran: as the submission's code
+        assert id(fn.__code__) not in blacklist._GIVEN
+        assert id(sys.modules[fn.__module__].given_helper.__code__) not in blacklist._GIVEN
+    finally:
+        _unload("toy")

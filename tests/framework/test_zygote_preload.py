@@ -123,3 +123,33 @@ def test_whether_a_call_may_use_opengl_is_worked_out_once(tmp_path, monkeypatch)
     monkeypatch.setattr(worker.ast, "walk", lambda node: (walked.append(node), real(node))[1])
     assert worker._may_use_gl(str(stubs), "plain") and worker._may_use_gl(str(stubs), "drawn")
     assert not walked, "the stubs were walked again"
+
+
+PER_CALL_SCRIPT = """
+import os, sys
+from pathlib import Path
+from geomlib.grading.sandbox import LabProxy
+
+root = Path(sys.argv[1])
+stubs, lab = root / "stubs" / "calllab", root / "calllab"
+stubs.mkdir(parents=True)
+lab.mkdir()
+(stubs / "truth.py").write_text("from scipy import ndimage\\n\\n\\ndef checked():\\n    raise NotImplementedError('Task 2')\\n")
+(stubs / "ops.py").write_text("def plain():\\n    raise NotImplementedError('Task 1')\\n")
+body = "import sys\\n\\n\\ndef {}():\\n    return ['scipy.ndimage' in sys.modules]\\n"  # before the stub's own imports
+(lab / "truth.py").write_text(body.format("checked"))
+(lab / "ops.py").write_text(body.format("plain"))
+os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
+proxy = LabProxy("calllab", lab, timeout=120)
+print(proxy.plain()[0], proxy.checked()[0])
+"""
+
+
+def test_a_module_is_preloaded_for_the_calls_whose_stub_module_imports_it(tmp_path):
+    """Shadows' stubs import scipy.ndimage (0.25 s of CPU) in truth.py only, whose helper no graded call
+    runs: a call into another module starts without it, a call into truth.py still inherits it."""
+    p = subprocess.run(
+        [sys.executable, "-c", PER_CALL_SCRIPT, str(tmp_path)], capture_output=True, text=True, timeout=300
+    )
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert p.stdout.split()[-2:] == ["False", "True"]
