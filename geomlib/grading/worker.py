@@ -33,7 +33,6 @@ import importlib
 import importlib.abc
 import importlib.util
 import json
-import marshal
 import os
 import re
 import resource
@@ -424,80 +423,22 @@ def merge_module(stub_path: Path, student_path: Path | None) -> list[tuple[ast.s
     return pieces
 
 
-#: The folder where the workers of one snapshot keep the submission's compiled pieces of each merged
-#: module (:func:`merged_code`): the snapshot's own cache folder (``jit_cache``, set by the zygote
-#: before the call), or None. Every worker of a call used to parse and compile the same modules again
-#: (about 25 ms of CPU per GLSL call of shadows, 2 s of a whole-lab run).
-CODE_CACHE: list = [None]
-
-
-def _code_cache_file(stub_path: Path, student_path: Path | None) -> Path | None:
-    """Where the compiled merge of these two files is kept, named by their bytes (an edited file is a
-    new name), or None: no cache folder, no submission file, or a stub the zygote did not prepare."""
-    folder, digest = CODE_CACHE[0], _STUB_STAT.get(str(stub_path))
-    if folder is None or digest is None or student_path is None or not _is_plain_file(student_path):
-        return None
-    try:
-        text = _read_source(student_path)
-    except OSError:
-        return None
-    key = hashlib.sha256(f"{sys.version}\0{stub_path}\0{digest}\0{student_path}\0{text}".encode()).hexdigest()
-    return Path(folder) / f"merged-{key[:40]}.marshal"
-
-
 def merged_code(stub_path: Path, student_path: Path | None) -> list[tuple[types.CodeType, bool]]:
-    """``(code, given)`` of each statement of the merged module (:func:`merge_module`), in order.
+    """``(code, given)`` of each statement of the merged module (:func:`merge_module`), in order: the
+    given statements are the zygote's compiled stub statements, the submission's are compiled here.
 
-    The given statements are always the zygote's compiled stub statements (never read from the
-    cache, so nothing a submission writes there runs as given code, see :mod:`blacklist`); the
-    submission's pieces are compiled once per snapshot and kept in :data:`CODE_CACHE`, which only
-    the workers of that snapshot (the same code) write and read.
+    Not kept between the workers of a snapshot: any file a worker can write, the submission can
+    forge, and a forged list of pieces could leave out a given helper and put the submission's own
+    version in its place (the merge drops such redefinitions).
     """
-    stub = _parsed(stub_path, student=False)
     flags = __future__.annotations.compiler_flag
-
-    def stub_code(stmt):
-        code = _STUB_CODE.get(id(stmt))
-        if code is None:
-            code = compile(
-                ast.Module(body=[stmt], type_ignores=[]), str(stub_path), "exec", flags=flags, dont_inherit=True
-            )
-        return code
-
-    where = _code_cache_file(stub_path, student_path)
-    if where is not None:
-        try:
-            kept = marshal.loads(where.read_bytes())
-            out = [
-                (stub_code(stub.body[k]), True) if type(k) is int and 0 <= k < len(stub.body) else (k, False)
-                for k in kept
-            ]
-            if all(isinstance(code, types.CodeType) for code, _ in out):
-                return out
-        except (OSError, ValueError, EOFError, TypeError):
-            pass  # not kept yet (or unreadable): merge and compile
-    position = {id(stmt): k for k, stmt in enumerate(stub.body)}
-    out, kept = [], []
+    out = []
     for stmt, filename in merge_module(stub_path, student_path):
-        if filename == str(stub_path):
-            out.append((stub_code(stmt), True))
-            k = position.get(id(stmt))
-            if k is None:  # a stub statement the merge changed (a syntax error's stub): not kept
-                kept = None
-            elif kept is not None:
-                kept.append(k)
-        else:
+        given = filename == str(stub_path)
+        code = _STUB_CODE.get(id(stmt)) if given else None
+        if code is None:
             code = compile(ast.Module(body=[stmt], type_ignores=[]), filename, "exec", flags=flags, dont_inherit=True)
-            out.append((code, False))
-            if kept is not None:
-                kept.append(code)
-    if where is not None and kept is not None:
-        tmp = where.with_name(f"{where.name}.{os.getpid()}")
-        try:
-            tmp.write_bytes(marshal.dumps(kept))
-            os.replace(tmp, where)
-        except (OSError, ValueError):
-            pass  # a read-only or full folder: the next worker compiles again
+        out.append((code, given))
     return out
 
 

@@ -342,7 +342,6 @@ def _worker_main(req: dict, blob: bytes, result_fd: int, out_fd: int) -> None:
         finally:
             os._exit(0)
     extra = (req.get("stubs_dir"), req.get("not_allowed"))  # not_allowed: the lab's blacklist
-    _worker.CODE_CACHE[0] = req.get("jit_cache")  # the snapshot's: its merged modules, compiled once
     _worker.run_call(result_fd, req["lab_dir"], req["lab"], req["function"], args, kwargs, *extra)
 
 
