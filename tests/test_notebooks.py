@@ -6,7 +6,7 @@ solutions, and the stubs run here grades every graded test against the stubs (th
 ``check(lab, task=N)`` cells, one per task; ``tests/framework/test_task_selection.py`` checks that
 together they select every graded test). So the run on the solutions executes every cell but the
 ``check()`` cells, which would grade the solutions a second time (and start a grading sandbox in the
-kernel for it, 3 to 20 s of CPU per lab); only in one notebook (:data:`PASSING_REPORT_IN`) it keeps
+kernel for it: seconds of CPU per lab); only in one notebook (:data:`PASSING_REPORT_IN`) it keeps
 the first one (task 1, it also imports ``check``), which shows a passing report in a kernel: the
 path from ``check()`` to the report is the same for every lab, and the stubs run takes it in every
 notebook.
