@@ -380,8 +380,21 @@ def _preload_for(stubs_dir: str | None, function: str | None = None) -> None:
         ):
             try:
                 importlib.import_module(module)
+                if module == "numba":
+                    _warm_numba()
             except Exception:  # noqa: BLE001 - a missing optional module only makes workers slower
                 pass
+
+
+def _warm_numba() -> None:
+    """Build numba's CPU typing and target contexts (its type registries, LLVM set-up) once, here:
+    otherwise every worker builds them at its first compiled call, even one loaded from the cache
+    (measured: 1.3 s of CPU per call of a numba lab, sdf's ``build_bvh`` on the stubs 1.5 s -> 0.5 s;
+    1.5 s once in the zygote). No code is compiled and no thread started (the fork stays safe)."""
+    from numba.core.registry import cpu_target
+
+    cpu_target.typing_context.refresh()
+    cpu_target.target_context.refresh()
 
 
 # ---------------------------------------------------------------------------------- the server
