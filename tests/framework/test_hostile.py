@@ -6,6 +6,10 @@ would change what the others' tests see) on a throw-away copy of the course, so 
 through could not damage this checkout. The copy is made once per module and shared: an attack that
 changed it would fail its own test (``test_detached_children_forged_lines_and_tampering...`` checks
 the copy's checks.py is untouched) and the ones graded after it.
+
+A grade starts the grader and its zygote (about 2 s of CPU) and costs about 0.07 s per test: each
+grades one part of the lab (``--part``), one that holds visible and hidden tests of the attacked
+functions and, where a test needs some points to survive the attack, tests of functions left alone.
 """
 
 from __future__ import annotations
@@ -28,6 +32,13 @@ pytestmark = [pytest.mark.slow, pytest.mark.skipif(sys.platform != "linux", reas
 
 COURSE = Path(__file__).resolve().parents[2]
 
+#: Sparse (loop_odd_matrix, loop_even_matrix, whose interior rows call loop_weight), dense
+#: (cc_edge_points, cc_vertex_points) and tuple (catmull_clark) outputs, three hidden cases, a test by
+#: hand, and Catmull-Clark tests that a loop_weight or loop_odd_matrix attack leaves alone.
+BOUNDARY = "boundary rules"
+#: loop_odd_matrix's visible and hidden reference cases and two tests by hand; 5 tests.
+ODD = "odd vertices"
+
 
 @pytest.fixture(scope="module")
 def course_root():
@@ -41,11 +52,13 @@ def course_root():
         shutil.rmtree(base, ignore_errors=True)
 
 
-def _grade(kind: str, root: Path, python: str | None = None, **env) -> dict:
+def _grade(kind: str, root: Path, part: str | None, python: str | None = None, **env) -> dict:
     work = Path(tempfile.mkdtemp(prefix=f"geomlib-hostile-{kind}-"))
     work.chmod(0o755)
     try:
-        r = grade_planted(kind, COURSE, work, python=python or sys.executable, env=env, timeout=600, root=root)
+        r = grade_planted(
+            kind, COURSE, work, python=python or sys.executable, env=env, timeout=600, root=root, part=part
+        )
     finally:
         shutil.rmtree(work, ignore_errors=True)
     assert not r["hung"], r["log"]
@@ -62,7 +75,7 @@ def _tests(r: dict, words: str) -> list[dict]:
 
 
 def test_nan_outputs_earn_nothing(course_root):
-    r = _grade("nan", course_root)
+    r = _grade("nan", course_root, BOUNDARY)
     refs = [t for t in r["results"]["tests"] if ' on "' in t["name"] and t["max_score"] > 0]
     assert refs and all(t["status"] == "failed" for t in refs)
     assert sum(t["score"] for t in r["results"]["tests"] if t["visibility"] == "hidden") == 0
@@ -72,7 +85,7 @@ def test_nan_outputs_earn_nothing(course_root):
 
 def test_looking_up_stored_outputs_earns_nothing(course_root):
     """The worker holds no case list and cannot open the cases or references (Landlock or the sandbox user)."""
-    r = _grade("lookup", course_root)
+    r = _grade("lookup", course_root, ODD)
     assert r["score"] == 0
     assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
 
@@ -85,13 +98,13 @@ def test_as_the_sandbox_user_looking_up_stored_outputs_earns_nothing(course_root
         pytest.skip(sandbox_user_problem("nobody"))
     python, extra = found
     env = {"GEOMLIB_SANDBOX_USER": "nobody", "GEOMLIB_LANDLOCK": landlock, **extra}
-    r = _grade("lookup", course_root, python=python, **env)
+    r = _grade("lookup", course_root, ODD, python=python, **env)
     assert r["score"] == 0
     assert all("lookup found nothing" in t["text"] for t in r["results"]["tests"] if t["max_score"] > 0)
 
 
 def test_a_lone_surrogate_in_a_message_costs_only_its_tests(course_root):
-    r = _grade("surrogate", course_root)
+    r = _grade("surrogate", course_root, BOUNDARY)
     weight = _tests(r, "loop_weight([3, 4, 6]")
     assert r["score"] > 0
     assert any("bad \ufffd" in t["text"] for t in r["results"]["tests"])
@@ -100,19 +113,19 @@ def test_a_lone_surrogate_in_a_message_costs_only_its_tests(course_root):
 
 
 def test_a_half_written_message_header_cannot_hang_the_grader(course_root):
-    r = _grade("partial_header", course_root, GEOMLIB_TIME_LIMIT="2")
+    r = _grade("partial_header", course_root, BOUNDARY, GEOMLIB_TIME_LIMIT="2")
     failed = [t for t in r["results"]["tests"] if "did not finish within 2 s" in t["text"]]
     assert failed and r["score"] > 0
 
 
 def test_a_huge_exception_is_cut_in_the_grader(course_root):
-    r = _grade("huge_message", course_root)
+    r = _grade("huge_message", course_root, BOUNDARY)
     assert r["results_bytes"] < 1_000_000
     assert r["score"] > 0
 
 
 def test_a_forged_sparse_shape_is_refused_before_anything_is_allocated(course_root):
-    r = _grade("sparse_bomb", course_root)
+    r = _grade("sparse_bomb", course_root, BOUNDARY)
     odd = [t for t in r["results"]["tests"] if "loop_odd_matrix" in t["text"] and t["max_score"] > 0]
     assert odd and all(t["status"] == "failed" for t in odd)
     assert any("300000000" in t["text"] for t in odd)
@@ -120,19 +133,22 @@ def test_a_forged_sparse_shape_is_refused_before_anything_is_allocated(course_ro
 
 
 def test_the_whole_run_stops_at_its_time_budget_and_still_writes_results(course_root):
-    r = _grade("slow", course_root, GEOMLIB_TIME_LIMIT="2", GEOMLIB_TIME_BUDGET="12")
+    # Every call sleeps (no call of this run needs time of its own), so the limits are the smallest
+    # that show the budget at work: 1 s calls in a 3 s budget, in a part of 10 tests.
+    r = _grade("slow", course_root, BOUNDARY, GEOMLIB_TIME_LIMIT="1", GEOMLIB_TIME_BUDGET="3")
     texts = [t["text"] for t in r["results"]["tests"]]
-    assert any("time budget of 12 s for the whole submission" in t for t in texts)
-    # Within a 12 s budget at most 12 / 2 calls can each use up their 2 s (plus the one running when
+    assert len(texts) == 10, len(texts)
+    assert any("time budget of 3 s for the whole submission" in t for t in texts)
+    # Within a 3 s budget at most 3 / 1 calls can each use up their 1 s (plus the one running when
     # the budget ran out); every later call fails at once. (Counted, not timed: a loaded machine is
-    # slower but cannot fit more 2 s waits into 12 s; it may spend the budget before the first one.)
-    waited = [t for t in texts if "did not finish within 2 s" in t]
-    assert len(waited) <= 12 // 2 + 1, len(waited)
-    assert r["seconds"] < 12 + 300  # a hang (the grader did not stop at its budget), not slowness
+    # slower but cannot fit more 1 s waits into 3 s; it may spend the budget before the first one.)
+    waited = [t for t in texts if "did not finish within 1 s" in t]
+    assert len(waited) <= 3 // 1 + 1, len(waited)
+    assert r["seconds"] < 3 + 300  # a hang (the grader did not stop at its budget), not slowness
 
 
 def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(course_root):
-    r = _grade("leftovers", course_root)
+    r = _grade("leftovers", course_root, BOUNDARY)
     assert r["daemons"] == 0
     assert not r["tampered"]
     assert not r["forged"]
@@ -142,14 +158,16 @@ def test_detached_children_forged_lines_and_tampering_do_not_survive_the_call(co
 
 def test_rewriting_a_given_helper_gains_nothing(course_root):
     """catmull_clark is given: the course's version runs, calling the submission's (stub) tasks."""
-    r = _grade("edit_given", course_root)
+    r = _grade("edit_given", course_root, "catmull-clark points")
     cc = [t for t in r["results"]["tests"] if "catmull_clark" in t["name"] and t["max_score"] > 0]
     assert cc and all(t["status"] == "failed" for t in cc)
     assert r["score"] == 0
 
 
 def test_a_broken_import_in_one_file_costs_only_that_files_functions(course_root):
-    r = _grade("blame_import", course_root)
+    # The whole lab: loop_faces and loop_weight (re-exported by the broken file) and cc_face_points
+    # are tested in three different parts.
+    r = _grade("blame_import", course_root, None)
     loop = [t for t in r["results"]["tests"] if "loop_faces" in t["name"] or "loop_weight" in t["name"]]
     assert loop and all(t["status"] == "passed" for t in loop)
     cc = [t for t in r["results"]["tests"] if "cc_face_points on" in t["name"]]

@@ -127,11 +127,12 @@ def test_the_seccomp_filter_leaves_unix_sockets_and_takes_every_other_family():
 
 # ---------------------------------------------------------------------------------- grade-all (item 2)
 
-#: The victim's task holds a secret and stays in the sandbox long enough to be spied on.
+#: The victim's task holds a secret and stays in the sandbox long enough to be spied on (each of its
+#: three calls: its grading outlasts the spy's calls, which take milliseconds once they see it).
 VICTIM = """    import time as _time
 
     _secret = "VICTIM-SECRET-1234"
-    _time.sleep(2.0)
+    _time.sleep(1.0)
 """
 
 #: The spy waits until the victim is being graded beside it (a second grade-all work folder in the

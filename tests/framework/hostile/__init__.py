@@ -167,9 +167,11 @@ for _name in TASKS:
     globals()[_name] = _sleeper(_name)
 """
 
-#: loop_weight starts a detached, CPU-burning daemon that later rewrites results.json with 999
-#: points, forges lines in every file descriptor it inherited, rewrites the grader's checks, then
-#: answers correctly.
+#: loop_weight starts a detached daemon that burns CPU until the grader has exited, then rewrites
+#: results.json with 999 points; it also forges lines in every file descriptor it inherited and
+#: rewrites the grader's checks, then answers correctly. (Waiting for the grader's exit, not a fixed
+#: time, puts the rewrite after the grader's own write however fast the run is, and lets the test wait
+#: only a moment after the grader ends.)
 LEFTOVERS = """
 def _daemon():
     import ctypes
@@ -184,7 +186,7 @@ def _daemon():
         os._exit(0)
     ctypes.CDLL(None).prctl(15, b"hostile-daemon", 0, 0, 0)
     try:
-        pid, results = os.getppid(), None
+        grader, results = None, None
         for p in os.listdir("/proc"):
             if p.isdigit():
                 try:
@@ -192,10 +194,10 @@ def _daemon():
                 except OSError:
                     continue
                 if b"--results" in args:
-                    results = args[args.index(b"--results") + 1].decode()
+                    grader, results = p, args[args.index(b"--results") + 1].decode()
         t0 = time.time()
-        while time.time() - t0 < 4:
-            pass  # burn CPU
+        while grader and os.path.exists(f"/proc/{grader}") and time.time() - t0 < 600:
+            pass  # burn CPU while the grader runs
         if results:
             open(results, "w").write(json.dumps({"score": 999, "tests": []}))
         time.sleep(60)
@@ -323,10 +325,13 @@ def grade_planted(
     env: dict | None = None,
     timeout: float = 900,
     root: Path | None = None,
+    part: str | None = None,
 ) -> dict:
     """Grade planted submission ``kind`` on a copy of ``course`` with ``python``; what happened.
 
     The copy is ``root`` when given (a :func:`course_copy` that several grades share), else made in ``work``.
+    With ``part``, only that part of the lab is graded (``--part``: a grade costs about 2 s of CPU to
+    start and 0.07 s per test).
 
     Returns ``score``, ``seconds``, ``results`` (the parsed results.json or None), ``hung`` (killed
     after ``timeout``), ``daemons`` (leftover hostile processes), ``tampered`` (the course's checks.py
@@ -345,6 +350,8 @@ def grade_planted(
     e = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     e.update({"GEOMLIB_ROOT": str(root), "GEOMLIB_NO_FEEDBACK_PICTURES": "1", **(env or {})})
     cmd = [python, "-m", "geomlib.cli", "grade", "--impl", str(sub), "--lab", "subdivision", "--results", str(results)]
+    if part is not None:
+        cmd += ["--part", part]
     t0 = time.monotonic()
     hung = False
     log = work / "grader-output.txt"
@@ -365,7 +372,7 @@ def grade_planted(
             data = None
     before = results.read_bytes() if results.is_file() else b""
     if kind == "leftovers":
-        time.sleep(6)  # the daemon rewrites results.json about 4 s after its call
+        time.sleep(1)  # a surviving daemon rewrites results.json once the grader has exited (~50 ms)
     daemons = 0
     for d in os.listdir("/proc"):
         if d.isdigit():
