@@ -91,21 +91,19 @@ def _hanging_relief_shader(lab: Path) -> None:
 def test_relief_hanging_shader_time_out_names_the_shader_the_task_and_the_cause():
     impl = _planted("relief", _hanging_relief_shader)
     try:
-        # The planted shader never ends, so each of the part's two tests waits out the whole limit,
-        # spinning llvmpipe's threads (20 s each made this the suite's fourth-slowest test). What the
-        # message needs is only that the call reached its shader before the limit: a fresh process
-        # gets from start to the shader's compile in 0.84 s of CPU (imports, inputs, GL context; 1.1 s
-        # of wall clock at a load of 17 on 2 cores); a worker forked from the grader's zygote makes
-        # the whole call on the good lab's fresh snapshot, draw included, in 0.2 s of CPU (0.9 s of
-        # wall clock at a load of 13). 4 s is x20 the CPU and x4 that loaded wall clock, and passed
-        # at a load of 17.
-        r = _grade(impl, "relief", "--part", "GLSL relief mapping", timeout=900, env_extra={"GEOMLIB_TIME_LIMIT": "4"})
+        # The planted shader never ends, so each of the part's two tests waits out the whole limit
+        # (20 s each made this the suite's fourth-slowest test). What the message needs is only that
+        # the call reached its shader before the limit: a fresh process gets from start to the
+        # shader's compile in 0.84 s of CPU (imports, inputs, GL context; 1.1 s of wall clock at a
+        # load of 17 on 2 cores), a worker forked from the grader's zygote in less; 6 s is x7 above
+        # the former and passed at 4 s on that loaded machine.
+        r = _grade(impl, "relief", "--part", "GLSL relief mapping", timeout=900, env_extra={"GEOMLIB_TIME_LIMIT": "6"})
     finally:
         shutil.rmtree(impl, ignore_errors=True)
     tests = [t for t in r["tests"] if "relief" in t["name"].lower()]
     assert tests and all(t["status"] == "failed" and t["score"] == 0 for t in tests), tests
     text = tests[0]["text"]
-    assert "glsl_relief_uv did not finish within 4 s" in text, text
+    assert "glsl_relief_uv did not finish within 6 s" in text, text
     assert "shaders/relief.frag" in text and "Task 3 (march and refine)" in text, text
     assert "a loop that does not end or a very long one" in text, text
     assert "Python loop" not in text, text
