@@ -522,6 +522,30 @@ def _unique_id(out: list[Mutant], base: str) -> str:
     return mid
 
 
+def _compiles(text: str, tree: ast.Module, a: int, z: int, new: str, filename: str) -> bool:
+    """Whether ``text`` with ``text[a:z]`` replaced by ``new`` compiles, judged on the top-level
+    statement that holds the edit only (its decorators to its last line): the rest of the file is
+    the solution's, which compiles, and nothing outside a statement changes what compiles inside it.
+    A lab file has hundreds of operator mutants: compiling each whole file took most of ``generate``."""
+    lines = text.splitlines(keepends=True)
+    starts = [0]
+    for line in lines:
+        starts.append(starts[-1] + len(line))
+    for node in tree.body:
+        first = min([node.lineno, *(d.lineno for d in getattr(node, "decorator_list", ()))])
+        s, e = starts[first - 1], starts[node.end_lineno]
+        if s <= a and z <= e:
+            src = text[s:a] + new + text[z:e]
+            break
+    else:  # not inside one statement: the whole file
+        src = text[:a] + new + text[z:]
+    try:
+        compile(src, filename, "exec", dont_inherit=True)
+    except SyntaxError:
+        return False
+    return True
+
+
 def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) -> tuple[list[Mutant], list[str]]:
     """Every mutant of a lab's solution, in file and line order, and notes on what was not mutated.
 
@@ -565,9 +589,7 @@ def generate(lab: str, lab_dir: Path | None = None, *, check_glsl: bool = True) 
             src = _apply(text, [(a, z, new)])
             if src in seen or src == text:
                 continue
-            try:
-                compile(src, b.file, "exec", dont_inherit=True)
-            except SyntaxError:
+            if not _compiles(text, tree, a, z, new, b.file):
                 continue
             seen.add(src)
             mid = _unique_id(out, f"{b.file}:{line}:{col}:{label}")

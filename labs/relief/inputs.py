@@ -32,6 +32,7 @@ __all__ = [
     "check_bias",
     "check_depths",
     "height_at",
+    "height_lookup",
     "normalize_rows",
 ]
 
@@ -138,22 +139,32 @@ def height_at(H: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
         h = (1-fx)(1-fy) H[y0, x0] + fx (1-fy) H[y0, x0+1] + (1-fx) fy H[y0+1, x0] + fx fy H[y0+1, x0+1]
 
-    the same value as ``geomlib.textures.sample_bilinear(H, uv, "clamp")`` without its checks
-    (this lookup runs dozens of times per pixel in the ray march).
+    the same value as ``geomlib.textures.sample_bilinear(H, uv, "clamp")`` without its checks.
+    A loop that reads one map many times (a ray march) takes :func:`height_lookup` once instead.
     """
+    return height_lookup(H)(u, v)
+
+
+def height_lookup(H: np.ndarray):
+    """:func:`height_at` for one map: ``lookup(u, v)`` gives the same values, bit for bit, and pads
+    the map once instead of at every call (a ray march reads it dozens of times per pixel)."""
     s = H.shape[0]
     # Clamping the continuous coordinate to [0, s - 1] first gives the same values (at a clamped
     # border both taps are the border texel, or the weight of the second is 0) with one clip per
     # axis; the map padded by one edge row and column makes x0 + 1 and y0 + 1 always valid.
-    x = np.clip(u * s - 0.5, 0.0, s - 1.0)
-    y = np.clip((1.0 - v) * s - 0.5, 0.0, s - 1.0)
-    x0 = x.astype(np.intp)  # floor, x >= 0
-    y0 = y.astype(np.intp)
-    fx, fy = x - x0, y - y0
     flat = np.pad(H, ((0, 1), (0, 1)), mode="edge").ravel()
-    i = y0 * (s + 1) + x0
-    t00, t01 = flat.take(i), flat.take(i + 1)
-    t10, t11 = flat.take(i + (s + 1)), flat.take(i + (s + 2))
-    top = t00 + (t01 - t00) * fx
-    bot = t10 + (t11 - t10) * fx
-    return top + (bot - top) * fy
+
+    def lookup(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        x = np.clip(u * s - 0.5, 0.0, s - 1.0)
+        y = np.clip((1.0 - v) * s - 0.5, 0.0, s - 1.0)
+        x0 = x.astype(np.intp)  # floor, x >= 0
+        y0 = y.astype(np.intp)
+        fx, fy = x - x0, y - y0
+        i = y0 * (s + 1) + x0
+        t00, t01 = flat.take(i), flat.take(i + 1)
+        t10, t11 = flat.take(i + (s + 1)), flat.take(i + (s + 2))
+        top = t00 + (t01 - t00) * fx
+        bot = t10 + (t11 - t10) * fx
+        return top + (bot - top) * fy
+
+    return lookup

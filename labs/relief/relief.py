@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .inputs import check_march, check_view_ray, height_at
+from .inputs import check_march, check_view_ray, height_lookup
 
 __all__ = ["relief_uv", "layer_count", "REFINEMENTS"]
 
@@ -92,9 +92,11 @@ def relief_uv(
     dv = (-scale * V[..., 1] / V[..., 2]).ravel()
     n = layer_count(V[..., 2], lo_n, hi_n).ravel()
 
+    h = height_lookup(H)  # height_at(H, ...) with the map padded once, not at every layer
+
     def f(k, d):
         """Depth below the surface of the ray point at normalised depth d (pixels k)."""
-        return d - (1.0 - height_at(H, u0[k] + d * du[k], v0[k] + d * dv[k]))
+        return d - (1.0 - h(u0[k] + d * du[k], v0[k] + d * dv[k]))
 
     P = u0.size
     hit = np.zeros(P, dtype=np.int64)  # the hit layer i of each pixel

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .inputs import check_layers, check_view_ray, height_at
+from .inputs import check_layers, check_view_ray, height_lookup
 
 __all__ = ["exact_uv", "uv_error_texels"]
 
@@ -30,8 +30,10 @@ def exact_uv(height, uv, view, *, scale: float, samples: int = 2048, bisections:
     du = (-scale * V[..., 0] / V[..., 2]).ravel()
     dv = (-scale * V[..., 1] / V[..., 2]).ravel()
 
+    h = height_lookup(H)
+
     def f(k, d):
-        return d - (1.0 - height_at(H, u0[k] + d * du[k], v0[k] + d * dv[k]))
+        return d - (1.0 - h(u0[k] + d * du[k], v0[k] + d * dv[k]))
 
     P = u0.size
     hit = np.zeros(P, dtype=np.int64)
