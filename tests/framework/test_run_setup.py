@@ -201,3 +201,33 @@ def test_the_set_up_of_a_one_lab_bundle_names_its_lab(tmp_path):
         assert last.startswith("[setup] ready") and last.endswith(f"uv run geomlib grade --impl labs {expected}"), (
             p.stderr
         )
+
+
+def test_the_suite_writes_bytecode_where_the_machine_says_not_to(tmp_path):
+    """`./run tests` unsets PYTHONDONTWRITEBYTECODE for the suite's processes (each would compile
+    geomlib and rewrite the graded tests again: ~1 s of CPU per grading run); other jobs keep it."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in (*TOOLS, "python3"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
+    log = tmp_path / "uv.log"
+    bash = shutil.which("bash")
+    uv = f'[ "$1" = run ] && echo "$* dont_write=${{PYTHONDONTWRITEBYTECODE:-unset}}" >> {log}\nexit 0\n'
+    for name, body in {"id": "echo 0", "uv": uv, "apt-get": "exit 0"}.items():
+        (fake / name).write_text(f"#!{bash}\n{body}")
+        (fake / name).chmod(0o755)
+    env = {
+        "PATH": f"{fake}:{tools}",
+        "HOME": str(tmp_path),
+        "GEOMLIB_LIB_DIRS": str(libs),
+        "GEOMLIB_UV": str(fake / "uv"),
+        "PYTHONDONTWRITEBYTECODE": "1",
+    }
+    for args in (("tests", "-q", "tests/unit"), ("figures",)):
+        p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+    runs = log.read_text().splitlines()
+    assert any(r.startswith("run --frozen pytest") and r.endswith("dont_write=unset") for r in runs), runs
+    assert any(r.startswith("run --frozen geomlib figures") and r.endswith("dont_write=1") for r in runs), runs
