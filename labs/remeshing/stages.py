@@ -104,7 +104,7 @@ def _collapse_all(S: RemeshState) -> int:
 
 
 #: Faces with a smaller angle (degrees) are cleaned up at the end of the loop (:func:`clean_slivers`).
-SLIVER_ANGLE = 30.0
+SLIVER_ANGLE = 35.0
 
 
 def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int = 10, project=None) -> int:
@@ -116,7 +116,7 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
     here raises the smallest angle around it and moves no vertex off the surface.
 
     With ``project`` (the loop's :class:`SurfaceProjector` of the input), the free vertices of the
-    faces still below 40° then move to the projection of the centroid of their neighbours, each only
+    faces still below 50° then move to the projection of the centroid of their neighbours, each only
     where that raises the smallest angle around it (:func:`_relocate`): the last iteration's flips
     leave their faces unrelaxed, and a few of them are the mesh's smallest angles.
     """
@@ -132,7 +132,7 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
 
 
 #: Vertices of faces with a smaller angle (degrees) are moved to improve it (:func:`_relocate`).
-RELOCATE_ANGLE = 40.0
+RELOCATE_ANGLE = 50.0
 
 
 def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
