@@ -147,17 +147,19 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     point on the surface of the centroid of their neighbours (taken in the tangent plane), each
     only when that raises the smallest angle around it (:func:`.kernels.relocate_pass`)."""
     total = 0
+    n = S.cnt[0]
+    Fl = S.faces()  # the passes move vertices only: the faces and edges stay
+    a, b = Fl.ravel(), Fl[:, [1, 2, 0]].ravel()
+    key = np.unique(np.minimum(a, b) * n + np.maximum(a, b))  # no new structure
+    E = np.c_[key // n, key % n]
+    deg = np.bincount(E.ravel(), minlength=n)
     for _ in range(passes):
-        n = S.cnt[0]
-        Fl = S.faces()
         V = S.V[:n]
         bad = Fl[K.faces_min_angle(V, Fl) < np.radians(min_angle)]
         cand = np.unique(bad)
         cand = cand[S.cls[cand] == 0]
         if not len(cand):
             break
-        E = np.unique(np.sort(Fl[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)  # no new structure
-        deg = np.bincount(E.ravel(), minlength=n)
         c = np.stack(
             [np.bincount(E[:, 0], V[E[:, 1], k], n) + np.bincount(E[:, 1], V[E[:, 0], k], n) for k in range(3)], 1
         )
