@@ -111,7 +111,7 @@ def _collapse_all(S: RemeshState) -> int:
 
 
 #: Faces with a smaller angle (degrees) are cleaned up at the end of the loop (:func:`clean_slivers`).
-SLIVER_ANGLE = 30.0
+SLIVER_ANGLE = 35.0
 
 
 def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int = 10, project=None) -> int:
@@ -123,7 +123,7 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
     here raises the smallest angle around it and moves no vertex off the surface.
 
     With ``project`` (the loop's :class:`SurfaceProjector` of the input), the free vertices of the
-    faces still below 40° then move to the projection of the centroid of their neighbours, each only
+    faces still below 50° then move to the projection of the centroid of their neighbours, each only
     where that raises the smallest angle around it (:func:`_relocate`): the last iteration's flips
     leave their faces unrelaxed, and a few of them are the mesh's smallest angles.
     """
@@ -139,7 +139,7 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
 
 
 #: Vertices of faces with a smaller angle (degrees) are moved to improve it (:func:`_relocate`).
-RELOCATE_ANGLE = 40.0
+RELOCATE_ANGLE = 50.0
 
 
 def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
@@ -147,17 +147,19 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     point on the surface of the centroid of their neighbours (taken in the tangent plane), each
     only when that raises the smallest angle around it (:func:`.kernels.relocate_pass`)."""
     total = 0
+    n = S.cnt[0]
+    Fl = S.faces()  # the passes move vertices only: the faces and edges stay
+    a, b = Fl.ravel(), Fl[:, [1, 2, 0]].ravel()
+    key = np.unique(np.minimum(a, b) * n + np.maximum(a, b))  # no new structure
+    E = np.c_[key // n, key % n]
+    deg = np.bincount(E.ravel(), minlength=n)
     for _ in range(passes):
-        n = S.cnt[0]
-        Fl = S.faces()
         V = S.V[:n]
         bad = Fl[K.faces_min_angle(V, Fl) < np.radians(min_angle)]
         cand = np.unique(bad)
         cand = cand[S.cls[cand] == 0]
         if not len(cand):
             break
-        E = np.unique(np.sort(Fl[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)  # no new structure
-        deg = np.bincount(E.ravel(), minlength=n)
         c = np.stack(
             [np.bincount(E[:, 0], V[E[:, 1], k], n) + np.bincount(E[:, 1], V[E[:, 0], k], n) for k in range(3)], 1
         )
