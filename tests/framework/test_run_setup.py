@@ -88,12 +88,6 @@ def _run_with_fake_uv(
 ) -> tuple[subprocess.CompletedProcess, list[str]]:
     """``./run figures`` as root with the library present and a fake uv (``GEOMLIB_UV``) that
     finds no supported Python unless ``python_found``; returns the result and uv's calls."""
-    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
-    for d in (fake, tools, libs):
-        d.mkdir()
-    for t in (*TOOLS, "python3"):
-        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    (libs / "libOSMesa.so.8").write_text("")
     log = tmp_path / "uv.log"
     find = (
         "exit 0"
@@ -107,18 +101,30 @@ case "$1 $2" in
 esac
 exit 0
 """
+    env = _fake_root_with_osmesa(tmp_path, uv=uv, apt_get=f'echo "apt-get $*" >> {log}')
+    p = subprocess.run([str(ROOT / "run"), "figures"], env=env, capture_output=True, text=True, timeout=120)
+    return p, (log.read_text().splitlines() if log.exists() else [])
+
+
+def _fake_root_with_osmesa(tmp_path: Path, *, uv: str, apt_get: str) -> dict[str, str]:
+    """The environment of a ``./run`` as root (fake ``id``) with libOSMesa present, the shell tools and
+    the system ``python3`` on the PATH, and the fake ``uv`` and ``apt-get`` given as bash bodies."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in (*TOOLS, "python3"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
     bash = shutil.which("bash")
-    for name, body in {"id": "echo 0", "uv": uv, "apt-get": f'echo "apt-get $*" >> {log}'}.items():
+    for name, body in {"id": "echo 0", "uv": uv, "apt-get": apt_get}.items():
         (fake / name).write_text(f"#!{bash}\n{body}")
         (fake / name).chmod(0o755)
-    env = {
+    return {
         "PATH": f"{fake}:{tools}",
         "HOME": str(tmp_path),
         "GEOMLIB_LIB_DIRS": str(libs),
         "GEOMLIB_UV": str(fake / "uv"),
     }
-    p = subprocess.run([str(ROOT / "run"), "figures"], env=env, capture_output=True, text=True, timeout=120)
-    return p, (log.read_text().splitlines() if log.exists() else [])
 
 
 def test_a_system_without_a_supported_python_gets_one_from_uv_and_is_told(tmp_path):
@@ -206,25 +212,9 @@ def test_the_set_up_of_a_one_lab_bundle_names_its_lab(tmp_path):
 def test_the_suite_writes_bytecode_where_the_machine_says_not_to(tmp_path):
     """`./run tests` unsets PYTHONDONTWRITEBYTECODE for the suite's processes (each would compile
     geomlib and rewrite the graded tests again: ~1 s of CPU per grading run); other jobs keep it."""
-    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
-    for d in (fake, tools, libs):
-        d.mkdir()
-    for t in (*TOOLS, "python3"):
-        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    (libs / "libOSMesa.so.8").write_text("")
     log = tmp_path / "uv.log"
-    bash = shutil.which("bash")
     uv = f'[ "$1" = run ] && echo "$* dont_write=${{PYTHONDONTWRITEBYTECODE:-unset}}" >> {log}\nexit 0\n'
-    for name, body in {"id": "echo 0", "uv": uv, "apt-get": "exit 0"}.items():
-        (fake / name).write_text(f"#!{bash}\n{body}")
-        (fake / name).chmod(0o755)
-    env = {
-        "PATH": f"{fake}:{tools}",
-        "HOME": str(tmp_path),
-        "GEOMLIB_LIB_DIRS": str(libs),
-        "GEOMLIB_UV": str(fake / "uv"),
-        "PYTHONDONTWRITEBYTECODE": "1",
-    }
+    env = {**_fake_root_with_osmesa(tmp_path, uv=uv, apt_get="exit 0"), "PYTHONDONTWRITEBYTECODE": "1"}
     for args in (("tests", "-q", "tests/unit"), ("figures",)):
         p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
         assert p.returncode == 0, p.stderr
