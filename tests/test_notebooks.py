@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import re
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -64,9 +65,13 @@ def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
         keep = checks[:1] if lab == PASSING_REPORT_IN else []
         nb.cells = [c for c in nb.cells if c not in checks or c in keep]
     nb.cells.append(nbformat.v4.new_code_cell(_REPORTS))
+    scratch = Path(tempfile.gettempdir())
+    before = set(scratch.glob(f"{lab}_*"))
     NotebookClient(
         nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(ROOT / "notebooks")}}
     ).execute()
+    left = sorted(set(scratch.glob(f"{lab}_*")) - before)
+    assert not left, f"{path.name} leaves {[str(p) for p in left]} behind (a student runs it again and again)"
     last = "".join(o.get("text", "") for o in nb.cells.pop().outputs)
     by_count = json.loads(last.split("@@reports", 1)[1])
     reports = {}
