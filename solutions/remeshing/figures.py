@@ -261,9 +261,10 @@ def fig_iterations(out: Path, R, quick: bool) -> Drawn:
     img = panels(imgs, caps, ncols=3, title=f"The decimated bunny after 0 to 5 iterations (L = {L}); {DOTS_TITLE}")
     return Drawn(
         img,
-        f"isotropic_remesh(V, F, {L}, iterations=k) of the QEM-decimated bunny for k = 0 (the input) to 5, "
-        "a dot on each vertex whose valence is not 6 (blue below, red above); each caption gives the faces, the "
-        "smallest angle, the share of angles below 30° and the share of interior vertices of valence 6.",
+        f"isotropic_remesh(V, F, {L}, iterations=k) of the QEM-decimated bunny for k = 0 to 5 (k = 0 is not "
+        "the input: the sliver clean-up that ends the loop still runs), a dot on each vertex whose valence "
+        "is not 6 (blue below, red above); each caption gives the faces, the smallest angle, the share of "
+        "angles below 30° and the share of interior vertices of valence 6.",
     )
 
 
