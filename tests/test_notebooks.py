@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import re
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -70,7 +71,11 @@ def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
     NotebookClient(
         nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(ROOT / "notebooks")}}
     ).execute()
-    left = sorted(set(scratch.glob(f"{lab}_*")) - before)
+    # A folder the kernel's last cells still wrote into goes when the kernel process exits (the
+    # TemporaryDirectory's finaliser), which nbclient does not wait for: wait for that, for hangs only.
+    deadline = time.monotonic() + 60
+    while (left := sorted(set(scratch.glob(f"{lab}_*")) - before)) and time.monotonic() < deadline:
+        time.sleep(0.2)
     assert not left, f"{path.name} leaves {[str(p) for p in left]} behind (a student runs it again and again)"
     last = "".join(o.get("text", "") for o in nb.cells.pop().outputs)
     by_count = json.loads(last.split("@@reports", 1)[1])
