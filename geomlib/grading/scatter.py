@@ -120,8 +120,12 @@ class Panel:
 
 def view(elev: float, azim: float) -> np.ndarray:
     """``(3, 2)``: 3D points ``@ view(...)`` are their screen ``(x, y)`` in an orthographic view from
-    ``elev`` degrees above the xy-plane and ``azim`` degrees around z (matplotlib's 3D angles)."""
+    ``elev`` degrees above the xy-plane and ``azim`` degrees around z (matplotlib's 3D angles): the
+    first two rows of :func:`geomlib.camera.look_at` from that direction (one camera in geomlib)."""
+    from geomlib.camera import look_at
+
     e, a = np.radians(elev), np.radians(azim)
-    right = [-np.sin(a), np.cos(a), 0.0]
+    toward_eye = [np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)]
+    # up: the direction of growing elevation (z tilted back), which stays defined looking straight down
     up = [-np.sin(e) * np.cos(a), -np.sin(e) * np.sin(a), np.cos(e)]
-    return np.array([right, up]).T
+    return look_at(toward_eye, (0.0, 0.0, 0.0), up=up)[:2, :3].T
