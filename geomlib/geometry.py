@@ -30,7 +30,6 @@ import os
 from collections import OrderedDict
 from dataclasses import dataclass
 
-import igl
 import numpy as np
 
 from geomlib import topology
@@ -284,6 +283,8 @@ def closest_points(V, F, P) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     P = _points(P, "P", where)
     if len(P) == 0:
         return np.zeros(0), np.zeros(0, np.int64), np.zeros((0, 3))
+    import igl  # here, not at the top: igl imports scipy.sparse (0.3 s of CPU for every importer)
+
     d, i, c = igl.point_mesh_squared_distance(P, V, F)
     return np.asarray(d, np.float64).ravel(), np.asarray(i, np.int64).ravel(), np.asarray(c, np.float64)
 
@@ -462,6 +463,8 @@ def _accelerators(V: np.ndarray, F: np.ndarray, need_bvh: bool) -> tuple:
     key = h.digest()
     entry = _ACCEL_CACHE.pop(key, None)
     if entry is None:
+        import igl
+
         tree = igl.AABB()
         tree.init(V, F)
         entry = (tree, None)
@@ -668,6 +671,8 @@ def _one_sided(Vs, Fs, Vt, Ft, n_samples, rng, where):
     """Distances from samples and from the vertices of mesh s to the surface of mesh t."""
     S = _sample(Vs, Fs, n_samples, rng, where)[0]
     used = np.flatnonzero(np.bincount(Fs.ravel(), minlength=len(Vs)))  # np.unique: slow hash path on NumPy 2.3+
+    import igl
+
     tree = igl.AABB()  # one tree, one query for samples and vertices together
     tree.init(Vt, Ft)
     d2 = np.asarray(tree.squared_distance(Vt, Ft, np.vstack([S, Vs[used]]))[0], np.float64).ravel()

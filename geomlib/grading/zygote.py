@@ -440,6 +440,11 @@ def serve(sock: socket.socket) -> None:
         except Exception:  # noqa: BLE001 - the worker parses them itself
             pass
         try:
+            if req.get("op") == "call":  # the submission's modules merged and compiled once per snapshot
+                _worker.prepare_merged(req.get("stubs_dir"), req.get("lab_dir"))
+        except Exception:  # noqa: BLE001 - each worker merges them itself
+            pass
+        try:
             if req.get("op") == "call":
                 _preload_for(req.get("stubs_dir"), req.get("function"))  # numba, scipy.fft: for the calls that use them
         except Exception:  # noqa: BLE001 - the workers import them themselves

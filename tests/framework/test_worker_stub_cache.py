@@ -51,6 +51,7 @@ def fresh_cache():
         worker._STUB_NAMES,
         worker._STUB_DEFINES,
         worker._STUB_PREFIX,
+        worker._MERGED,
     )
     saved = [dict(d) for d in caches]
     for d in caches:
@@ -226,3 +227,100 @@ def test_a_stub_statement_and_a_submissions_are_the_same_code_as_ast_dump_says()
                         pairs += 1
                         same += worker._same(a, b)
     assert pairs > 5000 and 0 < same < pairs, (pairs, same)
+
+
+def _unload(lab: str) -> None:
+    for name in [m for m in sys.modules if m.startswith(f"_graded_{lab}")]:
+        del sys.modules[name]
+    sys.meta_path[:] = [f for f in sys.meta_path if not isinstance(f, worker._LabFinder)]
+
+
+def _next_worker() -> None:
+    """What a new worker of the same zygote starts with: the zygote's caches, none of the last
+    worker's trees of the submission."""
+    for key in [k for k in worker._TREES if k[1]]:
+        del worker._TREES[key]
+
+
+def test_the_zygote_merges_a_snapshots_modules_once_for_all_its_workers(tmp_path, fresh_cache, monkeypatch):
+    """The zygote merges and compiles the submission's module ahead (prepare_merged): a worker runs it
+    without merging or compiling again, with the zygote's stub code as given code; the zygote keeps
+    no tree of the submission where a worker would take it unchecked."""
+    stubs, student = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, STUDENT)
+    worker.prepare_stubs(str(stubs))
+    worker.prepare_merged(str(stubs), str(student))
+    assert str(student / "ops.py") in worker._MERGED
+    assert not [k for k in worker._TREES if k[1]]
+
+    def merged(*_):
+        raise AssertionError("the worker merged and compiled the module again")
+
+    monkeypatch.setattr(worker, "merge_module", merged)
+    for _ in range(2):  # two workers of the same snapshot
+        try:
+            fn = worker.find_function(student, "toy", "task", stubs)
+            assert fn(2) == 7  # the course's helper (3 * 2) + 1
+            helper = sys.modules[fn.__module__].given_helper
+            tree = worker._parsed(stubs / "ops.py", student=False)
+            stmt = next(s for s in tree.body if getattr(s, "name", "") == "given_helper")
+            assert helper.__code__ in worker._STUB_CODE[id(stmt)].co_consts
+            assert id(helper.__code__) in blacklist._GIVEN
+            assert id(fn.__code__) not in blacklist._GIVEN
+        finally:
+            _unload("toy")
+        _next_worker()
+
+
+def test_a_file_changed_since_the_zygote_merged_it_is_merged_by_the_worker(tmp_path, fresh_cache):
+    """The worker compares the bytes it reads with those the zygote merged: a file changed since (its
+    size and modification time put back) runs as it is now."""
+    stubs, student = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, STUDENT)
+    worker.prepare_stubs(str(stubs))
+    worker.prepare_merged(str(stubs), str(student))
+    st = (student / "ops.py").stat()
+    _write(student, STUDENT.replace("+ 1", "+ 2"))
+    os.utime(student / "ops.py", ns=(st.st_atime_ns, st.st_mtime_ns))
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 8, "the zygote's merge of the old bytes ran"
+    finally:
+        _unload("toy")
+    _next_worker()
+    _write(stubs, STUB.format(scale=5))  # and the stubs changed since: merged with the stubs as they are
+    worker.prepare_stubs(str(stubs))
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 12
+    finally:
+        _unload("toy")
+
+
+FORGER = """
+import sys
+
+
+def given_helper(x):
+    return -1
+
+
+def task(x):
+    w = sys.modules["geomlib.grading.worker"]
+    for path, ahead in list(w._MERGED.items()):  # put its own helper in place of the course's
+        forged = compile("def given_helper(x):\\n    return -100\\n", path, "exec")
+        w._MERGED[path] = type(ahead)(ahead.digest, ahead.tree, ahead.stub, ahead.stub_tree, (*ahead.code, (forged, True)))
+    return given_helper(x) + (__file__ in w._MERGED)
+"""
+
+
+def test_a_worker_cannot_change_what_the_zygote_merged_for_the_next_calls(tmp_path, monkeypatch):
+    """Through the zygote: the submission's module comes merged from the zygote (one entry for its
+    file), and an entry a worker rewrites stays in that worker: the next call runs the course's helper."""
+    stubs_root, student = tmp_path / "stubs", tmp_path / "sub" / "toy"
+    _write(stubs_root / "toy", STUB.format(scale=3))
+    _write(student, FORGER)
+    monkeypatch.setenv("GEOMLIB_STUBS", str(stubs_root))
+    lab = LabProxy("toy", student)
+    assert lab.task(2) == 6 + 1  # the course's helper, and its file was merged ahead by the zygote
+    assert lab.task(2) == 6 + 1, "a worker's forged entry ran in the next call"
