@@ -9,7 +9,8 @@
   the stubs' ``NotImplementedError("Task N ...")`` messages;
 - ``make_figures`` and ``make_view`` on the untouched stubs finish, and draw one "Task N not implemented yet"
   picture (naming a task the stubs really leave open) for each figure it cannot draw, under the
-  figure's own file name.
+  figure's own file name (``make_figures`` of a lab with a notebook: on the stubs notebook's run,
+  ``tests/test_notebooks.py``).
 """
 
 from __future__ import annotations
@@ -90,23 +91,48 @@ def test_handout_task_table_matches_the_stubs(lab):
     )
 
 
+def untouched_stub_figure_problems(lab: str, drawn: list[tuple[str, str, np.ndarray]]) -> list[str]:
+    """What is wrong with figures drawn from the untouched stubs of ``lab``, given as ``(file name,
+    caption, RGB pixels)``: each must be one of the lab's documented figures and be a "Task N not
+    implemented yet" page (a page with text, not an empty file) naming a task the stubs leave open.
+    Used here for ``make_view`` and by ``tests/test_notebooks.py`` for ``make_figures``, whose
+    figures the stubs notebook's figures cell draws (so the suite draws them once)."""
+    open_tasks = stub_tasks(lab)
+    documented = {p.stem for p in (ROOT / "docs" / "figures" / lab).glob("*.png")} | {f"{lab}_3d"}
+    problems = []
+    if not drawn:
+        problems.append(f"{lab}: no figures drawn from the stubs")
+    for name, caption, img in drawn:
+        stem = Path(name).stem
+        if stem not in documented:
+            problems.append(f"{lab}: figure {name} is not in docs/figures/{lab}/")
+        m = re.match(r"Task (\d+[a-z]?) not implemented yet", caption)
+        if not m:
+            problems.append(f"{lab}: {name} drawn from the stubs without a missing task: {caption[:200]}")
+        elif m.group(1) not in open_tasks:
+            problems.append(f"{lab}: {name} names Task {m.group(1)}, not a stub task")
+        if not (img.shape[0] > 100 and (img < 200).any()):
+            problems.append(f"{lab}: {name} is not a page with text ({img.shape})")
+    return problems
+
+
 @pytest.mark.parametrize("lab", LABS)
 def test_figures_of_the_untouched_stubs_name_the_missing_tasks(lab, tmp_path):
+    """``make_view`` here; ``make_figures`` on the stubs is what the lab notebook's figures cell
+    runs, checked with the same rules on that run's output (``tests/test_notebooks.py``), and drawn
+    here only for a lab without a notebook."""
     from PIL import Image
 
     figures = importlib.import_module(f"labs.{lab}.figures")
-    out = [*figures.make_figures(tmp_path, quick=True), figures.make_view(tmp_path, quick=True)]
+    out = [figures.make_view(tmp_path, quick=True)]
+    if not course(ROOT).lab(lab).notebook.is_file():
+        out = [*figures.make_figures(tmp_path, quick=True), *out]
     assert out and all(isinstance(f, Figure) for f in out)
-    open_tasks = stub_tasks(lab)
-    documented = {p.stem for p in (ROOT / "docs" / "figures" / lab).glob("*.png")} | {f"{lab}_3d"}
     for f in out:
         assert f.path.is_file() and f.path.parent == tmp_path, f.path
-        assert f.path.stem in documented, f"{lab}: figure {f.path.name} is not in docs/figures/{lab}/"
-        m = re.match(r"Task (\d+[a-z]?) not implemented yet", f.caption)
-        assert m, f"{lab}: {f.path.name} drawn from the stubs without a missing task: {f.caption[:200]}"
-        assert m.group(1) in open_tasks, f"{lab}: {f.path.name} names Task {m.group(1)}, not a stub task"
-        img = np.asarray(Image.open(f.path).convert("RGB"))
-        assert img.shape[0] > 100 and (img < 200).any()  # a page with text, not an empty file
+    drawn = [(f.path.name, f.caption, np.asarray(Image.open(f.path).convert("RGB"))) for f in out]
+    problems = untouched_stub_figure_problems(lab, drawn)
+    assert not problems, "\n".join(problems)
 
 
 def test_make_figures_draws_the_lab_it_is_given(tmp_path):

@@ -11,6 +11,9 @@ the first one (task 1, it also imports ``check``), which shows a passing report 
 path from ``check()`` to the report is the same for every lab, and the stubs run takes it in every
 notebook.
 
+On the stubs, the figures cell's pictures are checked as ``tests/test_lab_contracts.py`` checks the
+stubs' figures (each names a task not implemented yet): the suite draws them once, here.
+
 A kernel runs its ``check()`` cells in one process: each is one pytest session, and they share one
 grading sandbox (the zygote, started by the first, with what it preloaded for the lab) and the
 kernels compiled earlier (:mod:`geomlib.grading.kernelcache`), as in a student's notebook.
@@ -18,13 +21,17 @@ kernels compiled earlier (:mod:`geomlib.grading.kernelcache`), as in a student's
 
 from __future__ import annotations
 
+import base64
+import io
 import json
 import re
 import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
+from jupyter_client.manager import KernelManager
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
@@ -45,16 +52,53 @@ print("@@reports" + _json.dumps({k: v.results for k, v in Out.items() if isinsta
 """
 
 
+_NO_DEBUGGER = (
+    "import sys; sys.modules['debugpy'] = None; from ipykernel import kernelapp; kernelapp.launch_new_instance()"
+)
+
+
+class _Kernel(KernelManager):
+    """The kernel Jupyter starts (``python -m ipykernel_launcher -f ...``), without its debugger:
+    ipykernel imports debugpy at start for JupyterLab's debugger panel, which no cell uses (0.12 s
+    of CPU of the 0.6 s a kernel costs, 18 kernels)."""
+
+    def format_kernel_cmd(self, extra_arguments=None):
+        cmd = super().format_kernel_cmd(extra_arguments)
+        for i in range(len(cmd) - 1):
+            if cmd[i : i + 2] == ["-m", "ipykernel_launcher"]:
+                return [*cmd[:i], "-c", _NO_DEBUGGER, *cmd[i + 2 :]]
+        return cmd
+
+
+def _figures(nb) -> list[tuple[str, str, np.ndarray]]:
+    """``(file name, caption, RGB pixels)`` of the figures the figures cell showed: a Markdown line
+    ``**name.png** — caption``, then the picture."""
+    from PIL import Image
+
+    out, caption = [], None
+    for c in nb.cells:
+        for o in c.get("outputs", []) if c.cell_type == "code" else []:
+            data = o.get("data", {})
+            m = re.match(r"\*\*(\S+\.png)\*\* — (.*)", data.get("text/markdown", ""), re.S)
+            if m:
+                caption = m.groups()
+            elif "image/png" in data and caption is not None:
+                img = Image.open(io.BytesIO(base64.b64decode(data["image/png"]))).convert("RGB")
+                out.append((*caption, np.asarray(img)))
+                caption = None
+    return out
+
+
 def _check_task(lab: str, source: str) -> int | None:
     """N for a cell that runs ``check(lab, task=N)``, else None."""
     m = re.search(rf'^check\("{lab}", task=(\d+)\)', source, re.M)
     return int(m.group(1)) if m else None
 
 
-def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
-    """Run the notebook in a fresh kernel; return its cells' printed text and ``{task: results}``
-    of its check() cells. ``solutions``: the check() cells are left out, but for the first one in
-    the notebook of :data:`PASSING_REPORT_IN`."""
+def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict], list]:
+    """Run the notebook in a fresh kernel; return its cells' printed text, ``{task: results}`` of
+    its check() cells and the figures it showed (:func:`_figures`). ``solutions``: the check()
+    cells are left out, but for the first one in the notebook of :data:`PASSING_REPORT_IN`."""
     import nbformat
     from nbclient import NotebookClient
 
@@ -69,7 +113,11 @@ def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
     scratch = Path(tempfile.gettempdir())
     before = set(scratch.glob(f"{lab}_*"))
     NotebookClient(
-        nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(ROOT / "notebooks")}}
+        nb,
+        timeout=CELL_TIMEOUT,
+        kernel_name="python3",
+        kernel_manager_class=_Kernel,
+        resources={"metadata": {"path": str(ROOT / "notebooks")}},
     ).execute()
     # A folder the kernel's last cells still wrote into goes when the kernel process exits (the
     # TemporaryDirectory's finaliser), which nbclient does not wait for: wait for that, for hangs only.
@@ -86,7 +134,7 @@ def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict]]:
             assert str(c.execution_count) in by_count, f"{path.name}: check(task={task}) returned no report"
             reports[task] = by_count[str(c.execution_count)]
     text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
-    return text, reports
+    return text, reports, _figures(nb)
 
 
 @pytest.mark.slow
@@ -96,7 +144,10 @@ def test_notebook_executes(path, monkeypatch):
     cell runs too and reports full marks."""
     monkeypatch.setenv("GEOMLIB_IMPL", "solutions")
     monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
-    _, reports = _execute(path, solutions=True)
+    _, reports, figures = _execute(path, solutions=True)
+    assert figures, f"{path.name}: the figures cell showed no figure"
+    missing = [f"{name}: {caption[:200]}" for name, caption, _ in figures if "not implemented yet" in caption]
+    assert not missing, f"{path.name}: figures of the solutions with a missing task:\n" + "\n".join(missing)
     if path.stem != PASSING_REPORT_IN:
         assert not reports, f"{path.name}: check() cells run {sorted(reports)}"
         return
@@ -110,7 +161,8 @@ def test_notebook_executes(path, monkeypatch):
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs_on_the_stubs(path, monkeypatch):
-    """As in the student bundle before any work: every cell runs, the missing tasks are named, and
+    """As in the student bundle before any work: every cell runs, the missing tasks are named (in
+    the figures too: :func:`tests.test_lab_contracts.untouched_stub_figure_problems`), and
     every task's check() scores 0 with no failure other than "not implemented yet" (a stub that
     fails for another reason, an error in the grader or in a given helper, shows here)."""
     from geomlib.grading import tasks
@@ -119,8 +171,12 @@ def test_notebook_runs_on_the_stubs(path, monkeypatch):
     lab = path.stem
     monkeypatch.setenv("GEOMLIB_IMPL", "labs")
     monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
-    text, reports = _execute(path, solutions=False)
+    from tests.test_lab_contracts import untouched_stub_figure_problems
+
+    text, reports, figures = _execute(path, solutions=False)
     assert "not implemented yet" in text
+    problems = untouched_stub_figure_problems(lab, figures)
+    assert not problems, f"{path.name}, figures cell:\n" + "\n".join(problems)
     assert set(reports) == set(tasks.table(lab).titles), f"{path.name}: check() reports for tasks {sorted(reports)}"
     pointed = {}
     for task, r in sorted(reports.items()):
