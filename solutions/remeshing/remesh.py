@@ -71,7 +71,8 @@ def isotropic_remesh(
     (feature-line and boundary vertices onto the input's lines, the others onto its surface). After
     the last iteration, :func:`~.stages.clean_slivers` flips or collapses away the faces with an
     angle below 35° where that raises the smallest angle around them, then moves the vertices of
-    faces below 50° toward the centroid of their neighbours (on the surface) where that raises it.
+    faces below 50° toward the centroid of their neighbours (on the surface), and those of faces
+    below 40° by short steps in the tangent plane, each where that raises it.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear

@@ -125,7 +125,9 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
     With ``project`` (the loop's :class:`SurfaceProjector` of the input), the free vertices of the
     faces still below 50° then move to the projection of the centroid of their neighbours, each only
     where that raises the smallest angle around it (:func:`_relocate`): the last iteration's flips
-    leave their faces unrelaxed, and a few of them are the mesh's smallest angles.
+    leave their faces unrelaxed, and a few of them are the mesh's smallest angles. The vertices of
+    the faces below 40° also try short steps in eight directions of their tangent plane (a pattern
+    search), where the centroid is no better.
     """
     total = 0
     for _ in range(passes):
@@ -140,12 +142,26 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
 
 #: Vertices of faces with a smaller angle (degrees) are moved to improve it (:func:`_relocate`).
 RELOCATE_ANGLE = 50.0
+#: Vertices of faces with a smaller angle (degrees) also try the steps of :data:`SEARCH_STEPS` (:func:`_relocate`).
+SEARCH_ANGLE = 40.0
+#: The pattern search's steps (in the tangent plane, as fractions of the vertex's mean edge) and
+#: their eight directions, written out (no sin/cos: the same bits on every CPU).
+SEARCH_STEP = 0.05
+_R = 0.7071067811865476
+SEARCH_DIRECTIONS = ((1.0, 0.0), (_R, _R), (0.0, 1.0), (-_R, _R), (-1.0, 0.0), (-_R, -_R), (0.0, -1.0), (_R, -_R))
 
 
 def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     """Move the free vertices of faces with an angle below ``min_angle`` degrees to the closest
     point on the surface of the centroid of their neighbours (taken in the tangent plane), each
-    only when that raises the smallest angle around it (:func:`.kernels.relocate_pass`)."""
+    only when that raises the smallest angle around it (:func:`.kernels.relocate_pass`).
+
+    The centroid is where relaxation would put the vertex, not where its worst angle is largest: a
+    vertex of a face below :data:`SEARCH_ANGLE` then also tries steps of :data:`SEARCH_STEP` times its
+    mean edge in the :data:`SEARCH_DIRECTIONS` of its tangent plane, each taken (on the surface)
+    only when it raises the smallest angle around it; over the passes, a hill climb of that angle
+    (fandisk at 0.75x its mean edge: 35.2° -> 38.1°, the cow at 1.5x: 14.8° -> 23.7°).
+    """
     total = 0
     n = S.cnt[0]
     Fl = S.faces()  # the passes move vertices only: the faces and edges stay
@@ -155,7 +171,8 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     deg = np.bincount(E.ravel(), minlength=n)
     for _ in range(passes):
         V = S.V[:n]
-        bad = Fl[K.faces_min_angle(V, Fl) < np.radians(min_angle)]
+        angle = K.faces_min_angle(V, Fl)
+        bad = Fl[angle < np.radians(min_angle)]
         cand = np.unique(bad)
         cand = cand[S.cls[cand] == 0]
         if not len(cand):
@@ -163,11 +180,22 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
         c = np.stack(
             [np.bincount(E[:, 0], V[E[:, 1], k], n) + np.bincount(E[:, 1], V[E[:, 0], k], n) for k in range(3)], 1
         )
-        X = np.cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
+        X = _cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
         N = np.stack([np.bincount(Fl.ravel(), np.repeat(X[:, k], 3), minlength=n) for k in range(3)], axis=1)[cand]
         N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
         D = c[cand] / np.maximum(deg[cand], 1)[:, None] - V[cand]
         D -= np.einsum("ij,ij->i", D, N)[:, None] * N
+        worst = np.isin(cand, Fl[angle < np.radians(SEARCH_ANGLE)])
+        if worst.any():  # the pattern search, after the centroid moves
+            w, Nw = cand[worst], N[worst]
+            u = _cross(Nw, np.where(np.abs(Nw[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
+            u /= np.maximum(np.sqrt(np.einsum("ij,ij->i", u, u)), 1e-300)[:, None]
+            v = _cross(Nw, u)
+            d = V[E[:, 0]] - V[E[:, 1]]
+            length = np.sqrt(np.einsum("ij,ij->i", d, d))
+            r = SEARCH_STEP * (np.bincount(E[:, 0], length, n) + np.bincount(E[:, 1], length, n))[w] / deg[w]
+            D = np.concatenate([D] + [r[:, None] * (x * u + y * v) for x, y in SEARCH_DIRECTIONS])
+            cand = np.r_[cand, np.tile(w, len(SEARCH_DIRECTIONS))]
         Q = V[cand] + D
         P = project(Q)
         # where the surface bends away within the step (a tip, a ridge) the move would cut it: skip
@@ -245,13 +273,23 @@ def _line_tangents(V, E_feat, n):
     return t
 
 
+def _cross(a, b):
+    """Row-wise cross product of (k, 3) arrays (np.cross's arithmetic, without its per-call overhead)."""
+    out = np.empty_like(a)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
+
+
 def _relax(V, F, cls, E_feat, damping):
     """Tangential relaxation on faces ``F`` of ``V`` (rows no face uses are left alone)."""
     n = len(V)
     # BEGIN SOLUTION: Task 8 (tangential relaxation): p += λ (I - n nᵀ)(c - p), c = Σ A_f c_f / Σ A_f; feature vertices along their line
-    X = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    P = V[F]  # (m, 3 corners, 3)
+    X = _cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
     A = 0.5 * np.linalg.norm(X, axis=1)
-    C = V[F].mean(axis=1)
+    C = P.mean(axis=1)
     w = np.bincount(F.ravel(), np.repeat(A, 3), minlength=n)
     c = np.stack([np.bincount(F.ravel(), np.repeat(A * C[:, k], 3), minlength=n) for k in range(3)], axis=1)
     N = np.stack([np.bincount(F.ravel(), np.repeat(X[:, k], 3), minlength=n) for k in range(3)], axis=1)
