@@ -229,3 +229,30 @@ def test_height_at_is_geomlibs_bilinear_clamp_lookup():
     uv = np.random.default_rng(1).uniform(-0.3, 1.3, (500, 2))
     uv[:4] = [[0, 0], [1, 1], [0.5 / 16, 1 - 0.5 / 16], [1 - 0.5 / 16, 0.5]]
     assert np.allclose(height_at(H, uv[:, 0], uv[:, 1]), sample_bilinear(H, uv, "clamp"), atol=1e-15, rtol=0)
+
+
+@pytest.mark.parametrize("deg", [0.5, 30, 75, 88])
+def test_the_exact_march_starts_only_past_samples_above_the_surface(deg):
+    """exact_uv starts each pixel's march where the map's highest texels under the ray allow: every
+    sample it skips is above the surface (checked one by one), so the hit is the first sample at or below."""
+    from solutions.relief.heights import bricks, bumps
+    from solutions.relief.inputs import height_lookup
+    from solutions.relief.truth import _first_sample
+
+    rng = np.random.default_rng(int(deg))
+    m = 512
+    skipped = 0
+    for H in (bumps(64), bricks(64), rng.random((32, 32)) * 0.7):
+        uv = rng.random((300, 2)) * 1.2 - 0.1  # also outside [0, 1] (clamped reads)
+        V = direction(deg, azimuth=rng.uniform(0, 2 * np.pi))
+        du = np.full(300, -SCALE * V[0] / V[2])
+        dv = np.full(300, -SCALE * V[1] / V[2])
+        start = _first_sample(H, uv[:, 0], uv[:, 1], du, dv, m)
+        h = height_lookup(H)
+        j = np.arange(m + 1)
+        d = j / m
+        f = d - (1.0 - h(uv[:, :1] + d * du[:, None], uv[:, 1:] + d * dv[:, None]))
+        first = np.argmax(f >= 0, axis=1)
+        assert (start <= first).all(), f"the march would skip the hit at sample {first[start > first][0]}"
+        skipped += int(start.sum())
+    assert skipped > 0 or deg > 80, "no sample skipped: the start bound does nothing"

@@ -175,6 +175,34 @@ def test_ray_cast_matches_brute_force():
     assert (t[~hit] == np.inf).all() and (face[~hit] == -1).all() and (bary[~hit] == 0).all()
 
 
+def test_ray_cast_rays_beside_the_mesh_and_grazing_its_box_match_brute_force():
+    """Most rays miss the mesh's box (ray_cast drops them before the traversal); the others start
+    inside it, run in a box face's plane, graze its corners or stop before it: all as brute force."""
+    V, F = datasets.icosphere(2)
+    rng = np.random.default_rng(1)
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    O = rng.uniform(-3, 3, (600, 3))
+    D = rng.normal(size=(600, 3))
+    O[:100] = rng.uniform(lo, hi, (100, 3))  # inside the box
+    D[100:200, 2] = 0.0  # parallel to the z slabs
+    O[100:200, 2] = np.where(rng.random(100) < 0.5, lo[2], hi[2])  # in a box face's plane
+    O[200:300] = hi + rng.uniform(0.1, 1, (100, 3))
+    D[200:300] = hi - O[200:300]  # aimed at the box's corner (just beside the sphere)
+    a, r = rng.uniform(0, 2 * np.pi, 100), rng.uniform(0.9, 1.0, 100)
+    O[300:400] = np.c_[r * np.cos(a), r * np.sin(a), np.full(100, 3.0)]
+    D[300:400] = [0.0, 0.0, -1.0]  # down past the sphere's rim, near the box's sides
+    for t_max in (np.inf, 2.0):
+        hit, t, face, _ = geometry.ray_cast(V, F, O, D, t_max=t_max)
+        with np.errstate(invalid="ignore"):  # rays parallel to a triangle: inf + inf in the reference
+            bh, bt, bf = brute_force_rays(V, F, O, D)
+        bh &= bt <= t_max
+        np.testing.assert_array_equal(hit, bh)
+        np.testing.assert_allclose(t[hit], bt[hit], rtol=1e-12)
+        np.testing.assert_array_equal(face[hit], bf[hit])
+        assert (t[~hit] == np.inf).all() and (face[~hit] == -1).all()
+        assert 0 < hit.sum() < 0.5 * len(hit)
+
+
 def test_ray_cast_against_analytic_sphere(sphere4):
     V, F = sphere4
     rng = np.random.default_rng(2)
