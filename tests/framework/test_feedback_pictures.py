@@ -404,12 +404,13 @@ def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, 
     assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
 
 
-@pytest.mark.parametrize("kind", ["free points", "rows inside a solid"])
-def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
+def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path):
     """The first picture of shadows' --task 3 (wrong (u, v, z): free points) and of subdivision's
     --task 1 (wrong matrix rows on a mesh) are drawn with Pillow, not a matplotlib figure (importing
     matplotlib.figure, a 3D axes and a tight savefig cost 0.5-0.8 s of the 3 s a student waits for
-    --task N). Three panels, as every kind (test above)."""
+    --task N). Three panels, as every kind (test above). Both are drawn in one fresh interpreter, one
+    after the other, each followed by a look at what is imported by then."""
+    kinds = ["free points", "rows inside a solid"]
     code = textwrap.dedent(
         f"""
         import sys
@@ -420,15 +421,20 @@ def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
         from geomlib.grading.checks import Context
 
         feedback._drawn_in_time = lambda path, draw: (draw(), str(path))[1]
-        name, inputs, expected, got = next(k for k in _kinds() if k[0] == {kind!r})
-        ctx = Context(label=name, lab="kinds", case_id="k", feedback_dir={str(tmp_path)!r})
-        path = feedback.default_picture(ctx, inputs, expected, got)
-        print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
+        for kind in {kinds!r}:
+            name, inputs, expected, got = next(k for k in _kinds() if k[0] == kind)
+            ctx = Context(label=name, lab="kinds", case_id=kind.replace(" ", "_"), feedback_dir={str(tmp_path)!r})
+            path = feedback.default_picture(ctx, inputs, expected, got)
+            print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
         """
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
-    assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, out
-    assert out[1:] == ["[]"], f"the picture imported {out[1:]}"
+    lines = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    lines = lines.strip().splitlines()
+    assert len(lines) == len(kinds), lines
+    for kind, line in zip(kinds, lines):
+        out = line.split()
+        assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, (kind, out)
+        assert out[1:] == ["[]"], f"the {kind} picture imported {out[1:]}"
 
 
 def _file(text: str) -> str:
