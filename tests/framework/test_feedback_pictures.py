@@ -26,6 +26,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import textwrap
 from pathlib import Path
 
@@ -226,34 +227,43 @@ def _not_blank_png(path: Path) -> bool:
 
 
 @pytest.mark.render
-@pytest.mark.parametrize("lab", list(HAND_WRITTEN))
-def test_hand_written_graded_tests_draw_their_failures(lab, tmp_path):
-    """A planted error makes the lab's hand-written tests fail, each with a picture named in its message."""
-    plants, tests = HAND_WRITTEN[lab]
-    folder = _plant(lab, *plants[0])
-    for module, source in plants[1:]:
-        with open(folder / f"{module}.py", "a") as f:
-            f.write("\n\n# planted error\n" + textwrap.dedent(source))
-    root = course_root()
-    pictures = tmp_path / "feedback"
-    env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_NO_FEEDBACK_PICTURES"}
+def test_hand_written_graded_tests_draw_their_failures(tmp_path):
+    """A planted error makes each lab's hand-written tests fail, each with a picture named in its
+    message. The planted labs of :data:`HAND_WRITTEN` sit side by side in one submission folder and
+    are graded by one pytest run (one interpreter, one zygote; a run per lab started four)."""
+    impl = Path(tempfile.mkdtemp(prefix="geomlib-plant-hand-written-"))
+    os.chmod(impl, 0o755)
+    selected = []
     try:
+        for lab, (plants, tests) in HAND_WRITTEN.items():
+            folder = _plant(lab, *plants[0])
+            for module, source in plants[1:]:
+                with open(folder / f"{module}.py", "a") as f:
+                    f.write("\n\n# planted error\n" + textwrap.dedent(source))
+            shutil.move(folder, impl / lab)
+            shutil.rmtree(folder.parent, ignore_errors=True)
+            selected += [f"tests/graded/{lab}/test_{lab}.py::{test}" for test in tests]
+        root = course_root()
+        pictures = tmp_path / "feedback"
+        env = {k: v for k, v in os.environ.items() if k != "GEOMLIB_NO_FEEDBACK_PICTURES"}
         p = subprocess.run(
-            [sys.executable, "-m", "pytest", f"tests/graded/{lab}/test_{lab}.py", f"--impl={folder.parent}",
-             f"--feedback-dir={pictures}", "-p", "no:cacheprovider",
-             "-q", "-k", " or ".join(tests)],
-            cwd=root, capture_output=True, text=True, env=env, timeout=600,
+            [sys.executable, "-m", "pytest", *selected, f"--impl={impl}",
+             f"--feedback-dir={pictures}", "-p", "no:cacheprovider", "-q"],
+            cwd=root, capture_output=True, text=True, env=env, timeout=1200,
         )  # fmt: skip
     finally:
-        shutil.rmtree(folder.parent, ignore_errors=True)
+        shutil.rmtree(impl, ignore_errors=True)
     failures = _failures(p.stdout)
-    assert sorted(failures) == sorted(tests), p.stdout[-3000:] + p.stderr[-2000:]
-    for test, message in failures.items():
-        seen = re.search(r"\(see (\S+\.png)\)", message)
-        assert seen, f"{test} failed without a picture: {message}"
-        picture = (root / seen.group(1)).resolve()
-        assert picture.parent == (pictures / lab).resolve() and picture.name.startswith(f"{test}--"), picture
-        assert picture.is_file() and _not_blank_png(picture), picture
+    expected = [test for _, tests in HAND_WRITTEN.values() for test in tests]
+    assert sorted(failures) == sorted(expected), p.stdout[-3000:] + p.stderr[-2000:]
+    for lab, (_, tests) in HAND_WRITTEN.items():
+        for test in tests:
+            message = failures[test]
+            seen = re.search(r"\(see (\S+\.png)\)", message)
+            assert seen, f"{lab}: {test} failed without a picture: {message}"
+            picture = (root / seen.group(1)).resolve()
+            assert picture.parent == (pictures / lab).resolve() and picture.name.startswith(f"{test}--"), picture
+            assert picture.is_file() and _not_blank_png(picture), picture
 
 
 def test_pictures_of_one_test_do_not_overwrite_each_other(tmp_path):
@@ -394,12 +404,13 @@ def test_every_picture_kind_shows_expected_yours_and_difference(kind, tmp_path, 
     assert not_white.sum() > 20, f"{kind}: the expected panel is blank"
 
 
-@pytest.mark.parametrize("kind", ["free points", "rows inside a solid"])
-def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
+def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path):
     """The first picture of shadows' --task 3 (wrong (u, v, z): free points) and of subdivision's
     --task 1 (wrong matrix rows on a mesh) are drawn with Pillow, not a matplotlib figure (importing
     matplotlib.figure, a 3D axes and a tight savefig cost 0.5-0.8 s of the 3 s a student waits for
-    --task N). Three panels, as every kind (test above)."""
+    --task N). Three panels, as every kind (test above). Both are drawn in one fresh interpreter, one
+    after the other, each followed by a look at what is imported by then."""
+    kinds = ["free points", "rows inside a solid"]
     code = textwrap.dedent(
         f"""
         import sys
@@ -410,15 +421,20 @@ def test_points_and_rows_pictures_need_no_matplotlib_figure(tmp_path, kind):
         from geomlib.grading.checks import Context
 
         feedback._drawn_in_time = lambda path, draw: (draw(), str(path))[1]
-        name, inputs, expected, got = next(k for k in _kinds() if k[0] == {kind!r})
-        ctx = Context(label=name, lab="kinds", case_id="k", feedback_dir={str(tmp_path)!r})
-        path = feedback.default_picture(ctx, inputs, expected, got)
-        print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
+        for kind in {kinds!r}:
+            name, inputs, expected, got = next(k for k in _kinds() if k[0] == kind)
+            ctx = Context(label=name, lab="kinds", case_id=kind.replace(" ", "_"), feedback_dir={str(tmp_path)!r})
+            path = feedback.default_picture(ctx, inputs, expected, got)
+            print(path, sorted(m for m in ("matplotlib.figure", "matplotlib.pyplot") if m in sys.modules))
         """
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
-    assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, out
-    assert out[1:] == ["[]"], f"the picture imported {out[1:]}"
+    lines = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    lines = lines.strip().splitlines()
+    assert len(lines) == len(kinds), lines
+    for kind, line in zip(kinds, lines):
+        out = line.split()
+        assert Path(out[0]).is_file() and Path(out[0]).stat().st_size > 5000, (kind, out)
+        assert out[1:] == ["[]"], f"the {kind} picture imported {out[1:]}"
 
 
 def _file(text: str) -> str:

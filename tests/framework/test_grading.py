@@ -152,19 +152,32 @@ def test_student_code_cannot_touch_the_results_or_read_hidden_references(sample_
     assert json.loads(results.read_text())["score"] == 7
 
 
-def test_plain_pytest_shows_the_message_not_a_traceback(sample_course, tmp_path):
+def _plain_pytest(sample_course: Path, sub: Path, *extra: str):
+    """``pytest tests/graded/sample --impl=sub *extra`` in the sample course, in a subprocess."""
+    import os
     import subprocess
     import sys
 
-    wrong = GOOD_OPS.replace("return c + s * (V - c)", "return s * V")
-    sub = _submission(tmp_path, wrong)
-    p = subprocess.run(
-        [sys.executable, "-m", "pytest", "tests/graded/sample", f"--impl={sub}", "-p", "no:cacheprovider", "-q"],
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "tests/graded/sample", f"--impl={sub}", "-p", "no:cacheprovider", *extra],
         cwd=sample_course,
         capture_output=True,
         text=True,
-        env={**__import__("os").environ, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"},
+        env={**os.environ, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"},
     )
+
+
+@pytest.fixture(scope="module")
+def wrong_scale_plain_run(sample_course):
+    """One plain ``pytest`` run (no xdist) of a submission whose scaling ignores the centroid: its
+    message (test below) and its score table (compared with xdist's) come from the same run."""
+    sub = _submission(None, GOOD_OPS.replace("return c + s * (V - c)", "return s * V"))
+    yield sub, _plain_pytest(sample_course, sub)
+    shutil.rmtree(sub.parent, ignore_errors=True)
+
+
+def test_plain_pytest_shows_the_message_not_a_traceback(wrong_scale_plain_run):
+    _, p = wrong_scale_plain_run
     out = p.stdout
     assert p.returncode == 1
     assert 'scale_about_centroid on "tet-scale": V[0] expected' in out
@@ -172,27 +185,17 @@ def test_plain_pytest_shows_the_message_not_a_traceback(sample_course, tmp_path)
     assert "graded score" in out
 
 
-def test_the_score_table_is_the_same_with_pytest_xdist(sample_course, tmp_path):
+def test_the_score_table_is_the_same_with_pytest_xdist(sample_course, wrong_scale_plain_run):
     """`./run tests` runs the whole suite on every core (pytest-xdist): the graded records travel on
     the reports from the workers, so the score table is printed there too, and is the same."""
     import importlib.util
     import re
-    import subprocess
-    import sys
 
     if importlib.util.find_spec("xdist") is None:
         pytest.skip("pytest-xdist is not installed (a dev dependency)")
-    wrong = GOOD_OPS.replace("return c + s * (V - c)", "return s * V")
-    sub = _submission(tmp_path, wrong)
+    sub, plain = wrong_scale_plain_run
     tables = []
-    for extra in ([], ["-n", "2"]):
-        p = subprocess.run(
-            [sys.executable, "-m", "pytest", "tests/graded/sample", f"--impl={sub}", "-p", "no:cacheprovider", *extra],
-            cwd=sample_course,
-            capture_output=True,
-            text=True,
-            env={**__import__("os").environ, "GEOMLIB_ROOT": str(sample_course), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"},
-        )
+    for p in (plain, _plain_pytest(sample_course, sub, "-n", "2")):
         m = re.search(r"=+ graded score =+\n(.*?\ntotal[^\n]*)", p.stdout, re.S)
         assert m, p.stdout[-3000:]
         tables.append(m.group(1))

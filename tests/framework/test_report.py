@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from .course import run_geomlib
 
 
@@ -25,8 +27,15 @@ def test_stub_report_is_concise_and_quiet(sample_course):
     assert lines.count(lines[0]) == 1  # the score table is printed once
 
 
-def test_one_task_only(sample_course):
-    lines = _report(sample_course, "--impl", "labs", "--task", "1")
+@pytest.fixture(scope="module")
+def task_1_of_the_stubs(sample_course) -> list[str]:
+    """The report of ``geomlib grade --impl labs --lab sample --task 1``: what ``--task`` selects
+    (below) and what ``check("sample", task=1)`` must print (the notebook test), from one run."""
+    return _report(sample_course, "--impl", "labs", "--lab", "sample", "--task", "1")
+
+
+def test_one_task_only(sample_course, task_1_of_the_stubs):
+    lines = task_1_of_the_stubs
     text = "\n".join(lines)
     assert "Task 1" in text and "Task 2" not in text, text
     part = "\n".join(_report(sample_course, "--impl", "labs", "--part", "Midpoints"))
@@ -35,12 +44,12 @@ def test_one_task_only(sample_course):
     assert any("no graded test of task 99" in ln for ln in none), none
 
 
-def test_check_in_a_notebook_returns_the_cli_lines(sample_course, monkeypatch):
+def test_check_in_a_notebook_returns_the_cli_lines(sample_course, task_1_of_the_stubs, monkeypatch):
     """``check("sample", task=1)`` in a Jupyter kernel gives the lines ``geomlib grade --task 1`` prints."""
     import nbformat
     from nbclient import NotebookClient
 
-    cli = _report(sample_course, "--impl", "labs", "--lab", "sample", "--task", "1")
+    cli = task_1_of_the_stubs
     monkeypatch.setenv("GEOMLIB_ROOT", str(sample_course))
     monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")
     code = 'from geomlib.grading import check\nr = check("sample", task=1, impl="labs")\nprint(str(r))'
