@@ -44,9 +44,22 @@ def test_stubs_score_zero_without_a_single_error(sample_course):
     assert "Task 1 (scaling)" in _by_name(r)['sample › scaling › scale_about_centroid on "tet-scale"']["output"]
 
 
+#: Folders made by :func:`_submission`, removed after each test (:func:`_remove_submissions`).
+_MADE: list[Path] = []
+
+
+@pytest.fixture(autouse=True)
+def _remove_submissions():
+    yield
+    while _MADE:
+        shutil.rmtree(_MADE.pop(), ignore_errors=True)
+
+
 def _submission(tmp_path: Path, ops_source: str, extra_files: dict[str, str] | None = None) -> Path:
-    # A world-readable folder, so the sandbox may drop privileges to `nobody` and still read it.
+    # A world-readable folder, so the sandbox may drop privileges to `nobody` and still read it
+    # (pytest's tmp_path lies under a folder only its owner may enter); removed after the test.
     tmp_path = Path(tempfile.mkdtemp(prefix="geomlib-sub-"))
+    _MADE.append(tmp_path)
     tmp_path.chmod(0o755)
     sub = tmp_path / "submission" / "sample"
     sub.mkdir(parents=True)
@@ -172,6 +185,7 @@ def wrong_scale_plain_run(sample_course):
     """One plain ``pytest`` run (no xdist) of a submission whose scaling ignores the centroid: its
     message (test below) and its score table (compared with xdist's) come from the same run."""
     sub = _submission(None, GOOD_OPS.replace("return c + s * (V - c)", "return s * V"))
+    _MADE.remove(sub.parent)  # kept for the module's tests, removed below
     yield sub, _plain_pytest(sample_course, sub)
     shutil.rmtree(sub.parent, ignore_errors=True)
 
