@@ -156,6 +156,20 @@ def test_solutions_score_every_point(autograder, points):
     assert any(t["visibility"] == "hidden" for t in r["tests"])
 
 
+#: The picture cap this test sets through run_autograder's GEOMLIB_MAX_FEEDBACK_PICTURES (default 8).
+#: A picture costs about 1.5 s of CPU and this submission has more failures that can be drawn than 8
+#: (docs/autograder.md: 14), so the default drew 8 (12 s) where 2 show the same: the first failures
+#: get their picture inlined, the cap stops the drawing, and the file stays small.
+PICTURE_CAP = 2
+
+
+def test_run_autograder_caps_feedback_pictures_at_8_by_default(released):
+    """The cap's default (what Gradescope runs with); the cap at work is the test below."""
+    with zipfile.ZipFile(released / f"autograder-{LAB}.zip") as z:
+        script = z.read("run_autograder").decode()
+    assert 'export GEOMLIB_MAX_FEEDBACK_PICTURES="${GEOMLIB_MAX_FEEDBACK_PICTURES-8}"' in script
+
+
 def test_a_wrong_weight_gets_feedback_pictures_inlined_up_to_the_cap(autograder, points):
     """A wrong odd-vertex weight (Task 1): the failing tests name it, the first few carry their feedback
     picture inside results.json (Gradescope serves no files), and the cap keeps the file small."""
@@ -168,14 +182,16 @@ def test_a_wrong_weight_gets_feedback_pictures_inlined_up_to_the_cap(autograder,
         assert wrong != src, "the planted line is gone from the solution: update this test"
         (lab / "loop.py").write_text(wrong)
 
-    r, _ = _run(autograder, fill)
+    r, _ = _run(autograder, fill, GEOMLIB_MAX_FEEDBACK_PICTURES=str(PICTURE_CAP))
     failed = [t for t in r["tests"] if t["status"] == "failed"]
     assert failed and r["score"] < sum(p + h for p, h in points.values())
+    # More failures than the cap, so the cap is what stops the pictures.
+    assert len(failed) > PICTURE_CAP + 4, len(failed)
     pictured = [t for t in failed if t.get("output_format") == "html"]
-    assert 1 <= len(pictured) <= 8, len(pictured)  # run_autograder's GEOMLIB_MAX_FEEDBACK_PICTURES
+    assert 1 <= len(pictured) <= PICTURE_CAP, len(pictured)
     assert all("data:image/png;base64," in t["output"] for t in pictured)
     size = (autograder / "results" / "results.json").stat().st_size
-    assert size < 8 * 450_000, size
+    assert size < PICTURE_CAP * 450_000, size
 
 
 def test_stubs_score_zero(autograder):
