@@ -325,24 +325,30 @@ for key in clash:
     del index[key], points[key]
 (out / "index.json").write_text(json.dumps(index))
 print(sum(points.values()))
+# The points of the instructors' course's public reference cases: in this process, which has the
+# student bundle's cases loaded (load_cases leaves that course's `graded` package for this one's).
+import os
+os.environ["GEOMLIB_ROOT"] = sys.argv[3]
+print(sum(c.points for c in load_cases(sys.argv[2], hidden=False)))
 """
 )
 
 
-def _lookup_submission(student: Path, sub: Path) -> float:
+def _lookup_submission(student: Path, sub: Path) -> tuple[float, float]:
     """The stubs, each task's ``raise NotImplementedError`` replaced by a look-up of the public stored outputs.
 
     The task's signature and the course's given lines before it stay (the grader uses the course's
-    anyway); returns the points of the public cases the look-up can find again.
+    anyway); returns the points of the public cases the look-up can find again, and the points of
+    the public reference cases of this course (not of the bundle), from the same interpreter.
     """
     lab = sub / "labs" / LAB
     shutil.copytree(student / "labs" / LAB, lab)
     env = _env(GEOMLIB_ROOT=str(student), PYTHONPATH=str(student))
     p = subprocess.run(
-        [sys.executable, "-c", BUILD_LOOKUP, str(lab / "_answers"), LAB],
+        [sys.executable, "-c", BUILD_LOOKUP, str(lab / "_answers"), LAB, str(ROOT)],
         env=env, check=True, timeout=300, capture_output=True, text=True, cwd=student,
     )  # fmt: skip
-    findable = float(p.stdout.strip().splitlines()[-1])
+    findable, public_refs = (float(x) for x in p.stdout.strip().splitlines()[-2:])
     for f in lab.glob("*.py"):
         text = f.read_text()
         lines = text.splitlines()
@@ -361,22 +367,14 @@ def _lookup_submission(student: Path, sub: Path) -> float:
             call = " " * col + f"return _lookup({name!r}, [{', '.join(params)}])"
             lines[first - 1 : last] = [call]
         f.write_text("\n".join(lines) + "\n" + LOOKUP)
-    return findable
-
-
-def _public_reference_points() -> float:
-    """Points of the public reference cases (in a subprocess: this session may hold another course's `graded`)."""
-    code = (
-        f"from geomlib.grading.cases import load_cases; print(sum(c.points for c in load_cases({LAB!r}, hidden=False)))"
-    )
-    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True, check=True)
-    return float(p.stdout.strip())
+    return findable, public_refs
 
 
 def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
-    findable = {}
-    r, _ = _run(autograder, lambda sub: findable.setdefault("points", _lookup_submission(released / "student", sub)))
-    public_refs = _public_reference_points()
+    found = {}
+    r, _ = _run(autograder, lambda sub: found.setdefault("points", _lookup_submission(released / "student", sub)))
+    findable = {"points": found["points"][0]}
+    public_refs = found["points"][1]
     assert 0 < findable["points"] <= public_refs
     total = sum(p + h for p, h in points.values())
     missed = [
