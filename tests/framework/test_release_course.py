@@ -404,6 +404,7 @@ def test_a_failure_of_the_grader_is_reported_as_the_graders(autograder):
     )
     assert r["score"] == 0 and r["tests"] == []
     assert "autograder itself failed" in r["output"] and "not a problem with your submission" in r["output"]
+    assert "its Python environment does not start; run setup.sh" in r["output"], r["output"]
 
 
 def test_a_submission_without_the_lab_is_told_what_to_upload(autograder):
