@@ -105,23 +105,29 @@ grader_failed() {
 }
 
 cd "$SRC" 2>/dev/null || grader_failed "no source folder at $SRC"
-"$PY" -c 'import geomlib.grading.grade' >>"$LOG" 2>&1 || grader_failed "its Python environment does not start; run setup.sh"
+# Whether the grader's Python starts is asked once a step has failed, before its failure is reported:
+# a grade imports the same (about 1 s of CPU), so asking first cost every submission that second.
+python_starts() {
+  "$PY" -c 'import geomlib.grading.grade' >>"$LOG" 2>&1 || grader_failed "its Python environment does not start; run setup.sh"
+}
 if [ "$(id -u)" = 0 ] && [ -n "$GEOMLIB_SANDBOX_USER" ]; then
-  id "$GEOMLIB_SANDBOX_USER" >/dev/null 2>&1 || grader_failed "unknown sandbox user $GEOMLIB_SANDBOX_USER"
+  id "$GEOMLIB_SANDBOX_USER" >/dev/null 2>&1 || { python_starts; grader_failed "unknown sandbox user $GEOMLIB_SANDBOX_USER"; }
   (cd / && runuser -u "$GEOMLIB_SANDBOX_USER" -- "$PY" -c 'import numpy, geomlib.grading.worker') >>"$LOG" 2>&1 \
-    || grader_failed "the sandbox user $GEOMLIB_SANDBOX_USER cannot run the grader's Python; run setup.sh"
+    || { python_starts; grader_failed "the sandbox user $GEOMLIB_SANDBOX_USER cannot run the grader's Python; run setup.sh"; }
 fi
 
-WORK="$(mktemp -d "${TMPDIR:-/tmp}/geomlib-submission.XXXXXX")" || grader_failed "cannot create a work folder"
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/geomlib-submission.XXXXXX")" || { python_starts; grader_failed "cannot create a work folder"; }
 trap 'rm -rf "$WORK"' EXIT
 chmod 755 "$WORK"
 "$PY" -m geomlib.grading.submission "$SUB" "$LAB" "$WORK/labs" --results "$RESULTS" >>"$LOG" 2>&1
 status=$?
+[ "$status" = 0 ] || python_starts  # a submission without the lab (3), or the Python does not start
 if [ "$status" = 0 ]; then
   "$PY" -m geomlib.cli grade --impl "$WORK/labs" --lab "$LAB" --results "$RESULTS" --feedback "$OUT/feedback" >>"$LOG" 2>&1
   status=$?
 fi
 if [ ! -s "$RESULTS" ]; then
+  python_starts
   "$PY" - "$RESULTS" "$LOG" "$status" <<'PY' || grader_failed "it ended with status $status"
 import json, sys
 out = open(sys.argv[2], errors="replace").read()[-4000:]

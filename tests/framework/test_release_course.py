@@ -156,6 +156,20 @@ def test_solutions_score_every_point(autograder, points):
     assert any(t["visibility"] == "hidden" for t in r["tests"])
 
 
+#: The picture cap this test sets through run_autograder's GEOMLIB_MAX_FEEDBACK_PICTURES (default 8).
+#: A picture costs about 1.5 s of CPU and this submission has more failures that can be drawn than 8
+#: (docs/autograder.md: 14), so the default drew 8 (12 s) where 2 show the same: the first failures
+#: get their picture inlined, the cap stops the drawing, and the file stays small.
+PICTURE_CAP = 2
+
+
+def test_run_autograder_caps_feedback_pictures_at_8_by_default(released):
+    """The cap's default (what Gradescope runs with); the cap at work is the test below."""
+    with zipfile.ZipFile(released / f"autograder-{LAB}.zip") as z:
+        script = z.read("run_autograder").decode()
+    assert 'export GEOMLIB_MAX_FEEDBACK_PICTURES="${GEOMLIB_MAX_FEEDBACK_PICTURES-8}"' in script
+
+
 def test_a_wrong_weight_gets_feedback_pictures_inlined_up_to_the_cap(autograder, points):
     """A wrong odd-vertex weight (Task 1): the failing tests name it, the first few carry their feedback
     picture inside results.json (Gradescope serves no files), and the cap keeps the file small."""
@@ -168,14 +182,16 @@ def test_a_wrong_weight_gets_feedback_pictures_inlined_up_to_the_cap(autograder,
         assert wrong != src, "the planted line is gone from the solution: update this test"
         (lab / "loop.py").write_text(wrong)
 
-    r, _ = _run(autograder, fill)
+    r, _ = _run(autograder, fill, GEOMLIB_MAX_FEEDBACK_PICTURES=str(PICTURE_CAP))
     failed = [t for t in r["tests"] if t["status"] == "failed"]
     assert failed and r["score"] < sum(p + h for p, h in points.values())
+    # More failures than the cap, so the cap is what stops the pictures.
+    assert len(failed) > PICTURE_CAP + 4, len(failed)
     pictured = [t for t in failed if t.get("output_format") == "html"]
-    assert 1 <= len(pictured) <= 8, len(pictured)  # run_autograder's GEOMLIB_MAX_FEEDBACK_PICTURES
+    assert 1 <= len(pictured) <= PICTURE_CAP, len(pictured)
     assert all("data:image/png;base64," in t["output"] for t in pictured)
     size = (autograder / "results" / "results.json").stat().st_size
-    assert size < 8 * 450_000, size
+    assert size < PICTURE_CAP * 450_000, size
 
 
 def test_stubs_score_zero(autograder):
@@ -309,24 +325,30 @@ for key in clash:
     del index[key], points[key]
 (out / "index.json").write_text(json.dumps(index))
 print(sum(points.values()))
+# The points of the instructors' course's public reference cases: in this process, which has the
+# student bundle's cases loaded (load_cases leaves that course's `graded` package for this one's).
+import os
+os.environ["GEOMLIB_ROOT"] = sys.argv[3]
+print(sum(c.points for c in load_cases(sys.argv[2], hidden=False)))
 """
 )
 
 
-def _lookup_submission(student: Path, sub: Path) -> float:
+def _lookup_submission(student: Path, sub: Path) -> tuple[float, float]:
     """The stubs, each task's ``raise NotImplementedError`` replaced by a look-up of the public stored outputs.
 
     The task's signature and the course's given lines before it stay (the grader uses the course's
-    anyway); returns the points of the public cases the look-up can find again.
+    anyway); returns the points of the public cases the look-up can find again, and the points of
+    the public reference cases of this course (not of the bundle), from the same interpreter.
     """
     lab = sub / "labs" / LAB
     shutil.copytree(student / "labs" / LAB, lab)
     env = _env(GEOMLIB_ROOT=str(student), PYTHONPATH=str(student))
     p = subprocess.run(
-        [sys.executable, "-c", BUILD_LOOKUP, str(lab / "_answers"), LAB],
+        [sys.executable, "-c", BUILD_LOOKUP, str(lab / "_answers"), LAB, str(ROOT)],
         env=env, check=True, timeout=300, capture_output=True, text=True, cwd=student,
     )  # fmt: skip
-    findable = float(p.stdout.strip().splitlines()[-1])
+    findable, public_refs = (float(x) for x in p.stdout.strip().splitlines()[-2:])
     for f in lab.glob("*.py"):
         text = f.read_text()
         lines = text.splitlines()
@@ -345,22 +367,14 @@ def _lookup_submission(student: Path, sub: Path) -> float:
             call = " " * col + f"return _lookup({name!r}, [{', '.join(params)}])"
             lines[first - 1 : last] = [call]
         f.write_text("\n".join(lines) + "\n" + LOOKUP)
-    return findable
-
-
-def _public_reference_points() -> float:
-    """Points of the public reference cases (in a subprocess: this session may hold another course's `graded`)."""
-    code = (
-        f"from geomlib.grading.cases import load_cases; print(sum(c.points for c in load_cases({LAB!r}, hidden=False)))"
-    )
-    p = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(), capture_output=True, text=True, check=True)
-    return float(p.stdout.strip())
+    return findable, public_refs
 
 
 def test_a_lookup_of_the_public_outputs_scores_below_half(autograder, released, points):
-    findable = {}
-    r, _ = _run(autograder, lambda sub: findable.setdefault("points", _lookup_submission(released / "student", sub)))
-    public_refs = _public_reference_points()
+    found = {}
+    r, _ = _run(autograder, lambda sub: found.setdefault("points", _lookup_submission(released / "student", sub)))
+    findable = {"points": found["points"][0]}
+    public_refs = found["points"][1]
     assert 0 < findable["points"] <= public_refs
     total = sum(p + h for p, h in points.values())
     missed = [
@@ -390,6 +404,7 @@ def test_a_failure_of_the_grader_is_reported_as_the_graders(autograder):
     )
     assert r["score"] == 0 and r["tests"] == []
     assert "autograder itself failed" in r["output"] and "not a problem with your submission" in r["output"]
+    assert "its Python environment does not start; run setup.sh" in r["output"], r["output"]
 
 
 def test_a_submission_without_the_lab_is_told_what_to_upload(autograder):
