@@ -51,6 +51,7 @@ import socket
 import struct
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from geomlib.grading import blacklist, kernelcache, landlock, seccomp
@@ -682,7 +683,16 @@ def _kernel_main(sock: socket.socket, req: dict, parent: int) -> None:
 def _refresh_kernels() -> bool:
     """In a kernel zygote, before each fork: import the lab's modules that became importable (a call
     imported a library they use) and load what was compiled for its kernels since it last looked.
-    False when a thread is running (then no worker may be forked from here)."""
+    False when a thread is running (then no worker may be forked from here), or when that issued a
+    warning (a ``SyntaxWarning`` of a lab file, say): a worker would have printed it, in the call's
+    output; then the zygote serves the snapshot itself."""
+    with warnings.catch_warnings(record=True) as issued:
+        _load_lab()
+    return _threads() == 1 and not issued
+
+
+def _load_lab() -> None:
+    """:func:`_refresh_kernels`' imports and loads."""
     st = _KERNEL_STATE
     if st and st["modules"] != len(sys.modules):
         req = st["req"]
@@ -699,7 +709,6 @@ def _refresh_kernels() -> bool:
         st["modules"] = len(sys.modules)
     if st:
         kernelcache.load_cached(st["kernels"], st["seen"])
-    return _threads() == 1
 
 
 def main() -> None:
