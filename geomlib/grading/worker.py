@@ -17,9 +17,10 @@ module of the lab is assembled from the stub and the submission (:func:`merge_mo
 - names the submission adds (its own helpers, imports) and its other top-level statements are
   kept; files the stub does not have are the submission's own.
 
-Longer than most modules (about 670 lines) on purpose: the parsed stubs and their compiled given
+Longer than most modules (about 790 lines) on purpose: the parsed stubs and their compiled given
 statements (``_TREES``, ``_STUB_CODE``), filled in the zygote before it forks, are read by the merge,
-by the OpenGL preload decision and by the function lookup; one module owns those caches, so no
+by the OpenGL preload decision, by the function lookup and by a kernel zygote's import of trusted
+code (:func:`preload_lab`); one module owns those caches, so no
 other module reaches into another's private state.
 """
 

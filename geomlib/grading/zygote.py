@@ -35,6 +35,10 @@ no machine code of it in their JIT. One kernel zygote at a time, for the last tr
 it starts no thread (parallel kernels are left to the workers) and imports only modules that define
 things and use no library the zygote has not loaded (:func:`worker.preload_lab`), so what a call
 prints or raises is the same.
+
+Longer than most modules (about 720 lines) on purpose: the zygote and the kernel zygotes run the
+same loop (fork, wait, kill what is left) and relay the same framed messages; split, the relay
+would need the loop's private state.
 """
 
 from __future__ import annotations
