@@ -40,6 +40,14 @@ grading user's cache). Without either protection student code can write whatever
 can (its own ``~/.cache`` included): ``sandbox.status()`` says so, grade others' code as root or
 under Landlock.
 
+Loaded once per grading process (:func:`kernels_in`, :func:`load_cached`): a worker that loads its
+kernels from the cache itself spends 0.03-0.1 s of CPU per call on it (reading numba's index,
+unpickling, linking the machine code) and on importing the lab; the grading process makes dozens
+of calls per lab. For the same trusted snapshots, the zygote forks a *kernel zygote*
+(:mod:`geomlib.grading.zygote`) that imports the lab and loads every kernel compiled for it from
+the workers' private cache folder (only the grader and that snapshot's own workers can write it,
+as for :func:`publish`) once, then forks that snapshot's workers: they start with the kernels loaded.
+
 Where: ``GEOMLIB_KERNEL_CACHE``, else ``$XDG_CACHE_HOME/geomlib-kernels``, else
 ``~/.cache/geomlib-kernels`` (:func:`geomlib.grading.settings.kernel_cache_dir`); ``off`` turns
 it off. Entries unused for :data:`MAX_AGE_S` are removed when a new one is made.
@@ -63,7 +71,7 @@ from pathlib import Path
 
 from geomlib.jit import is_private_folder
 
-__all__ = ["Entry", "open_entry", "seed", "publish", "remove_tree", "MAX_AGE_S"]
+__all__ = ["Entry", "open_entry", "seed", "publish", "remove_tree", "kernels_in", "load_cached", "MAX_AGE_S"]
 
 #: Entries not used for this long are removed when a new entry is made (none is ever in use that long).
 MAX_AGE_S = 14 * 24 * 3600
@@ -267,3 +275,113 @@ def publish(entry: Entry, private: Path, record: dict) -> int:
                 continue
             done += 1
     return done
+
+
+# ------------------------------------------------------------------ loading into a kernel zygote
+
+
+class _NotCached(Exception):
+    """Raised instead of compiling, or of starting numba's threads, while :func:`load_cached` loads."""
+
+
+class _LoadOnly:
+    """Stands in for a dispatcher's compiler while :func:`load_cached` loads: a signature whose data
+    file went missing is left to the worker instead of compiled in the kernel zygote."""
+
+    def compile(self, *args, **kwargs):
+        raise _NotCached
+
+
+def _names_used_by_python(modules) -> set[str]:
+    """The global and attribute names that the plain Python functions (and methods) of ``modules`` use."""
+    import types
+
+    names: set[str] = set()
+    todo = []
+    for module in modules:
+        for value in list(vars(module).values()):
+            if getattr(value, "__module__", None) != module.__name__:
+                continue
+            if isinstance(value, type):
+                todo += [f.__code__ for f in vars(value).values() if isinstance(f, types.FunctionType)]
+            elif isinstance(value, types.FunctionType):
+                todo.append(value.__code__)
+    while todo:
+        code = todo.pop()
+        names.update(code.co_names)
+        todo += [c for c in code.co_consts if isinstance(c, types.CodeType)]
+    return names
+
+
+def kernels_in(modules) -> list:
+    """The numba kernels of ``modules`` that Python code calls (a kernel called only by kernels is
+    compiled into them: loading it would be wasted) and that load from numba's disk cache
+    (``cache=True``), but not the ``parallel=True`` ones: loading one starts numba's threads, which a
+    process that forks must not have (a thread's locks stay taken in the child)."""
+    if "numba" not in sys.modules:
+        return []
+    from numba.core.dispatcher import Dispatcher
+
+    used = _names_used_by_python(modules)
+    out, seen = [], set()
+    for module in modules:
+        for name, value in list(vars(module).items()):
+            if (
+                isinstance(value, Dispatcher)
+                and name in used
+                and id(value) not in seen
+                and not value.targetoptions.get("parallel")
+                and getattr(value._cache, "_cache_file", None) is not None
+            ):
+                seen.add(id(value))
+                out.append(value)
+    return out
+
+
+@contextlib.contextmanager
+def _no_threads():
+    """numba starts its threading layer when it loads a kernel with parallel loops (``reload_init``),
+    before loading it: refuse instead (a kernel that calls a parallel one has the same ``reload_init``)."""
+    from numba.np.ufunc import parallel
+
+    def refuse():
+        raise _NotCached
+
+    real, parallel._launch_threads = parallel._launch_threads, refuse
+    try:
+        yield
+    finally:
+        parallel._launch_threads = real
+
+
+def load_cached(kernels: list, seen: dict) -> int:
+    """Load into each of ``kernels`` every signature numba's cache holds for it, for this CPU and this
+    bytecode; nothing is compiled and no thread is started. ``seen``: index file -> its stat when last
+    read, updated (an index not changed since is not read again). Returns the number loaded."""
+    n = 0
+    with _no_threads():
+        for disp in kernels:
+            cache = disp._cache
+            index = Path(cache._cache_file._index_path)
+            stamp = _stat_key(index)
+            if stamp is None or seen.get(index) == stamp:
+                continue
+            seen[index] = stamp
+            try:
+                keys = list(cache._cache_file._load_index())
+            except Exception:  # noqa: BLE001 - an unreadable index: the worker reads it itself
+                continue
+            codegen = disp.targetctx.codegen()
+            for key in keys:
+                sig = key[0]
+                if tuple(sig) in disp.overloads or cache._index_key(sig, codegen) != key:
+                    continue  # loaded already, or compiled for another CPU or other bytecode
+                compiler, disp._compiler = disp._compiler, _LoadOnly()
+                try:
+                    disp.compile(sig)
+                    n += 1
+                except Exception:  # noqa: BLE001 - _NotCached, or a broken entry: the worker's business
+                    pass
+                finally:
+                    disp._compiler = compiler
+    return n

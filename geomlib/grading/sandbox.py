@@ -487,6 +487,11 @@ class _Zygote:
         except OSError:
             pass  # the next process compiles what was not kept
 
+    def shares_kernels(self, lab_dir: Path) -> bool:
+        """Whether the current snapshot of ``lab_dir`` is trusted code's persistent one (:meth:`snapshot`)."""
+        snap = self.snapshots.get(str(Path(lab_dir).resolve()))
+        return snap is not None and snap.shared is not None
+
     def _jit_folder(self) -> Path:
         """A new numba cache folder that the workers (the sandbox user) can write."""
         folder = Path(tempfile.mkdtemp(prefix="jit-", dir=self.jit_cache))
@@ -795,6 +800,8 @@ def call(
             "read": [str(snap)] + ([str(stubs)] if stubs else []),
             "not_allowed": _not_allowed(lab),
             "jit_cache": str(jit),
+            # the course's own code in its persistent snapshot: served by a kernel zygote (zygote.py)
+            "trusted_kernels": z.shares_kernels(lab_dir),
         }
     )
     reply = z.run(req, blob, timeout, max_bytes)

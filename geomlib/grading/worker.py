@@ -17,10 +17,11 @@ module of the lab is assembled from the stub and the submission (:func:`merge_mo
 - names the submission adds (its own helpers, imports) and its other top-level statements are
   kept; files the stub does not have are the submission's own.
 
-Longer than most modules (about 790 lines) on purpose: the parsed stubs and their compiled given
+Longer than most modules (about 890 lines) on purpose: the parsed stubs and their compiled given
 statements (``_TREES``, ``_STUB_CODE``) and the submission's modules merged ahead (``_MERGED``, used
 only for the bytes the zygote merged), filled in the zygote before it forks, are read by the merge,
-by the OpenGL preload decision and by the function lookup; one module owns those caches, so no
+by the OpenGL preload decision, by the function lookup and by a kernel zygote's import of trusted
+code (:func:`preload_lab`); one module owns those caches, so no
 other module reaches into another's private state.
 """
 
@@ -591,6 +592,105 @@ def _student_defines(path: Path, name: str) -> bool:
         return re.search(rf"^\s*(async\s+)?def\s+{re.escape(name)}\b", text, re.M) is not None
 
 
+def _lab_package(lab_dir: Path, lab: str, stubs_dir: Path | None) -> str:
+    """Make ``_graded_<lab>`` the package of ``lab_dir`` (merged with ``stubs_dir``) and return its name.
+
+    Kept when it is already that folder's: the modules a kernel zygote imported for a trusted
+    snapshot (:func:`preload_lab`) are the ones its workers find. Any other ``_graded_<lab>``
+    module is dropped first (none in a worker of the plain zygote, which imports no lab)."""
+    name, origin = f"_graded_{lab}", (str(lab_dir), str(stubs_dir))
+    if getattr(sys.modules.get(name), "__graded_origin__", None) == origin:
+        return name
+    for key in [k for k in sys.modules if k == name or k.startswith(name + ".")]:
+        del sys.modules[key]
+    pkg = types.ModuleType(name)
+    pkg.__path__ = [str(lab_dir)]
+    pkg.__package__ = name
+    pkg.__graded_origin__ = origin
+    sys.modules[name] = pkg
+    sys.meta_path.insert(0, _LabFinder(name, lab_dir, stubs_dir))
+    return name
+
+
+#: Calls a module may make at its top level, in an assignment, to be imported by a kernel zygote:
+#: NumPy's and math's (the course's constant tables, ``TETRA = np.array(...)``).
+_PRELOAD_CALLS = ("np", "numpy", "math")
+
+
+def _plain_top_level(tree: ast.Module) -> bool:
+    """Whether a module's top level only defines things: imports, functions, classes, docstrings,
+    assignments whose calls are NumPy's or math's, ``use_cache_folder(__name__, __file__)`` and an
+    ``if __name__ == "__main__":`` block. A module that does more (prints, runs a test of its
+    own) is imported by each worker, as any submission's, so what it prints or raises is the call's."""
+    for node in tree.body:
+        if isinstance(node, ast.Import | ast.ImportFrom | ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            continue
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant):
+            continue
+        if isinstance(node, ast.Expr) and ast.unparse(node) == "use_cache_folder(__name__, __file__)":
+            continue
+        if isinstance(node, ast.If) and ast.unparse(node.test) in ("__name__ == '__main__'", '__name__ == "__main__"'):
+            continue
+        if isinstance(node, ast.Assign | ast.AnnAssign | ast.AugAssign):
+            calls = [n.func for n in ast.walk(node) if isinstance(n, ast.Call)]
+            if all(
+                isinstance(f, ast.Attribute)
+                and isinstance(f.value, ast.Name | ast.Attribute)
+                and ast.unparse(f.value).split(".")[0] in _PRELOAD_CALLS
+                for f in calls
+            ):
+                continue
+        return False
+    return True
+
+
+def _preload_deps(tree: ast.Module) -> set[str] | None:
+    """The lab modules a module imports at its top level (relative imports), or None when a kernel
+    zygote may not import it: its top level does more than define things (:func:`_plain_top_level`)
+    or imports a library this process has not loaded (figures' matplotlib, say)."""
+    if not _plain_top_level(tree):
+        return None
+    deps = set()
+    for node in tree.body:
+        if isinstance(node, ast.ImportFrom) and node.level:
+            deps |= {node.module.split(".")[0]} if node.module else {a.name for a in node.names}
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
+            if any(n not in sys.modules and n.split(".")[0] not in sys.stdlib_module_names for n in names):
+                return None
+    return deps
+
+
+def preload_lab(lab_dir: Path, lab: str, stubs_dir: Path | None) -> list[types.ModuleType]:
+    """Import the modules of a **trusted** lab snapshot (the course's own code, see
+    :mod:`geomlib.grading.kernelcache`) that a kernel zygote keeps for its workers: those whose stub
+    and own file pass :func:`_preload_deps`, with the lab modules they import. Never called for a
+    submission. Returns the modules imported (one that fails is left to the workers)."""
+    stems = {p.stem for p in lab_dir.glob("*.py")} | ({p.stem for p in stubs_dir.glob("*.py")} if stubs_dir else set())
+    stems.discard("__init__")
+    deps: dict[str, set[str]] = {}
+    for stem in sorted(stems):
+        found = [(stubs_dir / f"{stem}.py", False)] if stubs_dir else []
+        found = [(f, student) for f, student in [*found, (lab_dir / f"{stem}.py", True)] if _is_plain_file(f)]
+        try:
+            mine = [_preload_deps(_parsed(f, student=student)) for f, student in found]
+        except SyntaxError:
+            continue
+        if None not in mine:
+            deps[stem] = set().union(*mine)
+    ok = set(deps)
+    while (keep := {s for s in ok if deps[s] <= ok}) != ok:
+        ok = keep
+    pkg = _lab_package(lab_dir, lab, stubs_dir)
+    modules = []
+    for stem in sorted(ok):
+        try:
+            modules.append(importlib.import_module(f"{pkg}.{stem}"))
+        except Exception:  # noqa: BLE001 - each worker imports it itself and reports what fails
+            pass
+    return modules
+
+
 def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None = None):
     """Import the module of the lab that defines ``function`` and return the function.
 
@@ -598,12 +698,7 @@ def find_function(lab_dir: Path, lab: str, function: str, stubs_dir: Path | None
     says. The lab's ``__init__.py`` is not executed (it usually imports every module, which would
     let a syntax error in one file break them all); it is searched last.
     """
-    pkg_name = f"_graded_{lab}"
-    pkg = types.ModuleType(pkg_name)
-    pkg.__path__ = [str(lab_dir)]
-    pkg.__package__ = pkg_name
-    sys.modules[pkg_name] = pkg
-    sys.meta_path.insert(0, _LabFinder(pkg_name, lab_dir, stubs_dir))
+    pkg_name = _lab_package(lab_dir, lab, stubs_dir)
     broken = []
     stub_files = sorted(p for p in stubs_dir.glob("*.py") if p.name != "__init__.py") if stubs_dir else []
     stub_stems = {p.stem for p in stub_files}

@@ -23,10 +23,27 @@ For each request the zygote forks a worker that
 The zygote is a child subreaper: anything the student's code started and detached is re-parented
 to it, and after each call it kills and reaps every remaining descendant before it tells the grader
 the call is over.
+
+Kernel zygotes. The course's own code (``solutions/<lab>``, ``labs/<lab>``: the snapshots that
+:mod:`geomlib.grading.kernelcache` trusts, graded with workers running as the grading user) of a
+numba lab is served by a fork of the zygote that has imported the lab's modules and loaded their
+compiled kernels once (:func:`_kernel_main`); it forks that snapshot's workers as the zygote does,
+which then start with the kernels loaded instead of loading them from disk at every call (0.03-0.1 s
+of CPU each). The zygote itself never imports a lab, so the workers of any other code (a
+submission, another snapshot) start as before: nothing of the course's solution in their memory,
+no machine code of it in their JIT. One kernel zygote at a time, for the last trusted snapshot;
+it starts no thread (parallel kernels are left to the workers) and imports only modules that define
+things and use no library the zygote has not loaded (:func:`worker.preload_lab`), so what a call
+prints or raises is the same.
+
+Longer than most modules (about 720 lines) on purpose: the zygote and the kernel zygotes run the
+same loop (fork, wait, kill what is left) and relay the same framed messages; split, the relay
+would need the loop's private state.
 """
 
 from __future__ import annotations
 
+import ast
 import ctypes
 import importlib
 import json
@@ -38,9 +55,10 @@ import socket
 import struct
 import sys
 import time
+import warnings
 from pathlib import Path
 
-from geomlib.grading import blacklist, landlock, seccomp
+from geomlib.grading import blacklist, kernelcache, landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -144,11 +162,12 @@ def _children() -> list[int]:
     return kids
 
 
-def kill_descendants() -> int:
-    """SIGKILL and reap every descendant (orphans come back to us as subreaper); returns how many."""
+def kill_descendants(keep: tuple[int, ...] = ()) -> int:
+    """SIGKILL and reap every descendant (orphans come back to us as subreaper) but the children
+    ``keep`` (the kernel zygote); returns how many."""
     killed = 0
     for _ in range(1000):
-        kids = _children()
+        kids = [pid for pid in _children() if pid not in keep]
         if not kids:
             break
         for pid in kids:
@@ -424,6 +443,13 @@ def serve(sock: socket.socket) -> None:
             "notes": platform_notes(),
         },
     )
+    _loop(sock, kernel_zygotes=True)
+    kill_descendants()
+
+
+def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
+    """Serve the calls that come on ``sock`` until it closes: the zygote's, and a kernel zygote's
+    (``kernel_zygotes=False``: it relays nothing)."""
     while True:
         try:
             req, blob, fds = recv_msg(sock, with_fds=True)
@@ -433,22 +459,11 @@ def serve(sock: socket.socket) -> None:
             for fd in fds:
                 os.close(fd)
             break
+        if kernel_zygotes and _relayed(sock, req, blob, fds):
+            continue
         result_fd, out_fd = fds
         t0 = time.monotonic()
-        try:
-            _worker.prepare_stubs(req.get("stubs_dir"))  # the course's stubs, parsed once for every worker
-        except Exception:  # noqa: BLE001 - the worker parses them itself
-            pass
-        try:
-            if req.get("op") == "call":  # the submission's modules merged and compiled once per snapshot
-                _worker.prepare_merged(req.get("stubs_dir"), req.get("lab_dir"))
-        except Exception:  # noqa: BLE001 - each worker merges them itself
-            pass
-        try:
-            if req.get("op") == "call":
-                _preload_for(req.get("stubs_dir"), req.get("function"))  # numba, scipy.fft: for the calls that use them
-        except Exception:  # noqa: BLE001 - the workers import them themselves
-            pass
+        _prepare(req)
         try:
             # PyOpenGL, once, for a lab with shaders, at its first call that may use them
             _worker.prepare_gl(req.get("stubs_dir"), req.get("lab_dir"), function=req.get("function"))
@@ -458,6 +473,11 @@ def serve(sock: socket.socket) -> None:
             blacklist.prepare(req.get("not_allowed"))  # where the lab's forbidden functions are referenced
         except Exception:  # noqa: BLE001 - each worker searches every module itself
             pass
+        if not kernel_zygotes and (_threads() != 1 or not _refresh_kernels()):
+            os.close(result_fd)  # a thread would not survive the fork: the zygote serves the call itself
+            os.close(out_fd)
+            send_msg(sock, {"refused": True})
+            continue
         pid = os.fork()
         if pid == 0:
             sock.close()
@@ -471,9 +491,234 @@ def serve(sock: socket.socket) -> None:
             os.killpg(pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
-        leftovers = kill_descendants()
+        leftovers = kill_descendants(keep=tuple(k.pid for k in _KERNELS.values()))
         send_msg(sock, {"done": True, "status": status, "leftovers": leftovers, "seconds": time.monotonic() - t0})
-    kill_descendants()
+
+
+def _prepare(req: dict) -> None:
+    """What the zygote does for a call before it forks: parse the course's stubs, merge and compile
+    the submission's modules with them, import numba and the other modules the call may use (and
+    build numba's contexts)."""
+    try:
+        _worker.prepare_stubs(req.get("stubs_dir"))  # the course's stubs, parsed once for every worker
+    except Exception:  # noqa: BLE001 - the worker parses them itself
+        pass
+    try:
+        if req.get("op") == "call":  # the submission's modules merged and compiled once per snapshot
+            _worker.prepare_merged(req.get("stubs_dir"), req.get("lab_dir"))
+    except Exception:  # noqa: BLE001 - each worker merges them itself
+        pass
+    try:
+        if req.get("op") == "call":
+            _preload_for(req.get("stubs_dir"), req.get("function"))  # numba, scipy.fft: for the calls that use them
+    except Exception:  # noqa: BLE001 - the workers import them themselves
+        pass
+
+
+# ---------------------------------------------------------------------------------- kernel zygotes
+
+
+def _threads() -> int:
+    """This process's threads (1 where /proc cannot say: Linux is the only system with kernel zygotes)."""
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return 1
+
+
+class _KernelZygote:
+    """The zygote's side of a kernel zygote: its pid, the socket to it and the snapshot it serves."""
+
+    def __init__(self, key: tuple, pid: int, sock: socket.socket):
+        self.key, self.pid, self.sock = key, pid, sock
+
+    def close(self) -> None:
+        self.sock.close()
+        try:
+            os.kill(self.pid, signal.SIGKILL)
+            os.waitpid(self.pid, 0)
+        except (ProcessLookupError, ChildProcessError):
+            pass
+
+
+#: The kernel zygotes of the last trusted snapshots called, most recent last (at most
+#: :data:`KERNEL_ZYGOTES`: a process that grades the solutions and the stubs of a lab in turn keeps
+#: both); the snapshots that may have one (True) and those that cannot (False: no numba, or it failed).
+_KERNELS: dict[tuple, _KernelZygote] = {}
+KERNEL_ZYGOTES = 2
+_KERNEL_USE: dict = {}
+#: How long the zygote waits for a kernel zygote (to import its lab, to fork a worker) before it
+#: kills it and serves the snapshot itself (the grader waits 60 s for a worker's pid).
+KERNEL_ZYGOTE_WAIT_S = 20.0
+
+
+def _uses_numba(folder: str) -> bool:
+    """Whether a module of the lab folder imports numba (or :mod:`geomlib.jit`) at its top level."""
+    try:
+        for path in sorted(Path(folder).glob("*.py")):
+            for node in ast.parse(path.read_bytes()).body:
+                if isinstance(node, ast.Import | ast.ImportFrom) and not getattr(node, "level", 0):
+                    names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
+                    if any(n.split(".")[0] == "numba" or n == "geomlib.jit" for n in names):
+                        return True
+    except (OSError, SyntaxError, ValueError):
+        pass
+    return False
+
+
+def _kernel_key(req: dict) -> tuple | None:
+    """The snapshot a kernel zygote would serve this call of, or None: only calls the grader marks
+    ``trusted_kernels`` (the course's own code, :mod:`geomlib.grading.kernelcache`) of a lab that
+    uses numba, with the JIT on, on Linux. A trusted snapshot's folder is named by its content."""
+    if req.get("op") != "call" or not req.get("trusted_kernels") or not req.get("jit_cache") or sys.platform != "linux":
+        return None
+    key = (req["lab"], req["lab_dir"], req.get("stubs_dir"), req["jit_cache"])
+    if key not in _KERNEL_USE:
+        _KERNEL_USE[key] = _uses_numba(req.get("stubs_dir") or req["lab_dir"])
+    if not _KERNEL_USE[key]:
+        return None
+    # Not before something was compiled for it (in an earlier run, or by an earlier call): a kernel
+    # zygote with nothing to load costs its start (simplification's graded calls use no kernel).
+    return key if key in _KERNELS or any(Path(req["jit_cache"]).rglob("*.nbi")) else None
+
+
+def _drop_kernel_zygote(key: tuple, *, for_good: bool) -> None:
+    """Kill the kernel zygote of ``key`` and any worker it left (they come back to the zygote); with
+    ``for_good``, that snapshot's calls are served by the zygote from now on."""
+    k = _KERNELS.pop(key, None)
+    if k is not None:
+        k.close()
+        kill_descendants(keep=tuple(k.pid for k in _KERNELS.values()))
+    if for_good:
+        _KERNEL_USE[key] = False
+
+
+def _relayed(sock: socket.socket, req: dict, blob: bytes, fds: list[int]) -> bool:
+    """Have the kernel zygote of the call's trusted snapshot serve it (started when there is none):
+    True when it did (the grader got its replies), False when the zygote must serve the call itself."""
+    key = _kernel_key(req)
+    if key is None:
+        return False
+    if key not in _KERNELS:
+        for old in list(_KERNELS)[: max(0, len(_KERNELS) - KERNEL_ZYGOTES + 1)]:
+            _drop_kernel_zygote(old, for_good=False)
+        _prepare(req)
+        if "numba" not in sys.modules:  # built here once, for every later kernel zygote
+            importlib.import_module("numba")
+            _warm_numba()
+        import numba
+
+        if numba.config.DISABLE_JIT or _threads() != 1:
+            _KERNEL_USE[key] = False
+            return False
+        k = _start_kernel_zygote(key, req, sock)
+        if k is None:
+            _KERNEL_USE[key] = False
+            return False
+        _KERNELS[key] = k
+    k = _KERNELS[key] = _KERNELS.pop(key)  # the most recent last
+    try:
+        k.sock.settimeout(KERNEL_ZYGOTE_WAIT_S)
+        send_msg(k.sock, req, blob, fds=fds)
+        head, _, _ = recv_msg(k.sock)
+        k.sock.settimeout(None)
+    except (OSError, EOFError, ValueError):
+        head = {}
+    if "pid" not in head:  # it refused (a thread), hung or died: the zygote serves this snapshot from now on
+        _drop_kernel_zygote(key, for_good=True)
+        return False
+    for fd in fds:
+        os.close(fd)
+    send_msg(sock, head)
+    try:
+        done, _, _ = recv_msg(k.sock)
+    except (OSError, EOFError, ValueError):  # it died during the call: its worker came back to us
+        _drop_kernel_zygote(key, for_good=True)
+        done = {"done": True, "status": 0, "leftovers": 0, "seconds": 0.0}
+    send_msg(sock, done)
+    return True
+
+
+def _start_kernel_zygote(key: tuple, req: dict, grader: socket.socket) -> _KernelZygote | None:
+    """Fork a kernel zygote for ``req``'s snapshot and wait until it is ready; None when it is not."""
+    ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+    parent = os.getpid()
+    pid = os.fork()
+    if pid == 0:
+        try:
+            ours.close()
+            grader.close()
+            for other in _KERNELS.values():  # its siblings are the zygote's
+                other.sock.close()
+            _KERNELS.clear()
+            _kernel_main(theirs, req, parent)
+        finally:
+            os._exit(0)
+    theirs.close()
+    k = _KernelZygote(key, pid, ours)
+    ours.settimeout(KERNEL_ZYGOTE_WAIT_S)
+    try:
+        ready, _, _ = recv_msg(ours)
+    except (OSError, EOFError, ValueError):
+        ready = {}
+    if not ready.get("ready"):
+        k.close()
+        return None
+    return k
+
+
+#: A kernel zygote's snapshot (``req``), its modules' number, kernels and the index files it read.
+_KERNEL_STATE: dict = {}
+
+
+def _kernel_main(sock: socket.socket, req: dict, parent: int) -> None:
+    """A kernel zygote: import the trusted snapshot's modules, load their compiled kernels, serve."""
+    _prctl(_PR_SET_CHILD_SUBREAPER, 1)  # its workers' orphans come back to it
+    _prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM))
+    if os.getppid() != parent:
+        return
+    os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # the workers' own folder: the decorators read it
+    try:
+        importlib.import_module("geomlib.jit")
+        _KERNEL_STATE.update(req=req, modules=-1, kernels=[], seen={})
+        ready = _refresh_kernels()
+    except Exception:  # noqa: BLE001 - then it is not ready, and the zygote serves the calls
+        ready = False
+    send_msg(sock, {"ready": ready})
+    if ready:
+        _loop(sock, kernel_zygotes=False)
+        kill_descendants()
+
+
+def _refresh_kernels() -> bool:
+    """In a kernel zygote, before each fork: import the lab's modules that became importable (a call
+    imported a library they use) and load what was compiled for its kernels since it last looked.
+    False when a thread is running (then no worker may be forked from here), or when that issued a
+    warning (a ``SyntaxWarning`` of a lab file, say): a worker would have printed it, in the call's
+    output; then the zygote serves the snapshot itself."""
+    with warnings.catch_warnings(record=True) as issued:
+        _load_lab()
+    return _threads() == 1 and not issued
+
+
+def _load_lab() -> None:
+    """:func:`_refresh_kernels`' imports and loads."""
+    st = _KERNEL_STATE
+    if st and st["modules"] != len(sys.modules):
+        req = st["req"]
+        stubs = req.get("stubs_dir")
+        # the call's memory limit, as a worker's (soft: the workers set their own), while it imports
+        old = resource.getrlimit(resource.RLIMIT_AS)
+        if req.get("memory_mb"):
+            _set_limit("AS", _worker.vm_size_bytes() + int(req["memory_mb"]) * 2**20, old[1])
+        try:
+            modules = _worker.preload_lab(Path(req["lab_dir"]), req["lab"], Path(stubs) if stubs else None)
+        finally:
+            _set_limit("AS", *old)
+        st["kernels"] = kernelcache.kernels_in(modules)
+        st["modules"] = len(sys.modules)
+    if st:
+        kernelcache.load_cached(st["kernels"], st["seen"])
 
 
 def main() -> None:
