@@ -199,21 +199,25 @@ _SKIP_DIRS = ("__pycache__", ".git", ".ipynb_checkpoints")
 
 
 def _lab_files(lab_dir: Path):
-    """``(relative path, os.lstat)`` of the plain files a snapshot of ``lab_dir`` holds, in a fixed order."""
+    """``(relative path, full path, os.lstat)`` of what a snapshot of ``lab_dir`` holds, in a fixed
+    order: each folder (``st`` None; the top one is ``"."``) then its plain files. Walked on strings
+    (``Path`` objects cost the grader 5 ms per call: the digest is asked twice per call)."""
+    top = str(lab_dir)
     total = 0
-    for dirpath, dirnames, filenames in os.walk(lab_dir, followlinks=False):
+    for dirpath, dirnames, filenames in os.walk(top, followlinks=False):
         dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS)
-        rel = Path(dirpath).relative_to(lab_dir)
-        yield rel, None  # the folder itself (an empty folder is part of the snapshot too)
+        rel = dirpath[len(top) + 1 :] if dirpath != top else "."
+        yield rel, dirpath, None  # the folder itself (an empty folder is part of the snapshot too)
         for name in sorted(filenames):
+            full = os.path.join(dirpath, name)
             try:
-                st = os.lstat(Path(dirpath) / name)
+                st = os.lstat(full)
             except OSError:
                 continue
             if not stat.S_ISREG(st.st_mode) or st.st_size > _FILE_LIMIT or total > _TOTAL_LIMIT:
                 continue
             total += st.st_size
-            yield rel / name, st
+            yield (name if rel == "." else f"{rel}/{name}"), full, st
 
 
 def _read_plain(path: Path) -> bytes:
@@ -245,50 +249,32 @@ def _file_digest(path: str, st: os.stat_result) -> str:
 
 
 def _folder_digest(lab_dir: Path) -> str:
-    """What a snapshot of ``lab_dir`` would hold (names and bytes), as one sha256.
-
-    Asked twice per call (the lab and its stubs): the walk of :func:`_lab_files` done on strings
-    (``Path`` objects made it 5 ms of the grader's CPU per call, 0.6 s of a whole shadows run)."""
+    """What a snapshot of ``lab_dir`` would hold (names and bytes), as one sha256 (:func:`_copy_lab`'s)."""
     h = hashlib.sha256()
-    top = str(lab_dir)
-    total = 0
-    for dirpath, dirnames, filenames in os.walk(top, followlinks=False):
-        dirnames[:] = sorted(d for d in dirnames if d not in _SKIP_DIRS)
-        rel = dirpath[len(top) + 1 :] if dirpath != top else "."
-        h.update(f"{rel}\0dir\n".encode("utf-8", "surrogateescape"))
-        for name in sorted(filenames):
-            full = os.path.join(dirpath, name)
-            try:
-                st = os.lstat(full)
-            except OSError:
-                continue
-            if not stat.S_ISREG(st.st_mode) or st.st_size > _FILE_LIMIT or total > _TOTAL_LIMIT:
-                continue
-            total += st.st_size
-            try:
-                digest = _file_digest(full, st)
-            except OSError:
-                continue
-            line = f"{name}\0{digest}\n" if rel == "." else f"{rel}/{name}\0{digest}\n"
-            h.update(line.encode("utf-8", "surrogateescape"))
+    for rel, full, st in _lab_files(lab_dir):
+        try:
+            digest = _file_digest(full, st) if st is not None else "dir"
+        except OSError:
+            continue
+        h.update(f"{rel}\0{digest}\n".encode("utf-8", "surrogateescape"))
     return h.hexdigest()
 
 
 def _copy_lab(lab_dir: Path, dest: Path) -> str:
     """Copy ``lab_dir`` into ``dest`` (read-only); returns the digest of what was copied."""
     h = hashlib.sha256()
-    for rel, st in _lab_files(lab_dir):
+    for rel, full, st in _lab_files(lab_dir):
         if st is None:
             (dest / rel).mkdir(parents=True, exist_ok=True)
             digest = "dir"
         else:
             try:
-                data = _read_plain(lab_dir / rel)
+                data = _read_plain(full)
             except OSError:
                 continue
             (dest / rel).write_bytes(data)
             digest = hashlib.sha256(data).hexdigest()
-        h.update(f"{rel.as_posix()}\0{digest}\n".encode("utf-8", "surrogateescape"))
+        h.update(f"{rel}\0{digest}\n".encode("utf-8", "surrogateescape"))
     for dirpath, _dirnames, filenames in os.walk(dest.parent):
         os.chmod(dirpath, 0o555)
         for name in filenames:

@@ -1,4 +1,4 @@
-"""The digest the sandbox checks at every call (``_folder_digest``, walked on strings) is the digest of
+"""The digest the sandbox checks at every call (``_folder_digest``) is the digest of
 what a snapshot copies (``_copy_lab``): were they to differ, every call would make a new snapshot."""
 
 from __future__ import annotations
