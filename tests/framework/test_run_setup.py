@@ -221,3 +221,35 @@ def test_the_suite_writes_bytecode_where_the_machine_says_not_to(tmp_path):
     runs = log.read_text().splitlines()
     assert any(r.startswith("run --frozen pytest") and r.endswith("dont_write=unset") for r in runs), runs
     assert any(r.startswith("run --frozen geomlib figures") and r.endswith("dont_write=1") for r in runs), runs
+
+
+def test_the_suite_finds_the_uv_that_run_found_on_its_path(tmp_path):
+    """A fresh machine: uv is the private copy, off the PATH (its ~/.local/bin link too). The suite's
+    tests run `uv` themselves (test_release_course.py installs the released autograder with it), so
+    `./run tests` gives pytest that uv first on the PATH; it was missing there and 9 release tests
+    skipped in a fresh CI clone ("uv is not installed")."""
+    fake, tools, libs, private = (tmp_path / d for d in ("fake", "tools", "lib", "private"))
+    for d in (fake, tools, libs, private):
+        d.mkdir()
+    for t in (*TOOLS, "python3", "mkdir", "ln"):
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    (libs / "libOSMesa.so.8").write_text("")
+    log = tmp_path / "uv.log"
+    bash = shutil.which("bash")
+    (fake / "id").write_text(f"#!{bash}\necho 0")
+    # the private copy: as pytest's process it reports which uv a test would find on its PATH
+    (private / "uv").write_text(f'#!{bash}\n[ "$1" = run ] && echo "$* found=$(command -v uv)" >> {log}\nexit 0\n')
+    for f in (fake / "id", private / "uv"):
+        f.chmod(0o755)
+    env = {
+        "PATH": f"{fake}:{tools}",
+        "HOME": str(tmp_path),
+        "GEOMLIB_LIB_DIRS": str(libs),
+        "GEOMLIB_UV": str(private / "uv"),
+    }
+    for args in (("tests", "-q", "tests/unit"), ("tests",)):
+        p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
+        assert p.returncode == 0, p.stderr
+    runs = log.read_text().splitlines()
+    assert len(runs) == 2 and all(r.startswith("run --frozen pytest") for r in runs), runs
+    assert all(r.endswith(f"found={private / 'uv'}") for r in runs), runs
