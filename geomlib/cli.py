@@ -49,8 +49,18 @@ def _cmd_info(a) -> int:
 
 
 def _cmd_view(a) -> int:
-    from geomlib import viewer
+    import shlex
 
+    from geomlib import viewer
+    from geomlib.validate import MeshError
+
+    if a.html is None and Path(a.file).is_file() and not viewer.has_display():
+        # The library's message names its Python call; at the command line, the command to paste.
+        page = shlex.quote(Path(a.file).with_suffix(".html").name)
+        raise MeshError(
+            "no display here (DISPLAY/WAYLAND_DISPLAY unset): write one page that works offline in any "
+            f"browser instead: uv run geomlib view {shlex.quote(a.file)} --html {page}"
+        )
     out = viewer.view_file(a.file, html=a.html, up=a.up, edges=a.edges)
     if out is not None:
         print(f"wrote {out} (open it in a web browser; it needs no network)")

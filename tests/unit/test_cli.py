@@ -64,7 +64,8 @@ def test_view_without_a_display_names_the_command_once(tmp_path, capsys, monkeyp
     assert main(["view", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("geomlib view: no display here") and "view: view:" not in err, err
-    assert "--html" in err
+    # the command to paste, with the file the student gave (it said `geomlib view FILE --html mesh.html`)
+    assert f"uv run geomlib view {path} --html ball.html" in err and "FILE" not in err, err
 
 
 @pytest.mark.render
