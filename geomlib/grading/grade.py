@@ -291,6 +291,12 @@ def _remove_stale_pictures(feedback_dir, records, *, before: float, ran: dict | 
                     png.unlink()
             except OSError:
                 pass
+    # A folder whose pictures all went says nothing: leave no empty feedback/<lab>/ or feedback/.
+    for folder in [*(Path(feedback_dir, lab) for lab in {r.lab for r in records}), Path(feedback_dir)]:
+        try:
+            folder.rmdir()  # only when empty
+        except OSError:
+            pass
 
 
 def _problem_lines(text: str, limit: int = 12) -> list[str]:

@@ -164,3 +164,6 @@ def test_a_picture_a_message_still_cites_stays_and_a_k_selection_removes_only_it
     assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png", "odd-a.png", "test_x--V.png"]
     _remove_stale_pictures(tmp_path / "feedback", records, before=2e9)  # whole labs ran
     assert sorted(p.name for p in folder.iterdir()) == ["loop-b--odd-b.png"]
+    # everything passes now: no picture, and no empty feedback/lab/ or feedback/ left behind
+    _remove_stale_pictures(tmp_path / "feedback", [record("t.py::test_references[loop-b]", True)], before=2e9)
+    assert not (tmp_path / "feedback").exists(), list((tmp_path / "feedback").rglob("*"))
