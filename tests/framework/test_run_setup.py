@@ -150,10 +150,9 @@ def test_a_supported_system_python_is_used_as_it_is(tmp_path):
     assert not [c for c in calls if c.startswith("uv python install")] and "Python" not in p.stderr, calls
 
 
-def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
-    """docs/instructors.md's commands are `uv run geomlib ...` after `./run figures` or `./run tests`:
-    every job, not only `setup`, links the uv it found into ~/.local/bin and says so once when that
-    folder is off the PATH (a uv outside the PATH, as the private copy is)."""
+def _root_with_a_private_uv(tmp_path: Path, uv_body: str) -> dict[str, str]:
+    """The environment of a ``./run`` as root (fake ``id``) with libOSMesa present and ``uv`` only as a
+    private copy off the PATH (as on a fresh machine), given as a bash body."""
     fake, tools, libs, private = (tmp_path / d for d in ("fake", "tools", "lib", "private"))
     for d in (fake, tools, libs, private):
         d.mkdir()
@@ -162,15 +161,23 @@ def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
     (libs / "libOSMesa.so.8").write_text("")
     bash = shutil.which("bash")
     (fake / "id").write_text(f"#!{bash}\necho 0")
-    (private / "uv").write_text(f"#!{bash}\nexit 0")  # the private copy: not on the PATH
+    (private / "uv").write_text(f"#!{bash}\n{uv_body}")
     for f in (fake / "id", private / "uv"):
         f.chmod(0o755)
-    env = {
+    return {
         "PATH": f"{fake}:{tools}",
         "HOME": str(tmp_path),
         "GEOMLIB_LIB_DIRS": str(libs),
         "GEOMLIB_UV": str(private / "uv"),
     }
+
+
+def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
+    """docs/instructors.md's commands are `uv run geomlib ...` after `./run figures` or `./run tests`:
+    every job, not only `setup`, links the uv it found into ~/.local/bin and says so once when that
+    folder is off the PATH (a uv outside the PATH, as the private copy is)."""
+    env = _root_with_a_private_uv(tmp_path, "exit 0")
+    private = tmp_path / "private"
     for job, says in (("figures", True), ("figures", False), ("setup", True)):
         p = subprocess.run([str(ROOT / "run"), job], env=env, capture_output=True, text=True, timeout=120)
         assert p.returncode == 0, p.stderr
@@ -228,25 +235,10 @@ def test_the_suite_finds_the_uv_that_run_found_on_its_path(tmp_path):
     tests run `uv` themselves (test_release_course.py installs the released autograder with it), so
     `./run tests` gives pytest that uv first on the PATH; it was missing there and 9 release tests
     skipped in a fresh CI clone ("uv is not installed")."""
-    fake, tools, libs, private = (tmp_path / d for d in ("fake", "tools", "lib", "private"))
-    for d in (fake, tools, libs, private):
-        d.mkdir()
-    for t in (*TOOLS, "python3", "mkdir", "ln"):
-        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    (libs / "libOSMesa.so.8").write_text("")
     log = tmp_path / "uv.log"
-    bash = shutil.which("bash")
-    (fake / "id").write_text(f"#!{bash}\necho 0")
     # the private copy: as pytest's process it reports which uv a test would find on its PATH
-    (private / "uv").write_text(f'#!{bash}\n[ "$1" = run ] && echo "$* found=$(command -v uv)" >> {log}\nexit 0\n')
-    for f in (fake / "id", private / "uv"):
-        f.chmod(0o755)
-    env = {
-        "PATH": f"{fake}:{tools}",
-        "HOME": str(tmp_path),
-        "GEOMLIB_LIB_DIRS": str(libs),
-        "GEOMLIB_UV": str(private / "uv"),
-    }
+    env = _root_with_a_private_uv(tmp_path, f'[ "$1" = run ] && echo "$* found=$(command -v uv)" >> {log}\nexit 0\n')
+    private = tmp_path / "private"
     for args in (("tests", "-q", "tests/unit"), ("tests",)):
         p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
         assert p.returncode == 0, p.stderr
