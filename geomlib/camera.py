@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from geomlib import portable
 from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int
 
 __all__ = [
@@ -103,17 +104,17 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     where = "look_at"
     eye, target, up = _vec3(eye, "eye", where), _vec3(target, "target", where), _vec3(up, "up", where)
     d = target - eye
-    dist = np.linalg.norm(d)
+    dist = portable.norm(d)  # portable: camera matrices feed stored test inputs (no BLAS)
     if dist == 0 or dist <= 1e-12 * max(np.abs(eye).max(), np.abs(target).max()):
         raise MeshError(
             f"{where}: eye {tuple(eye)} and target {tuple(target)} coincide; the view direction is undefined"
         )
     f = d / dist
-    nu = np.linalg.norm(up)
+    nu = portable.norm(up)
     if nu == 0:
         raise MeshError(f"{where}: up is the zero vector")
     s = np.cross(f, up / nu)
-    ns = np.linalg.norm(s)
+    ns = portable.norm(s)
     if ns < 1e-9:
         raise MeshError(
             f"{where}: up {tuple(up)} is parallel to the view direction {tuple(np.round(f, 6))}; "
@@ -123,7 +124,7 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     u = np.cross(s, f)
     V = np.eye(4)
     V[0, :3], V[1, :3], V[2, :3] = s, u, -f
-    V[:3, 3] = -V[:3, :3] @ eye
+    V[:3, 3] = -portable.matmul(V[:3, :3], eye)
     return V
 
 
@@ -231,7 +232,7 @@ def perspective(fov_y_deg: float, aspect: float, near: float, far: float) -> np.
     near, far = check_float(near, "near", where=where), check_float(far, "far", where=where)
     if not 0 < near < far:
         raise MeshError(f"{where}: need 0 < near < far, got near={near}, far={far}")
-    f = 1.0 / np.tan(np.radians(fov) / 2)
+    f = 1.0 / float(portable.tan(np.radians(fov) / 2))
     P = np.zeros((4, 4))
     P[0, 0] = f / aspect
     P[1, 1] = f
@@ -266,7 +267,7 @@ def perspective_look_at(eye, target, up, fov_y_deg: float, aspect: float, near: 
     >>> bool(np.allclose(M, perspective(60, 1.0, 0.1, 10) @ look_at((0, 0, 3), (0, 0, 0))))
     True
     """
-    return perspective(fov_y_deg, aspect, near, far) @ look_at(eye, target, up)
+    return portable.matmul(perspective(fov_y_deg, aspect, near, far), look_at(eye, target, up))
 
 
 def orthographic(left: float, right: float, bottom: float, top: float, near: float, far: float) -> np.ndarray:
@@ -344,8 +345,8 @@ def project(P, M, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
     M = as_array(M, "M", shape=(4, 4), where=where)
     width = check_int(width, "width", minimum=1, where=where)
     height = check_int(height, "height", minimum=1, where=where)
-    C = X @ M[:3, :3].T + M[:3, 3]
-    w = X @ M[3, :3] + M[3, 3]
+    C = portable.matmul(X, M[:3, :3].T) + M[:3, 3]
+    w = portable.matmul(X, M[3, :3]) + M[3, 3]
     ok = w > 0
     with np.errstate(divide="ignore", invalid="ignore"):
         ndc = np.where(ok[:, None], C / np.where(ok, w, 1.0)[:, None], np.nan)

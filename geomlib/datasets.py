@@ -23,7 +23,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from geomlib import topology
+from geomlib import portable, topology
 from geomlib.validate import MeshError, as_array, as_vertices, check_choice, check_float, check_int, check_mesh
 
 __all__ = [
@@ -109,8 +109,8 @@ def icosphere(level: int = 2, radius: float = 1.0) -> tuple[np.ndarray, np.ndarr
 def _torus_points(major: float, minor: float, i: np.ndarray, j: np.ndarray, n_major: int, n_minor: int) -> np.ndarray:
     th = 2.0 * np.pi * (i % n_major) / n_major  # modulo: seam copies get bit-identical positions
     ph = 2.0 * np.pi * (j % n_minor) / n_minor
-    rr = major + minor * np.cos(ph)
-    return np.stack([rr * np.cos(th), rr * np.sin(th), minor * np.sin(ph)], axis=-1)
+    rr = major + minor * portable.cos(ph)
+    return np.stack([rr * portable.cos(th), rr * portable.sin(th), minor * portable.sin(ph)], axis=-1)
 
 
 def _grid_quads(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> np.ndarray:
@@ -282,7 +282,7 @@ def _bumps(x: np.ndarray, y: np.ndarray, rng: np.random.Generator, count: int = 
     s = rng.uniform(0.08, 0.2, size=count)
     w = rng.uniform(0.5, 1.0, size=count) * rng.choice([-1.0, 1.0], size=count)
     d2 = (x[:, None] - c[:, 0]) ** 2 + (y[:, None] - c[:, 1]) ** 2
-    return (w * np.exp(-d2 / (2 * s**2))).sum(axis=1)
+    return (w * portable.exp(-d2 / (2 * s**2))).sum(axis=1)
 
 
 def height_field(
@@ -382,7 +382,7 @@ def polygon_cage() -> tuple[np.ndarray, list[list[int]]]:
         ``[pentagon] + 5 quads + 5 triangles``.
     """
     a = 2.0 * np.pi * np.arange(5) / 5 + np.pi / 2
-    ring = np.stack([np.cos(a), np.sin(a), np.zeros(5)], axis=1)
+    ring = np.stack([portable.cos(a), portable.sin(a), np.zeros(5)], axis=1)
     V = np.vstack([ring, ring + [0.0, 0.0, 1.0], [[0.25, 0.0, 1.6]]])
     floor = [[4, 3, 2, 1, 0]]  # clockwise seen from above = outward (down)
     walls = [[i, (i + 1) % 5, 5 + (i + 1) % 5, 5 + i] for i in range(5)]
@@ -451,18 +451,20 @@ def rock_on_plinth(n: int = 48, seed: int = 0, size: float = 1.0) -> tuple[np.nd
     # The rock (units of size): a dome over a lumpy outline, modulated by bumps and ridges.
     rng = np.random.default_rng(seed)
     xs, ys = x / size, y / size
-    ang = np.arctan2(ys, xs)
+    ang = portable.arctan2(ys, xs)
     outline = 1 + sum(
-        rng.uniform(0.06, 0.14) * np.cos(m * ang + rng.uniform(0, 2 * np.pi))
+        rng.uniform(0.06, 0.14) * portable.cos(m * ang + rng.uniform(0, 2 * np.pi))
         for m in rng.choice([2, 3, 4, 5], 3, replace=False)
     )
     r0 = 0.85 * rho_w / 2  # the rock stays inside 85% of the plinth's half-width
-    s = np.hypot(xs, ys) / (r0 * outline / outline.max())
+    s = portable.hypot(xs, ys) / (r0 * outline / outline.max())
     dome = np.sqrt(np.clip(1 - s**2, 0, None))  # steep flanks: a crease where it meets the plinth
     bumps = _bumps(xs / (2 * r0) + 0.5, ys / (2 * r0) + 0.5, rng, count=12)
     bumps /= np.abs(bumps).max()
     d = rng.normal(size=(3, 2))
-    ridges = sum(np.abs(np.cos(rng.uniform(12, 20) * (u[0] * xs + u[1] * ys) / np.hypot(*u))) for u in d) / 3
+    ridges = (
+        sum(np.abs(portable.cos(rng.uniform(12, 20) * (u[0] * xs + u[1] * ys) / portable.hypot(*u))) for u in d) / 3
+    )
     z = z + 0.28 * dome * (1 + 0.35 * bumps + 0.3 * (ridges - 0.5))
     V = np.stack([x + size / 2, y + size / 2, z * size], axis=1)
     V[k == h, 0:2] = _grid_xy(n, size)[k == h, 0:2]  # the border exactly on the grid's border
@@ -509,9 +511,9 @@ def uv_sphere(n_lat: int = 16, n_lon: int = 32, radius: float = 1.0) -> tuple[np
     th = np.pi * rows / n_lat
     mid = np.stack(
         [
-            np.outer(np.sin(th), np.cos(phi)),
-            np.outer(np.sin(th), np.sin(phi)),
-            np.repeat(np.cos(th), n_lon + 1).reshape(-1, n_lon + 1),
+            np.outer(portable.sin(th), portable.cos(phi)),
+            np.outer(portable.sin(th), portable.sin(phi)),
+            np.repeat(portable.cos(th), n_lon + 1).reshape(-1, n_lon + 1),
         ],
         axis=-1,
     ).reshape(-1, 3)

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from geomlib import portable
 from geomlib.validate import MeshError, as_array, as_faces, check_choice, check_int
 
 __all__ = ["GBuffer", "rasterize", "rasterize_clip", "SUBPIXEL_BITS", "MAX_SIZE", "GUARD_BAND_PX"]
@@ -143,6 +144,13 @@ def _vertex_values(values, n: int, name: str, where: str) -> np.ndarray:
     return A
 
 
+def _weighted_corners(w: np.ndarray, X: np.ndarray) -> np.ndarray:
+    """``sum_i w[:, i] * X[:, i]`` for weights ``(p, 3)`` and corner values ``(p, 3, ...)``, summed in
+    corner order by separate multiplies and adds (an ``einsum`` may fuse them where the CPU has FMA)."""
+    w = w.reshape(w.shape + (1,) * (X.ndim - 2))
+    return w[:, 0] * X[:, 0] + w[:, 1] * X[:, 1] + w[:, 2] * X[:, 2]
+
+
 def _interpolate(A: np.ndarray, F: np.ndarray, face_id: np.ndarray, bary: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """``sum_i bary[..., i] * A[F[face_id, i]]`` on covered pixels, zero elsewhere; blockwise for memory."""
     out = np.zeros((mask.size,) + A.shape[1:])
@@ -150,7 +158,7 @@ def _interpolate(A: np.ndarray, F: np.ndarray, face_id: np.ndarray, bary: np.nda
     fid, b = face_id.reshape(-1), bary.reshape(-1, 3)
     for a in range(0, len(pix), _PIX_BLOCK):
         p = pix[a : a + _PIX_BLOCK]
-        out[p] = np.einsum("pi,pi...->p...", b[p], A[F[fid[p]]])
+        out[p] = _weighted_corners(b[p], A[F[fid[p]]])
     return out.reshape(mask.shape + A.shape[1:])
 
 
@@ -202,7 +210,7 @@ def rasterize(
     where = "rasterize"
     V = as_array(V, "V", shape=(None, 3), where=where)
     M = as_array(M, "M", shape=(4, 4), where=where)
-    C = V @ M[:, :3].T + M[:, 3]
+    C = portable.matmul(V, M[:, :3].T) + M[:, 3]  # not BLAS: the same bits on every CPU (geomlib.portable)
     if not np.all(np.isfinite(C)):
         r = int(np.flatnonzero(~np.isfinite(C).all(axis=1))[0])
         raise MeshError(f"{where}: M @ V overflows at vertex {r} (clip coordinates {tuple(C[r])})")
@@ -576,6 +584,6 @@ def _barycentrics(pix: np.ndarray, tri: np.ndarray, S: dict, width: int) -> np.n
     q /= q.sum(axis=1, keepdims=True)
     if S["B"] is None:
         return q
-    b = np.einsum("pi,pij->pj", q, S["B"][tri])
+    b = _weighted_corners(q, S["B"][tri])
     np.clip(b, 0.0, None, out=b)
     return b / b.sum(axis=1, keepdims=True)

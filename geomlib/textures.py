@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from geomlib import portable
 from geomlib.validate import MeshError, as_array, as_faces, as_image, as_vertices, check_choice, check_float, check_int
 
 __all__ = ["WRAP_MODES", "sample_bilinear", "rasterize_uv", "dilate", "weld_by_position", "triangle_atlas"]
@@ -276,7 +277,7 @@ def weld_by_position(V, tol: float | None = None) -> tuple[np.ndarray, int]:
     if n == 0:
         return np.zeros(0, np.int64), 0
     if tol is None:
-        diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+        diag = portable.norm(V.max(axis=0) - V.min(axis=0))  # not BLAS: the same tolerance on every CPU
         tol = 1e-9 * (diag if diag > 0 else 1.0)
     else:
         tol = check_float(tol, "tol", minimum=0.0, where=where)
@@ -353,7 +354,7 @@ def triangle_atlas(
     l0 = np.linalg.norm(e0, axis=1)
     ok = l0 > 0
     ex = np.where(ok[:, None], e0 / np.where(ok, l0, 1.0)[:, None], 0.0)
-    x2 = np.einsum("ij,ij->i", e1, ex)
+    x2 = e1[:, 0] * ex[:, 0] + e1[:, 1] * ex[:, 1] + e1[:, 2] * ex[:, 2]  # not einsum: no FMA (same bits everywhere)
     y2 = np.linalg.norm(e1 - x2[:, None] * ex, axis=1)
     loc = np.zeros((m, 3, 2))
     loc[:, 1, 0] = l0

@@ -43,6 +43,68 @@ def test_solutions_reproduce_the_stored_references():
     assert p.returncode == 0, p.stdout[-4000:] + p.stderr[-2000:]
 
 
+#: Functions whose float64 results depend on the CPU: numpy runs its own AVX-512 code for the
+#: transcendental ufuncs where the CPU has it and glibc's libm (FMA and non-FMA variants) elsewhere,
+#: and ``math`` calls the same libm; the products call OpenBLAS (kernels per CPU) or may fuse
+#: multiply-adds (einsum). ``geomlib.portable`` has CPU-independent versions.
+CPU_DEPENDENT_NUMPY = (
+    "sin", "cos", "tan", "arcsin", "arccos", "arctan", "arctan2", "sinh", "cosh", "tanh", "arcsinh",
+    "arccosh", "arctanh", "exp", "exp2", "expm1", "log", "log2", "log10", "log1p", "power",
+    "float_power", "cbrt", "hypot", "dot", "vdot", "inner", "matmul", "tensordot", "einsum",
+)  # fmt: skip
+CPU_DEPENDENT_MATH = (
+    "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
+    "exp", "exp2", "expm1", "log", "log2", "log10", "log1p", "pow", "cbrt",
+)  # fmt: skip
+
+
+def test_case_inputs_call_nothing_whose_bits_depend_on_the_cpu(monkeypatch):
+    # tests/solutions/test_deterministic.py compares every case's inputs with an emulated other CPU,
+    # but no machine can play one with AVX-512 (numpy's own float64 exp, sin, cos, arctan2, power:
+    # how 27 cases' references, built on such a CPU, broke on an AVX2 one). So here the course's
+    # own code that builds the inputs of every case of every lab may not call those functions at
+    # all. (``@`` and ``x ** 3`` cannot be intercepted: the emulated run catches what BLAS changes.)
+    import math
+
+    import numpy as np
+
+    from geomlib.grading.cases import load_cases, load_stored
+    from geomlib.grading.registry import graded_package_modules
+
+    for name in graded_package_modules():  # imported afresh: some inputs are built when a case module loads
+        monkeypatch.delitem(sys.modules, name)
+
+    course_code = tuple(str(ROOT / d) + os.sep for d in ("geomlib", "tests", "solutions", "labs"))
+    calls: dict[str, set[str]] = {}
+    case = [""]
+
+    def watch(module, name, label, blas_unless_axis=False):
+        f = getattr(module, name)
+
+        def watched(*args, **kwargs):
+            frame = sys._getframe(1)
+            if frame.f_code.co_filename.startswith(course_code) and not (
+                blas_unless_axis and kwargs.get("axis", args[2] if len(args) > 2 else None) is not None
+            ):
+                where = f"{label} at {Path(frame.f_code.co_filename).relative_to(ROOT)}:{frame.f_lineno}"
+                calls.setdefault(where, set()).add(case[0])
+            return f(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, watched)
+
+    for name in CPU_DEPENDENT_NUMPY:
+        watch(np, name, f"np.{name}")
+    for name in CPU_DEPENDENT_MATH:
+        watch(math, name, f"math.{name}")
+    watch(np.linalg, "norm", "np.linalg.norm without axis (a BLAS dot)", blas_unless_axis=True)
+    for lab in LABS:
+        for c in load_stored(lab) + load_cases(lab):
+            case[0] = f"{lab}/{c.id}"
+            c.inputs()
+    found = [f"{where} (in {len(ids)} cases, e.g. {sorted(ids)[0]})" for where, ids in sorted(calls.items())]
+    assert not found, "case inputs depend on the CPU: use geomlib.portable instead of\n" + "\n".join(found)
+
+
 def test_every_lab_is_complete():
     for lab in LABS:
         for rel in (

@@ -4,12 +4,14 @@ Run as a script in a fresh interpreter with the environment under test (``NUMBA_
 ``NUMBA_CPU_NAME=generic``, ``OPENBLAS_CORETYPE=...``, ``NPY_DISABLE_CPU_FEATURES=...``: numba,
 numpy and OpenBLAS read them when they load, so one process cannot switch them)::
 
-    python tests/solutions/kernel_digests.py LAB/ID [LAB/ID ...]
+    python tests/solutions/kernel_digests.py [--case-inputs] LAB/ID [LAB/ID ...]
 
 It prints one JSON object on its last line: ``digests`` maps each ``LAB/ID`` to the sha256 of its
 output (every returned array's dtype, shape and bytes), so two runs agree only when they agree
 bit for bit; ``inputs`` holds the same for the run's inputs; ``kernels`` maps each lab to the functions of its numba module that ran (recorded
-only with ``NUMBA_DISABLE_JIT=1``, when the kernels are plain Python functions).
+only with ``NUMBA_DISABLE_JIT=1``, when the kernels are plain Python functions). With
+``--case-inputs``, ``case_inputs`` holds :func:`case_inputs`: the inputs digest of every case of
+every lab, as ``geomlib refs check`` computes it.
 
 Run ids are the graded case ids of ``tests/graded/<lab>/cases*.py``; for simplification, whose
 graded cases only run the lab's Python loop, ``<case id>[greedy]`` and ``<case id>[fast]`` run a
@@ -156,10 +158,31 @@ def compute(wanted: list[str], record: bool = False) -> dict:
     }
 
 
+def case_inputs() -> dict[str, str]:
+    """``{lab/id: inputs digest}`` of every stored input and case of every lab: the digest
+    ``geomlib refs check`` compares with the manifests (``inputs_digest`` of ``case.inputs()`` and
+    its parameters), so equal digests on two machines mean equal inputs, byte for byte."""
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from geomlib.grading import impl
+    from geomlib.grading.cases import inputs_digest, load_cases, load_stored
+
+    return {
+        f"{lab}/{case.id}": inputs_digest(case.inputs(), case.params)
+        for lab in impl.lab_names()
+        for case in load_stored(lab) + load_cases(lab)
+    }
+
+
 def main(argv: list[str]) -> None:
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
-    print(json.dumps(compute(argv, record=os.environ.get("NUMBA_DISABLE_JIT") == "1")))
+    with_inputs = "--case-inputs" in argv
+    argv = [a for a in argv if a != "--case-inputs"]
+    out = compute(argv, record=os.environ.get("NUMBA_DISABLE_JIT") == "1")
+    if with_inputs:
+        out["case_inputs"] = case_inputs()
+    print(json.dumps(out))
 
 
 if __name__ == "__main__":

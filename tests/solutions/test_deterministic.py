@@ -8,6 +8,8 @@ one flipped bit in a cost reorders the heap. These tests run the labs' graded ca
 
 * with the numba kernels compiled and with ``NUMBA_DISABLE_JIT=1`` (plain Python), byte for byte,
   and check that the chosen cases together call every kernel of each lab's numba module;
+* every case's inputs (of every lab, as ``geomlib refs check`` digests them) on this machine and
+  on an emulated other one, byte for byte;
 * on this machine and on an emulated other one, byte for byte: numba compiling for the generic
   x86-64 CPU (no AVX, no FMA), OpenBLAS running its oldest x86-64 kernels, numpy its baseline
   loops (no AVX2/AVX-512 dispatch) and glibc's libm its non-FMA code — the switches a different
@@ -139,7 +141,10 @@ def started(tmp_path_factory, jit_cache):
     runs = {
         "plain": Digests(NO_JIT_RUNS, tmp_path_factory.mktemp("no-jit"), NUMBA_DISABLE_JIT="1"),
         "other": Digests(
-            MACHINE_RUNS, tmp_path_factory.mktemp("other"), NUMBA_CACHE_DIR=str(jit_cache), **OTHER_MACHINE
+            ["--case-inputs", *MACHINE_RUNS],
+            tmp_path_factory.mktemp("other"),
+            NUMBA_CACHE_DIR=str(jit_cache),
+            **OTHER_MACHINE,
         ),
     }
     yield runs
@@ -203,26 +208,25 @@ def test_compiled_kernels_give_the_bytes_of_plain_python(here, plain):
     )
 
 
-#: Runs whose *inputs* differ between CPUs: ``geomlib.datasets.height_field`` sums Gaussian bumps
-#: with ``np.exp``, and numpy's float64 ``exp`` has separate AVX-512, AVX2 and baseline code that
-#: differ in the last bit. The solutions cannot give equal bytes for unequal inputs; their outputs
-#: are not compared. (Making the datasets CPU-independent would change stored references of
-#: several labs: a separate change.)
-MACHINE_DEPENDENT_INPUTS = {
-    "simplification/simplify-height-field-10pct[fast]",
-    "simplification/simplify-height-field-10pct[greedy]",
-    "remeshing/hidden-remesh-height-field",
-}
+def test_every_cases_inputs_are_the_same_bytes_on_another_machine(other):
+    # The inputs digests ``geomlib refs check`` compares with the references' manifests, of every
+    # case of every lab: references built on one CPU must hold on another (27 cases failed on an
+    # AVX2 machine with references built on an AVX-512 one). Inputs are built with geomlib.portable.
+    here = kernel_digests.case_inputs()
+    theirs = other["case_inputs"]
+    assert set(theirs) == set(here)
+    moved = sorted(k for k in here if here[k] != theirs[k])
+    assert not moved, (
+        f"{len(moved)} cases' inputs differ on an emulated other CPU ({OTHER_MACHINE}): {moved[:12]}; "
+        "a generator calls numpy's exp/sin/cos/arctan2/power, math.*, BLAS (@, np.dot, 1-D norm) or einsum: "
+        "use geomlib.portable"
+    )
 
 
 def test_another_machine_gives_the_same_bytes(here, other):
-    moved = set(differing(here["inputs"], other["inputs"], MACHINE_RUNS))
-    assert moved <= MACHINE_DEPENDENT_INPUTS, (
-        f"the inputs of {sorted(moved - MACHINE_DEPENDENT_INPUTS)} differ on an emulated other CPU "
-        f"({OTHER_MACHINE}): a dataset depends on the CPU's SIMD code (numpy's exp/log/pow, BLAS)"
-    )
-    same_inputs = [r for r in MACHINE_RUNS if r not in moved]
-    diff = differing(here["digests"], other["digests"], same_inputs)
+    moved = differing(here["inputs"], other["inputs"], MACHINE_RUNS)
+    assert not moved, f"the inputs of {moved} differ on an emulated other CPU ({OTHER_MACHINE})"
+    diff = differing(here["digests"], other["digests"], MACHINE_RUNS)
     assert not diff, (
         f"an emulated other CPU ({OTHER_MACHINE}) gives different bytes on {diff}: something depends on "
         "the CPU's SIMD kernels (np.linalg / BLAS, numpy's dispatched pow/exp/log, numba's CPU target)"

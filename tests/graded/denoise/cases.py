@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets
+from geomlib import datasets, portable
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
@@ -35,9 +35,9 @@ def offsets_on_uv(make, seed: int = 0):
         V, F, UV = make()
         x, y, z = V.T
         s = (
-            0.03 * np.sin(5 * x + 1) * np.cos(4 * y)
+            0.03 * portable.sin(5 * x + 1) * portable.cos(4 * y)
             + 0.01 * z
-            + 0.002 * np.round(np.sin(37 * x + 53 * y + 71 * z + seed), 3)
+            + 0.002 * np.round(portable.sin(37 * x + 53 * y + 71 * z + seed), 3)
         )
         return {"V": V, "F": F, "UV": UV, "s": s}
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets
+from geomlib import datasets, portable
 from geomlib.geometry import bbox_diagonal, closest_points, mean_edge_length, vertex_normals
 from geomlib.grading import checks
 from geomlib.grading.checks import format_vec
@@ -82,7 +82,8 @@ def random_map(size: int, seed: int = 0, dtype=np.uint16) -> np.ndarray:
     rng = np.random.default_rng(seed)
     r, c = np.mgrid[0:size, 0:size] / size
     H = sum(
-        rng.uniform(0.3, 1) * np.sin(2 * np.pi * (rng.integers(1, 5) * c + rng.integers(1, 5) * r) + rng.uniform(0, 6))
+        rng.uniform(0.3, 1)
+        * portable.sin(2 * np.pi * (rng.integers(1, 5) * c + rng.integers(1, 5) * r) + rng.uniform(0, 6))
         for _ in range(5)
     )
     H = (H - H.min()) / (H.max() - H.min())

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geomlib import camera, datasets
+from geomlib import camera, datasets, portable
 from geomlib.grading import Case, checks
 from geomlib.grading.checks import Context, as_output_array, format_vec
 from geomlib.raster import rasterize
@@ -72,7 +72,7 @@ def texel_uv(s: int) -> tuple[np.ndarray, np.ndarray]:
 def wave(s: int) -> np.ndarray:
     """h(u, v) = 1/2 + 1/2 sin(2 pi u) cos(2 pi v) at the texel centres (tileable, in [0, 1])."""
     u, v = texel_uv(s)
-    return 0.5 + 0.5 * np.sin(2 * np.pi * u) * np.cos(2 * np.pi * v)
+    return 0.5 + 0.5 * portable.sin(2 * np.pi * u) * portable.cos(2 * np.pi * v)
 
 
 def random_map(s: int, seed: int, channels: int | None = None) -> np.ndarray:
@@ -88,7 +88,7 @@ def unit_vectors(shape, seed: int) -> np.ndarray:
 def affine_grid(n: int = 4):
     V, F = datasets.grid_patch(n)
     A = np.array([[0.7, 0.4], [-0.3, 0.9]])  # det > 0: not mirrored
-    return {"V": V, "F": F, "UV": V[:, :2] @ A.T + [0.1, 0.05]}
+    return {"V": V, "F": F, "UV": portable.matmul(V[:, :2], A.T) + [0.1, 0.05]}
 
 
 def mirrored_torus():
@@ -109,7 +109,7 @@ def degenerate_uvs():
 def top_camera(size: int):
     """Orthographic camera above the unit square, looking down -z."""
     eye = np.array([0.5, 0.5, 4.0])
-    M = camera.orthographic(-0.5, 0.5, -0.5, 0.5, 0.5, 8.0) @ camera.look_at(eye, (0.5, 0.5, 0.0))
+    M = portable.matmul(camera.orthographic(-0.5, 0.5, -0.5, 0.5, 0.5, 8.0), camera.look_at(eye, (0.5, 0.5, 0.0)))
     return eye, M
 
 
@@ -135,10 +135,10 @@ def torus_gbuffer(size: int = 48):
     n_major, n_minor = 32, 16
     V, F, UV = datasets.uv_torus(n_major, n_minor)
     th, ph = 2 * np.pi * UV[:, 0], 2 * np.pi * UV[:, 1]
-    N = np.stack([np.cos(ph) * np.cos(th), np.cos(ph) * np.sin(th), np.sin(ph)], axis=1)
-    T = np.stack([-np.sin(th), np.cos(th), np.zeros_like(th), np.ones_like(th)], axis=1)
+    N = np.stack([portable.cos(ph) * portable.cos(th), portable.cos(ph) * portable.sin(th), portable.sin(ph)], axis=1)
+    T = np.stack([-portable.sin(th), portable.cos(th), np.zeros_like(th), np.ones_like(th)], axis=1)
     eye = np.array([0.4, -2.4, 1.8])
-    M = camera.perspective(40, 1.0, 0.5, 8.0) @ camera.look_at(eye, (0, 0, 0), (0, 0, 1))
+    M = camera.perspective_look_at(eye, (0, 0, 0), (0, 0, 1), 40, 1.0, 0.5, 8.0)
     g = rasterize(V, F, M, size, size, attributes={"position": V, "normal": N, "uv": UV, "tangent": T}, cull="back")
     return g, eye
 
@@ -158,7 +158,9 @@ def shade_inputs(kind: str):
         if kind == "quad-float-map":
             g, eye = quad_gbuffer()
             u, v = texel_uv(16)
-            n = np.stack([-0.3 * np.cos(2 * np.pi * u), 0.2 * np.sin(2 * np.pi * v), np.ones_like(u)], axis=-1)
+            n = np.stack(
+                [-0.3 * portable.cos(2 * np.pi * u), 0.2 * portable.sin(2 * np.pi * v), np.ones_like(u)], axis=-1
+            )
             return {"gbuffer": g, "lights": LIGHT, "eye": eye, "albedo": (0.7, 0.7, 0.7), "normal_map": n}
         if kind == "quad-uint8-map":
             g, eye = quad_gbuffer()
@@ -177,7 +179,9 @@ def shade_inputs(kind: str):
         if kind == "torus-two-lights":
             g, eye = torus_gbuffer()
             u, v = texel_uv(32)
-            n = np.stack([0.4 * np.sin(8 * np.pi * u), 0.4 * np.cos(4 * np.pi * v), np.ones_like(u)], axis=-1)
+            n = np.stack(
+                [0.4 * portable.sin(8 * np.pi * u), 0.4 * portable.cos(4 * np.pi * v), np.ones_like(u)], axis=-1
+            )
             return {"gbuffer": g, "lights": TWO_LIGHTS, "eye": eye, "albedo": (0.8, 0.7, 0.6), "normal_map": n}
         if kind == "torus-texture":
             g, eye = torus_gbuffer()
@@ -202,7 +206,7 @@ def displace_inputs(mesh: str, s: int = 32):
 def bake_flat_inputs():
     """High: the height field z = 0.05 h(x, y) (h = wave); low: the flat unit square with tangent (1, 0, 0), w = +1."""
     Vh, Fh = datasets.height_field(
-        48, fn=lambda x, y: 0.05 * (0.5 + 0.5 * np.sin(2 * np.pi * x) * np.cos(2 * np.pi * y))
+        48, fn=lambda x, y: 0.05 * (0.5 + 0.5 * portable.sin(2 * np.pi * x) * portable.cos(2 * np.pi * y))
     )
     Vl, Fl, UVl = datasets.uv_grid(2)
     return {

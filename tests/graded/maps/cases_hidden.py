@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets
+from geomlib import datasets, portable
 from geomlib.grading import Case, checks
 
 from .cases import TANGENTS, MapClose, displace_inputs, shade_inputs, texel_uv, unit_vectors
@@ -30,7 +30,7 @@ def torus_finer_bake():
     V, F, UV = datasets.uv_torus(20, 10)
     V_hi, F_hi = datasets.torus(1.0, 0.35, 33, 17)
     th = 2 * np.pi * UV[:, 0]
-    tangents = np.stack([-np.sin(th), np.cos(th), np.zeros_like(th), np.ones_like(th)], axis=1)
+    tangents = np.stack([-portable.sin(th), portable.cos(th), np.zeros_like(th), np.ones_like(th)], axis=1)
     return {"V_hi": V_hi, "F_hi": F_hi, "V_lo": V, "F_lo": F, "UV_lo": UV, "tangents": tangents}
 
 
@@ -72,7 +72,9 @@ CASES = [
     Case(
         id="height-wave-clamp-strong",
         function="height_to_normal_map",
-        inputs=lambda: {"H": 0.5 + 0.5 * np.sin(2 * np.pi * texel_uv(20)[0]) * np.cos(4 * np.pi * texel_uv(20)[1])},
+        inputs=lambda: {
+            "H": 0.5 + 0.5 * portable.sin(2 * np.pi * texel_uv(20)[0]) * portable.cos(4 * np.pi * texel_uv(20)[1])
+        },
         params={"strength": 0.5, "border": "clamp"},
         outputs=("n",),
         check=MapClose("n", atol=1e-12, display="normals"),

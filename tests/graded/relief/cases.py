@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from geomlib import portable
 from geomlib.grading import Case
 from geomlib.grading.checks import Context, as_output_array, format_vec
 
@@ -90,7 +91,7 @@ def pixel_uv(p: int, lo: float = 0.0, hi: float = 1.0) -> np.ndarray:
 def smooth_bumps(s: int, k: int = 2) -> np.ndarray:
     """h = 1/2 + 1/2 sin(2 pi k u) sin(2 pi k v) at the texel centres, in [0, 1]."""
     uv = texel_uv(s)
-    return 0.5 + 0.5 * np.sin(2 * np.pi * k * uv[..., 0]) * np.sin(2 * np.pi * k * uv[..., 1])
+    return 0.5 + 0.5 * portable.sin(2 * np.pi * k * uv[..., 0]) * portable.sin(2 * np.pi * k * uv[..., 1])
 
 
 def steps_map(s: int, rows: int = 4) -> np.ndarray:
@@ -104,7 +105,7 @@ def steps_map(s: int, rows: int = 4) -> np.ndarray:
 
 def direction(deg: float, azimuth_deg: float = 20.0) -> np.ndarray:
     t, a = np.radians(deg), np.radians(azimuth_deg)
-    return np.array([np.sin(t) * np.cos(a), np.sin(t) * np.sin(a), np.cos(t)])
+    return np.array([portable.sin(t) * portable.cos(a), portable.sin(t) * portable.sin(a), portable.cos(t)])
 
 
 def perspective_views(p: int, eye=(0.3, 0.8, 0.9)) -> np.ndarray:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from geomlib import datasets, topology
+from geomlib import datasets, portable, topology
 from geomlib.grading import Case, checks
 from geomlib.grading import tolerances as tol
 
@@ -38,7 +38,7 @@ def box8_with_lines():
     V, F = box8()
     a = np.abs(V).max(axis=0)
     on_line = np.isclose(np.abs(V), a).sum(axis=1) >= 2
-    V = V + 0.2 * a / np.pi * np.sin(np.pi * V / a)
+    V = V + 0.2 * a / np.pi * portable.sin(np.pi * V / a)
     E = topology.unique_edges(F)
     return {"V": V, "F": F, "feature_edges": E[on_line[E].all(axis=1)]}
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from geomlib import datasets, topology
+from geomlib import datasets, portable, topology
 from geomlib.geometry import mesh_distance, triangle_quality
 from geomlib.grading import checks, expect_raises
 from geomlib.grading.cases import stored_input
@@ -51,7 +51,7 @@ def bumpy_sphere(level=3, seed=2):
 
 def wavy_patch(n=12, seed=0):
     V, F = datasets.grid_patch(n)
-    V[:, 2] = 0.15 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    V[:, 2] = 0.15 * portable.sin(3 * V[:, 0]) * portable.cos(2 * V[:, 1])
     return V, F
 
 

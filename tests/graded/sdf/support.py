@@ -9,7 +9,7 @@ from __future__ import annotations
 import igl
 import numpy as np
 
-from geomlib import datasets
+from geomlib import datasets, portable
 from geomlib.grading.checks import Context, as_output_array
 
 # ------------------------------------------------------------------------------------ meshes
@@ -43,7 +43,7 @@ def wedge():
 
 def thin_prism():
     """A closed prism over a 20-degree sliver triangle: its sharp edge fools the face-normal sign."""
-    T = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0 * np.tan(np.radians(20))]])
+    T = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0 * portable.tan(np.radians(20))]])
     V = np.vstack([np.c_[T, np.zeros(3)], np.c_[T, np.full(3, 0.5)]])
     F = [[0, 2, 1], [3, 4, 5]]
     for i in range(3):

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geomlib import camera, datasets
+from geomlib import camera, datasets, portable
 from geomlib.grading.checks import Context, as_output_array, format_vec
 
 from .. import common
@@ -65,16 +65,18 @@ CAMERA = (np.array([3.9, -4.8, 3.4]), np.array([-0.2, 0.3, 0.4]), np.array([0.0,
 
 def ortho_light(direction=(0.4, 0.5, -0.75), bounds=SCENE_BOUNDS, up=None) -> np.ndarray:
     """An orthographic light-space matrix made with geomlib.camera (not with the lab): a loose box."""
-    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    d = np.asarray(direction, float) / portable.norm(direction)  # portable: no BLAS in case inputs
     B = np.asarray(bounds, float)
-    c, R = B.mean(0), 0.5 * np.linalg.norm(B[1] - B[0])
+    c, R = B.mean(0), 0.5 * portable.norm(B[1] - B[0])
     up = np.eye(3)[np.argmin(np.abs(d))] if up is None else up
-    return camera.orthographic(-R, R, -R, R, 0.0, 2 * R) @ camera.look_at(c - R * d, c, up)
+    return portable.matmul(camera.orthographic(-R, R, -R, R, 0.0, 2 * R), camera.look_at(c - R * d, c, up))
 
 
 def spot_light(position=(-3.0, -3.5, 5.0), target=(0.0, 0.0, 0.0), fov=70.0, near=2.0, far=12.0) -> np.ndarray:
     p, t = np.asarray(position, float), np.asarray(target, float)
-    return camera.perspective(fov, 1.0, near, far) @ camera.look_at(p, t, np.eye(3)[np.argmin(np.abs(t - p))])
+    return portable.matmul(
+        camera.perspective(fov, 1.0, near, far), camera.look_at(p, t, np.eye(3)[np.argmin(np.abs(t - p))])
+    )
 
 
 def surface_points(V, F, n: int, seed: int):
@@ -82,7 +84,8 @@ def surface_points(V, F, n: int, seed: int):
     rng = np.random.default_rng(seed)
     f = rng.integers(0, len(F), n)
     b = rng.dirichlet(np.ones(3), n)
-    P = np.einsum("ki,kij->kj", b, V[F[f]])
+    T = V[F[f]]
+    P = b[:, 0, None] * T[:, 0] + b[:, 1, None] * T[:, 1] + b[:, 2, None] * T[:, 2]  # not einsum: no FMA
     N = np.cross(V[F[f, 1]] - V[F[f, 0]], V[F[f, 2]] - V[F[f, 0]])
     return P, N / np.linalg.norm(N, axis=1, keepdims=True)
 

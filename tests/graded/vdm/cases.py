@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from geomlib import datasets
+from geomlib import datasets, portable
 from geomlib.grading import Case, checks
 from geomlib.grading.cases import stored_input
 from geomlib.grading.checks import Context, as_output_array, format_vec
@@ -123,8 +123,8 @@ def warped(res: int, amount: float = 0.04) -> np.ndarray:
     """A smooth, unfolded warp of the uniform grid that keeps the boundary on the square's edges."""
     G = uniform(res)
     u, v = G[..., 0], G[..., 1]
-    du = amount * np.sin(np.pi * u) * np.sin(2 * np.pi * v)
-    dv = amount * np.sin(2 * np.pi * u) * np.sin(np.pi * v)
+    du = amount * portable.sin(np.pi * u) * portable.sin(2 * np.pi * v)
+    dv = amount * portable.sin(2 * np.pi * u) * portable.sin(np.pi * v)
     return np.stack([u + du, v + dv], axis=-1)
 
 
@@ -136,12 +136,12 @@ def pixel_centres(n: int) -> tuple[np.ndarray, np.ndarray]:
 
 def blob_field(n: int, centre=(0.3, 0.6), width: float = 0.08, background: float = 0.1) -> np.ndarray:
     u, v = pixel_centres(n)
-    return background + np.exp(-((u - centre[0]) ** 2 + (v - centre[1]) ** 2) / (2 * width**2))
+    return background + portable.exp(-((u - centre[0]) ** 2 + (v - centre[1]) ** 2) / (2 * width**2))
 
 
 def line_field(n: int) -> np.ndarray:
     u, v = pixel_centres(n)
-    return 0.05 + 0.5 * np.exp(-((u + v - 1.2) ** 2 / 2) / (2 * 0.04**2))
+    return 0.05 + 0.5 * portable.exp(-((u + v - 1.2) ** 2 / 2) / (2 * 0.04**2))
 
 
 def random_splats(k: int, seed: int) -> dict:
