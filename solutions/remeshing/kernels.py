@@ -643,8 +643,9 @@ def clean_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, min_angle):
         worst = face_min_angle(V, F[f, 0], F[f, 1], F[f, 2])
         if worst >= min_angle:
             continue
-        # flips first: the edge whose flip gives the largest smallest angle
-        best_h, best = -1, worst
+        # flips first: the edge whose flip gives the largest smallest angle. np.int64(-1), not -1: numba
+        # would compile flip, collapse and their checks once more for the literal -1 (here and below)
+        best_h, best = np.int64(-1), worst
         for k in range(3):
             h = 3 * f + k
             if T[h] < 0 or feat[h]:
@@ -657,13 +658,13 @@ def clean_pass(V, F, T, VH, val, cls, feat, falive, cnt, high, min_angle):
             done += 1
             continue
         # the shortest edge, into the end that keeps the face's neighbourhood best
-        hs, ls = -1, np.inf
+        hs, ls = np.int64(-1), np.inf
         for k in range(3):
             h = 3 * f + k
             L = length(V, F, h)
             if L < ls:
                 hs, ls = h, L
-        best_hh, best = -1, worst
+        best_hh, best = np.int64(-1), worst
         for side in range(2):
             hh = hs if side == 0 else T[hs]
             if hh < 0:

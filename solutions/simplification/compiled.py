@@ -92,7 +92,8 @@ def place(Q: np.ndarray, v1: tuple, v2: tuple) -> tuple:
     ``A x = -b`` is solved with the adjugate of ``A`` (its cofactors also give the determinant
     for the singularity test).
     """
-    A0, A1, A2 = vec(Q, 0), vec(Q, 1), vec(Q, 2)  # rows of A
+    # rows of A, not vec(Q, 0): numba compiles a kernel called with a constant once more, for the literal
+    A0, A1, A2 = (Q[0, 0], Q[0, 1], Q[0, 2]), (Q[1, 0], Q[1, 1], Q[1, 2]), (Q[2, 0], Q[2, 1], Q[2, 2])
     b = (Q[0, 3], Q[1, 3], Q[2, 3])
     c = Q[3, 3]
     adj0, adj1, adj2 = cross(A1, A2), cross(A2, A0), cross(A0, A1)  # A⁻¹ = [adj0 adj1 adj2] / det
@@ -345,7 +346,9 @@ def greedy_collapse(V, F, Q, normal0, on_boundary, target_faces, min_cos) -> np.
     version = np.zeros(n, np.int64)
     head, tail, next_corner = link_corner_lists(F, n)
     n_faces = m
-    heap, tiebreak = heap_of_all_edges(V, F, Q, face_alive, version, 0)  # equal costs pop in push order
+    # equal costs pop in push order; np.int64(0), not 0: a constant argument would make numba compile
+    # heap_of_all_edges twice (for the literal 0, then for the int64 of the later calls)
+    heap, tiebreak = heap_of_all_edges(V, F, Q, face_alive, version, np.int64(0))
     contracted_since_rebuild = 0
     while n_faces > target_faces:
         if len(heap) == 0:

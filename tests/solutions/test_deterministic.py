@@ -15,7 +15,10 @@ one flipped bit in a cost reorders the heap. These tests run the labs' graded ca
   loops (no AVX2/AVX-512 dispatch) and glibc's libm its non-FMA code — the switches a different
   CPU flips;
 * and check that numba's on-disk cache keeps one entry per CPU target (a kernel compiled for one
-  CPU is never loaded on another) and that a second process loads a kernel instead of compiling it.
+  CPU is never loaded on another) and that a second process loads a kernel instead of compiling it;
+* and check that no kernel is compiled for a literal argument type (a kernel called with a constant,
+  ``flip(..., -1)``, is compiled for ``Literal[int](-1)`` and again for int64: the same code twice in
+  every process that compiles it).
 
 Compiling is nearly all of the time (about 53 of the 60 CPU seconds of a compiled run; the runs
 themselves take a few), and each kind of compile happens once: this process compiles every kernel
@@ -220,6 +223,44 @@ def test_every_cases_inputs_are_the_same_bytes_on_another_machine(other):
         f"{len(moved)} cases' inputs differ on an emulated other CPU ({OTHER_MACHINE}): {moved[:12]}; "
         "a generator calls numpy's exp/sin/cos/arctan2/power, math.*, BLAS (@, np.dot, 1-D norm) or einsum: "
         "use geomlib.portable"
+    )
+
+
+def literal_signatures(lab: str) -> tuple[dict[str, list], list[str]]:
+    """``({kernel: [signatures]}, [kernels])``: the signatures with a literal argument type
+    (``Literal[int](-1)``) that numba's cache of the lab's kernel module holds for its current
+    source, and the kernels it holds nothing for (inlined ones aside). Every process that compiled
+    them wrote them there: a run that loaded its kernels from the cache sees them as well as one
+    that compiled them."""
+    from numba.core import types
+    from numba.core.dispatcher import Dispatcher
+
+    module = importlib.import_module(kernel_digests.KERNEL_MODULES[lab])
+    found, unindexed = {}, []
+    for name, disp in vars(module).items():
+        if not isinstance(disp, Dispatcher) or disp.py_func.__module__ != module.__name__:
+            continue
+        sigs = [key[0] for key in disp._cache._cache_file._load_index()]
+        if not sigs and disp.targetoptions.get("inline", "never") != "always":
+            unindexed.append(name)
+        if literal := [s for s in sigs if any(isinstance(t, types.Literal) for t in s)]:
+            found[name] = literal
+    return found, unindexed
+
+
+def test_each_kernel_is_compiled_once_per_argument_types(here):
+    # A kernel that another kernel calls with a constant (``flip(..., -1)``, or a variable first
+    # set to one) is compiled for the literal (``Literal[int](-1)``) and again for int64: the same
+    # code compiled twice in every process that compiles it (this one, the other machine's, each
+    # grader's). ``here`` ran every case, so every kernel they call has its cache index.
+    checked = {lab: literal_signatures(lab) for lab in kernel_digests.KERNEL_MODULES}
+    unindexed = {lab: u for lab, (_, u) in checked.items() if u}
+    assert not unindexed, (
+        f"numba's cache holds nothing for these kernels after the runs (nothing to check): {unindexed}"
+    )
+    found = {lab: f for lab, (f, _) in checked.items() if f}
+    assert not found, (
+        f"kernels compiled for a literal argument (pass a typed value, np.int64(-1), instead of a constant): {found}"
     )
 
 
