@@ -8,12 +8,12 @@ import numpy as np
 
 from geomlib.validate import MeshError, check_choice, check_float, check_mesh, checked
 
-from .contraction import make_state, state_mesh
+from .contraction import SimplifyState, make_state, state_mesh
 from .greedy import candidate_pairs, greedy_collapse
 from .quadrics import WEIGHTINGS, crease_quadrics, vertex_quadrics
 from .refit import refine_positions
 
-__all__ = ["qem_simplify", "SimplificationWarning"]
+__all__ = ["qem_simplify", "qem_simplify_series", "SimplificationWarning"]
 
 METHODS = ("greedy", "fast")
 
@@ -129,9 +129,25 @@ def qem_simplify(
         For an invalid mesh or parameter, and when the target cannot be reached without breaking
         manifoldness or flipping faces (``on_unreachable="raise"``).
     """
+    return _qem(V, F, target_faces, (), **_options(locals()))[0]
+
+
+def _options(given: dict) -> dict:
+    """The keyword options of :func:`qem_simplify` from its ``locals()``."""
+    return {k: given[k] for k in _OPTIONS}
+
+
+def _qem(V, F, target_faces, passing, *, pair_threshold, preserve_boundary, method, weighting, boundary_weight,
+         crease_angle, crease_weight, min_cos, on_unreachable, refit):  # fmt: skip
+    """:func:`qem_simplify`, also keeping the meshes of the greedy loop at the face counts ``passing``.
+
+    Returns ``((V, F), {count: (V, F)})``: the result, and the meshes kept on the way (see
+    :class:`_Passing`; empty when ``passing`` is, and for ``method="fast"``).
+    """
     where = "qem_simplify"
     V, F = check_mesh(V, F, where=where, manifold=True)
     target_faces = _check_target(target_faces, len(F))
+    passing = [_check_target(t, len(F)) for t in passing]
     pair_threshold = check_float(pair_threshold, "pair_threshold", minimum=0.0, where=where)
     if not isinstance(preserve_boundary, bool | np.bool_):
         raise MeshError(f"{where}: preserve_boundary must be True or False, got {preserve_boundary!r}")
@@ -157,6 +173,8 @@ def qem_simplify(
             Q += crease_quadrics(V, F, crease_angle, crease_weight)
         if method == "greedy":
             state = make_state(V, F, Q)
+            if passing:
+                state = _Passing(state, passing)
             _, others = candidate_pairs(V, F, pair_threshold)
             greedy_collapse(state, others, target_faces, min_cos)
             V_out, F_out = state_mesh(state)
@@ -176,5 +194,76 @@ def qem_simplify(
         )
         if on_unreachable == "raise":
             raise MeshError(msg)
-        warnings.warn(msg, SimplificationWarning, stacklevel=2)
-    return V_out, F_out
+        warnings.warn(msg, SimplificationWarning, stacklevel=3)
+    return (V_out, F_out), (state.kept if method == "greedy" and passing else {})
+
+
+#: The keyword options of :func:`qem_simplify` and their defaults.
+_OPTIONS: dict = dict(qem_simplify.__kwdefaults__)
+
+
+class _Passing(SimplifyState):
+    """A :class:`SimplifyState` that keeps the compact mesh (:func:`state_mesh`) at given face counts.
+
+    :func:`greedy_collapse` tests ``state.n_faces > target_faces`` before every contraction, the
+    previous one complete. The loop is deterministic and its target decides only when it stops, so
+    the first test that reads ``t`` faces or fewer sees the mesh a run to the target ``t`` stops
+    with: that mesh is kept in ``kept[t]``. A loop that never reads ``n_faces`` there keeps nothing
+    (:func:`qem_simplify_series` then runs to that target on its own).
+    """
+
+    def __init__(self, state: SimplifyState, counts):
+        self.__dict__.update(vars(state))
+        self._n = self.__dict__.pop("n_faces")
+        self.pending = sorted(set(counts), reverse=True)
+        self.kept: dict = {}
+
+    @property
+    def n_faces(self) -> int:
+        while self.pending and self._n <= self.pending[0]:
+            self.kept[self.pending.pop(0)] = state_mesh(self)
+        return self._n
+
+    @n_faces.setter
+    def n_faces(self, n: int) -> None:
+        self._n = n
+
+
+def qem_simplify_series(V, F, targets, **options) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``qem_simplify(V, F, t, **options)`` for every ``t`` of ``targets``, from one run of the loop.
+
+    A series of simplifications (the handout's 50%, 10% and 2% of the faces) need not repeat the
+    greedy loop from the input for each: the loop runs once, to the smallest target, and keeps the
+    mesh as it passes the others (the mesh a run to that target returns, bit for bit). With
+    ``method="fast"`` or ``refit``, and for a target the loop passed without reading its face
+    count, ``qem_simplify`` runs to that target on its own.
+
+    Parameters
+    ----------
+    V, F
+        As for :func:`qem_simplify`.
+    targets : sequence of int
+        Face counts, each as ``target_faces`` of :func:`qem_simplify`; any order, repeats allowed.
+    **options
+        The keyword options of :func:`qem_simplify`.
+
+    Returns
+    -------
+    list of (V, F)
+        One result per target, in the order of ``targets``.
+    """
+    unknown = sorted(set(options) - set(_OPTIONS))
+    if unknown:
+        raise MeshError(f"qem_simplify_series: unknown options {unknown}; qem_simplify takes {list(_OPTIONS)}")
+    targets = list(targets)
+    if not targets:
+        raise MeshError("qem_simplify_series: targets is empty; give at least one face count")
+    smallest = min(targets, key=lambda t: _check_target(t, np.iinfo(np.int64).max))  # integers >= 4
+    chosen = {**_OPTIONS, **options}
+    passing = [t for t in targets if t != smallest] if chosen["method"] == "greedy" and not chosen["refit"] else []
+    result, kept = _qem(V, F, smallest, passing, **chosen)
+    meshes = {int(smallest): result, **kept}
+    for t in targets:
+        if int(t) not in meshes:
+            meshes[int(t)] = qem_simplify(V, F, t, **options)
+    return [meshes[int(t)] for t in targets]

@@ -31,6 +31,7 @@ from solutions.simplification import (
     make_state,
     optimal_contraction,
     qem_simplify,
+    qem_simplify_series,
     state_mesh,
     vertex_quadrics,
 )
@@ -445,6 +446,36 @@ def test_boundary_is_kept_on_an_open_mesh():
     U, G = qem_simplify(V, F, len(F) // 10, preserve_boundary=False)
     loop = topology.boundary_loops(G)[0]  # still one loop, but it is free to move inwards
     assert distance_to_polyline(U[loop], V[B[:, 0]], V[B[:, 1]]).max() > 0.05 * diag
+
+
+@pytest.mark.parametrize(
+    "name, targets, options",
+    [
+        ("noisy icosphere", [320, 192, 64, 32, 13, 64], {}),
+        ("height field, no boundary quadrics", [300, 101, 40, 20], {"preserve_boundary": False}),
+        ("cracked sheets, non-edge pairs", [200, 61, 24], {"pair_threshold": 0.05, "boundary_weight": 0.1}),
+        ("fast loop", [300, 64, 20], {"method": "fast"}),
+    ],
+)
+def test_a_series_from_one_run_equals_a_run_per_target(name, targets, options):
+    """The figures' series (one greedy run kept as it passes each target) is each target's own run, bit for bit."""
+    from solutions.simplification.figures import cracked_sheet
+
+    if name.startswith("noisy"):
+        V, F = datasets.icosphere(3)
+        V = datasets.add_noise(V, 0.01, seed=1, direction="normal", F=F)
+    elif name.startswith("cracked"):
+        V, F = cracked_sheet(8)
+    else:
+        V, F = datasets.height_field(16)
+    series = qem_simplify_series(V, F, targets, **options)
+    assert len(series) == len(targets)
+    for t, (U, G) in zip(targets, series):
+        U1, G1 = qem_simplify(V, F, t, **options)
+        assert U.dtype == U1.dtype and G.dtype == G1.dtype, (name, t)
+        assert np.array_equal(U, U1) and np.array_equal(G, G1), (
+            f"{name}: target {t}: {len(G)} faces, a run to it {len(G1)}"
+        )
 
 
 def test_face_count_is_within_two_of_the_target():
