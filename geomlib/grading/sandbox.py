@@ -687,11 +687,16 @@ def _resolved(path: str) -> Path:
     return resolved(path)
 
 
-def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
+def _stubs_path(lab: str) -> Path:
+    """Where the course's stubs of ``lab`` are (``GEOMLIB_STUBS``, else the course's ``labs/``)."""
     base = setting("GEOMLIB_STUBS")
     from geomlib.grading.course import course
 
-    stubs = Path(base) / lab if base else course().lab(lab).stubs
+    return Path(base) / lab if base else course().lab(lab).stubs
+
+
+def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
+    stubs = _stubs_path(lab)
     if not stubs.is_dir() or _resolved(str(stubs)) == lab_dir.resolve():
         return None
     return stubs
@@ -780,6 +785,11 @@ def call(
             "lab": lab,
             "function": function,
             "stubs_dir": str(stubs) if stubs else None,
+            # The stubs graded in place (a student's labs/<lab>, `--impl labs`): the zygote preloads
+            # what their own imports use (zygote._preload_for), not numba & co. for every lab.
+            "preload_from": str(snap)
+            if stubs is None and _resolved(str(_stubs_path(lab))) == lab_dir.resolve()
+            else None,
             "memory_mb": memory_mb,
             "cpu_s": timeout,
             "cwd": str(snap),

@@ -366,36 +366,59 @@ def _worker_main(req: dict, blob: bytes, result_fd: int, out_fd: int) -> None:
 
 def _stub_imports(stubs_dir: str) -> set[str]:
     """The absolute modules the course's stubs import at their top level (parsed by prepare_stubs)."""
-    import ast
 
     names = set()
     for path in Path(stubs_dir).glob("*.py"):
-        tree = _worker._TREES.get((str(path), False))
-        for node in getattr(tree, "body", ()):
-            if isinstance(node, ast.Import):
-                names.update(a.name for a in node.names)
-            elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
-                names.add(node.module)
-                names.update(f"{node.module}.{a.name}" for a in node.names)
+        names |= _imports_in(getattr(_worker._TREES.get((str(path), False)), "body", ()))
+    return names
+
+
+def _imports_in(body) -> set[str]:
+    """The absolute modules (and ``module.name`` of ``from module import name``) the statements ``body`` import."""
+    import ast
+
+    names = set()
+    for node in body:
+        if isinstance(node, ast.Import):
+            names.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+            names.add(node.module)
+            names.update(f"{node.module}.{a.name}" for a in node.names)
+    return names
+
+
+def _top_imports(folder: str) -> set[str]:
+    """The absolute modules the ``.py`` files of ``folder`` import at their top level (parsed here,
+    never kept as the course's stubs: the folder is graded code)."""
+    import ast
+
+    names = set()
+    for path in Path(folder).glob("*.py"):
+        try:
+            names |= _imports_in(ast.parse(path.read_bytes()).body)
+        except (OSError, SyntaxError, ValueError, RecursionError, MemoryError):
+            continue
     return names
 
 
 _PRELOADED_FOR: set = set()
 
 
-def _preload_for(stubs_dir: str | None, function: str | None = None) -> None:
+def _preload_for(stubs_dir: str | None, function: str | None = None, own: str | None = None) -> None:
     """Import the modules of :data:`PRELOAD_IF_USED` the lab uses (all of them without stubs); with
     ``function``, only those the call may import (:func:`worker.may_import`): shadows' stubs import
-    scipy.ndimage (0.25 s of CPU) for a ray-casting helper that no graded call runs."""
+    scipy.ndimage (0.25 s of CPU) for a ray-casting helper that no graded call runs. ``own``: the
+    snapshot of stubs graded in place (no other stubs): the modules its files import (numba and its
+    warm-up cost 1.5 s of CPU at every start of the grader of a lab without it)."""
     todo = [m for m in PRELOAD_IF_USED if m not in sys.modules]
-    if not todo or (stubs_dir, function) in _PRELOADED_FOR:
+    if not todo or (stubs_dir, function, own) in _PRELOADED_FOR:
         return
-    _PRELOADED_FOR.add((stubs_dir, function))
-    used = _stub_imports(stubs_dir) if stubs_dir else None
+    _PRELOADED_FOR.add((stubs_dir, function, own))
+    used = _stub_imports(stubs_dir) if stubs_dir else (_top_imports(own) if own else None)
     for module in todo:
         if used is None or (
             any(n == u or n.startswith(u + ".") for n in used for u in PRELOAD_IF_USED[module])
-            and (function is None or _worker.may_import(stubs_dir, function, PRELOAD_IF_USED[module]))
+            and (function is None or not stubs_dir or _worker.may_import(stubs_dir, function, PRELOAD_IF_USED[module]))
         ):
             try:
                 importlib.import_module(module)
@@ -510,7 +533,8 @@ def _prepare(req: dict) -> None:
         pass
     try:
         if req.get("op") == "call":
-            _preload_for(req.get("stubs_dir"), req.get("function"))  # numba, scipy.fft: for the calls that use them
+            # numba, scipy.fft: for the calls that use them
+            _preload_for(req.get("stubs_dir"), req.get("function"), req.get("preload_from"))
     except Exception:  # noqa: BLE001 - the workers import them themselves
         pass
 

@@ -1,8 +1,13 @@
-"""The grading framework end to end on the sample course: scores, messages, hostile submissions."""
+"""The grading framework end to end on the sample course: scores, reports, messages, hostile submissions.
+
+The stubs and the solutions are graded once each for the module (:func:`sample_stubs_graded`,
+:func:`sample_solutions_graded`): the tests of their scores and of their reports read the same run
+(in one file, so that pytest-xdist's ``--dist loadfile`` keeps them in one process)."""
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import tempfile
 import textwrap
@@ -22,8 +27,40 @@ def _by_name(results: dict) -> dict[str, dict]:
     return {t["name"]: {**t, "output": plain_text(t.get("output", ""))} for t in results["tests"]}
 
 
-def test_solutions_score_full_marks_and_results_follow_the_schema(sample_course):
-    r = grade(sample_course, "solutions")
+@pytest.fixture(scope="module")
+def sample_stubs_graded(sample_course) -> tuple:
+    """``(stdout, results)`` of one ``geomlib grade --impl labs --results R`` on the sample course:
+    the report and the results of the stubs (tests below) come from one run (a
+    grade costs about 2 s of CPU, most of it the start of the grader and its zygote)."""
+    results = sample_course / "results" / "labs-shared.json"
+    p = run_geomlib(sample_course, "grade", "--impl", "labs", "--results", str(results))
+    assert p.stderr.strip() == "", p.stderr
+    return p.stdout, json.loads(results.read_text())
+
+
+@pytest.fixture(scope="module")
+def sample_solutions_graded(sample_course, tmp_path_factory) -> tuple:
+    """``(results, feedback folder)`` of one whole-lab ``geomlib grade --impl solutions --results R
+    --feedback F`` on the sample course, ``F`` holding beforehand old pictures, of a test that now
+    passes (``sample/tet-scale.png``) and a stray one (``an-old-test.png``), and a file of the
+    student's (``sample/notes.txt``): the solutions' score and the stale pictures' removal (tests below)
+    come from one run."""
+    feedback = tmp_path_factory.mktemp("solutions-feedback") / "feedback"
+    (feedback / "sample").mkdir(parents=True)
+    for name in ("tet-scale.png", "an-old-test.png"):
+        (feedback / "sample" / name).write_bytes(b"\x89PNG old picture")
+        os.utime(feedback / "sample" / name, (1e9, 1e9))
+    (feedback / "sample" / "notes.txt").write_text("mine")
+    results = sample_course / "results" / "solutions-shared.json"
+    p = run_geomlib(
+        sample_course, "grade", "--impl", "solutions", "--results", str(results), "--feedback", str(feedback)
+    )
+    assert p.stderr.strip() == "", p.stderr
+    return json.loads(results.read_text()), feedback
+
+
+def test_solutions_score_full_marks_and_results_follow_the_schema(sample_solutions_graded):
+    r, _ = sample_solutions_graded
     validate_results(r)
     assert r["score"] == sum(t["max_score"] for t in r["tests"]) == 7  # 6 public + 1 hidden point
     assert all(t["status"] == "passed" for t in r["tests"])
@@ -32,8 +69,8 @@ def test_solutions_score_full_marks_and_results_follow_the_schema(sample_course)
     assert "total" in r["output"] and "scaling" in r["output"]
 
 
-def test_stubs_score_zero_without_a_single_error(sample_course):
-    r = grade(sample_course, "labs")
+def test_stubs_score_zero_without_a_single_error(sample_stubs_graded):
+    _, r = sample_stubs_graded
     validate_results(r)
     assert r["score"] == 0
     pointed = [t for t in r["tests"] if t["max_score"] > 0]
@@ -42,6 +79,27 @@ def test_stubs_score_zero_without_a_single_error(sample_course):
         assert "not implemented yet" in t["output"], t
         assert "Traceback" not in t["output"]
     assert "Task 1 (scaling)" in _by_name(r)['sample › scaling › scale_about_centroid on "tet-scale"']["output"]
+
+
+def test_stub_report_is_concise_and_quiet(sample_stubs_graded):
+    lines = sample_stubs_graded[0].splitlines()
+    text = "\n".join(lines)
+    for noise in ("Warning", "FAILED", "Traceback", "=====", "short test summary", "[100%]"):
+        assert noise not in text, text
+    body = [ln for ln in lines if ln.startswith("  ✗")]
+    assert body and len(body) == len(set(body)), text
+    assert text.index("total") < text.index("What to fix"), text
+    assert all("not implemented yet" in ln for ln in body), text
+    assert lines.count(lines[0]) == 1  # the score table is printed once
+
+
+def test_a_whole_lab_run_removes_pictures_of_tests_that_pass_now(sample_solutions_graded):
+    """The run (the fixture) had an old picture of a test that passes now (``tet-scale.png``), a stray
+    old one that no test's name owns (``an-old-test.png``) and the student's ``notes.txt`` in its
+    feedback folder: both pictures go, the student's file stays."""
+    _, feedback = sample_solutions_graded
+    assert not list((feedback / "sample").glob("*.png"))
+    assert (feedback / "sample" / "notes.txt").read_text() == "mine"
 
 
 #: Folders made by :func:`_submission`, removed after each test (:func:`_remove_submissions`).

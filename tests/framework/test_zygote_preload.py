@@ -39,6 +39,18 @@ def preload(root, stub_import, modules):
     return LabProxy("prelab", lab, timeout=120).loaded()
 
 
+def graded_in_place(root, stub_import, modules):
+    # The course's stubs graded themselves (a student's labs/<lab>, `--impl labs`): no other stubs.
+    stubs = root / "stubs" / "prelab"
+    stubs.mkdir(parents=True)
+    (stubs / "ops.py").write_text(
+        (stub_import + "\\n" if stub_import else "") + "import sys\\n\\ndef loaded():\\n    names = list(sys.modules)\\n"
+        f"    return [m in names and names.index(m) < names.index('_graded_prelab') for m in {modules!r}]\\n"
+    )
+    os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
+    return LabProxy("prelab", stubs, timeout=120).loaded()
+
+
 def gl(root, first):
     stubs, lab = root / "stubs" / "gllab", root / "gllab"
     for folder in (stubs, lab):
@@ -62,20 +74,24 @@ def gl(root, first):
 out, zygotes = {}, set()
 for name, (kind, *args) in json.loads(sys.argv[2]).items():
     os.environ.pop("GEOMLIB_STUBS", None)
-    out[name] = (preload if kind == "preload" else gl)(Path(sys.argv[1]) / name, *args)
+    play = {"preload": preload, "in-place": graded_in_place, "gl": gl}[kind]
+    out[name] = play(Path(sys.argv[1]) / name, *args)
     zygotes.add(sandbox._STATE["zygote"].proc.pid)
     sandbox.shutdown()  # the next scenario starts a zygote of its own
 out["zygotes"] = len(zygotes)
 print(json.dumps(out))
 """
 
-#: Scenario name -> ("preload", the stub's import ("" none, "none": no known stubs), modules checked)
-#: or ("gl", the function called first). A lab whose stubs import none of them checks them all at once.
+#: Scenario name -> ("preload", the stub's import ("" none, "none": no known stubs), modules checked),
+#: ("in-place", the same, the stubs graded themselves) or ("gl", the function called first). A lab
+#: whose stubs import none of them checks them all at once.
 SCENARIOS = {
     "plain": ("preload", "", ["numba", "scipy.spatial", "scipy.ndimage"]),
     "njit": ("preload", "from numba import njit", ["numba"]),
     "jit": ("preload", "from geomlib.jit import use_cache_folder", ["numba"]),
     "no-stubs": ("preload", "none", ["numba"]),
+    "in-place": ("in-place", "", ["numba", "scipy.spatial", "scipy.ndimage"]),
+    "in-place-njit": ("in-place", "from numba import njit", ["numba"]),
     "scipy.spatial": ("preload", "import scipy.spatial", ["scipy.spatial"]),
     "scipy.ndimage": ("preload", "import scipy.ndimage", ["scipy.ndimage"]),
     "gl-loaded": ("gl", "loaded"),
@@ -110,6 +126,14 @@ def test_a_worker_of_a_numba_lab_inherits_numba(scenarios, scenario):
 
 def test_without_known_stubs_everything_is_preloaded(scenarios):
     assert scenarios["no-stubs"] == [True]
+
+
+def test_stubs_graded_in_place_preload_what_their_own_files_import(scenarios):
+    """``geomlib grade --impl labs`` and a student's grade of their labs/<lab>: the graded folder is
+    the course's stubs, so no other stubs say what the lab uses; its own imports do (numba's import
+    and warm-up cost 1.5 s of CPU at every start of the grader, for a lab without it too)."""
+    assert scenarios["in-place"] == [False, False, False], "the zygote preloaded for a lab that imports none"
+    assert scenarios["in-place-njit"] == [True], "a numba lab graded in place: its worker imported numba itself"
 
 
 @pytest.mark.parametrize("module", ["scipy.spatial", "scipy.ndimage"])

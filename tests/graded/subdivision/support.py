@@ -201,13 +201,17 @@ def matrix_check(name: str, *, atol: float = tol.EXACT, what_row: str = "row"):
     return checks.Custom(lambda e, g, ctx: matrix_mismatch(name, e[name], g.get(name), atol=atol, what_row=what_row))
 
 
-def canonical_faces(F) -> set:
-    """Faces as a set of oriented cycles, each rotated to start at its smallest index."""
+def _rotated(F) -> list[tuple]:
+    """Each face as an oriented cycle rotated to start at its smallest index."""
     F = np.asarray(F, dtype=np.int64)
     s = np.argmin(F, axis=1)
     k = F.shape[1]
-    R = np.take_along_axis(F, (s[:, None] + np.arange(k)) % k, axis=1)
-    return {tuple(r) for r in R.tolist()}
+    return list(map(tuple, np.take_along_axis(F, (s[:, None] + np.arange(k)) % k, axis=1).tolist()))
+
+
+def canonical_faces(F) -> set:
+    """Faces as a set of oriented cycles, each rotated to start at its smallest index."""
+    return set(_rotated(F))
 
 
 def faces_mismatch(name: str, expected, got) -> str | None:
@@ -229,7 +233,8 @@ def faces_mismatch(name: str, expected, got) -> str | None:
     if ce == cg:
         return None
     missing = sorted(ce - cg)
-    flipped = sum(1 for f in missing if canonical_faces([f[::-1]]) <= cg)
+    # All missing faces reversed in one array operation (a face at a time took seconds on a large mesh).
+    flipped = sum(1 for f in _rotated(np.array(missing, dtype=np.int64)[:, ::-1]) if f in cg)
     extra = sorted(cg - ce)
     msg = f"{len(missing)} of {len(E)} expected faces are missing, e.g. {format_vec(np.array(missing[0]))}"
     if extra:
