@@ -1,7 +1,9 @@
 """The stages of the loop (Tasks 4-9): split, collapse, flip, feature edges, tangential relaxation, projection.
 
 Stages 1-3 run the passes of :mod:`.kernels` (Tasks 4-6) on the state of :mod:`.state`; features
-(Task 7), relaxation (Task 8) and projection (Task 9) are vectorised NumPy.
+(Task 7), relaxation (Task 8) and projection (Task 9) are vectorised NumPy (the reference
+relaxation sums its faces with the given :func:`.kernels.face_sums`, a loop: on a small mesh a dozen
+NumPy calls per step were most of the loop's time).
 """
 
 from __future__ import annotations
@@ -162,25 +164,32 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     key = np.unique(np.minimum(a, b) * n + np.maximum(a, b))  # no new structure
     E = np.c_[key // n, key % n]
     deg = np.bincount(E.ravel(), minlength=n)
+    xyz = np.arange(3)
+    # bincount indices of 3-vectors summed at an edge's first / second end and at a face's corners
+    at0, at1, at_corner = ((I[..., None] * 3 + xyz).ravel() for I in (E[:, 0], E[:, 1], Fl))
+    # A vertex's candidates depend on its faces only: one whose faces did not move in the last pass
+    # (not fresh) gets the points it got then (P_at, flat_at: centroid, then the search's steps)
+    fresh = np.ones(n, bool)
+    P_at = np.empty((n, 1 + len(SEARCH_DIRECTIONS), 3))
+    flat_at = np.zeros((n, 1 + len(SEARCH_DIRECTIONS)), bool)
     for _ in range(passes):
         V = S.V[:n]
         angle = K.faces_min_angle(V, Fl)
-        bad = Fl[angle < np.radians(min_angle)]
-        cand = np.unique(bad)
+        cand = np.unique(Fl[angle < np.radians(min_angle)])
         cand = cand[S.cls[cand] == 0]
-        if not len(cand):
+        if not fresh[cand].any():  # nothing around them moved: the last pass's answers stand
             break
-        c = np.stack(
-            [np.bincount(E[:, 0], V[E[:, 1], k], n) + np.bincount(E[:, 1], V[E[:, 0], k], n) for k in range(3)], 1
-        )
-        X = _cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
-        N = np.stack([np.bincount(Fl.ravel(), np.repeat(X[:, k], 3), minlength=n) for k in range(3)], axis=1)[cand]
-        N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
-        D = c[cand] / np.maximum(deg[cand], 1)[:, None] - V[cand]
-        D -= np.einsum("ij,ij->i", D, N)[:, None] * N
         worst = np.isin(cand, Fl[angle < np.radians(SEARCH_ANGLE)])
-        if worst.any():  # the pattern search, after the centroid moves
-            w, Nw = cand[worst], N[worst]
+        new, search = cand[fresh[cand]], worst[fresh[cand]]
+        c = (np.bincount(at0, V[E[:, 1]].ravel(), 3 * n) + np.bincount(at1, V[E[:, 0]].ravel(), 3 * n)).reshape(n, 3)
+        X = _cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
+        N = np.bincount(at_corner, np.repeat(X, 3, axis=0).ravel(), 3 * n).reshape(n, 3)[new]
+        N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
+        D = c[new] / np.maximum(deg[new], 1)[:, None] - V[new]
+        D -= np.einsum("ij,ij->i", D, N)[:, None] * N
+        rows = new
+        if search.any():  # the pattern search, after the centroid moves
+            w, Nw = new[search], N[search]
             u = _cross(Nw, np.where(np.abs(Nw[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
             u /= np.maximum(np.sqrt(np.einsum("ij,ij->i", u, u)), 1e-300)[:, None]
             v = _cross(Nw, u)
@@ -188,16 +197,27 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
             length = np.sqrt(np.einsum("ij,ij->i", d, d))
             r = SEARCH_STEP * (np.bincount(E[:, 0], length, n) + np.bincount(E[:, 1], length, n))[w] / deg[w]
             D = np.concatenate([D] + [r[:, None] * (x * u + y * v) for x, y in SEARCH_DIRECTIONS])
-            cand = np.r_[cand, np.tile(w, len(SEARCH_DIRECTIONS))]
-        Q = V[cand] + D
+            rows = np.r_[new, np.tile(w, len(SEARCH_DIRECTIONS))]
+        Q = V[rows] + D
         P = project(Q)
         # where the surface bends away within the step (a tip, a ridge) the move would cut it: skip
         flat = np.einsum("ij,ij->i", P - Q, P - Q) <= 0.0625 * np.einsum("ij,ij->i", D, D)
-        cand, P = cand[flat], P[flat]
-        done = K.relocate_pass(*S.args(), cand, np.ascontiguousarray(P))
+        step = np.repeat(np.arange(1 + len(SEARCH_DIRECTIONS)), [len(new)] + [search.sum()] * len(SEARCH_DIRECTIONS))
+        P_at[rows, step], flat_at[rows, step] = P, flat
+        w = cand[worst]  # every candidate's points, in the order: centroids, then each step of the search
+        rows = np.r_[cand, np.tile(w, len(SEARCH_DIRECTIONS))]
+        step = np.repeat(np.arange(1 + len(SEARCH_DIRECTIONS)), [len(cand)] + [len(w)] * len(SEARCH_DIRECTIONS))
+        keep = flat_at[rows, step]
+        was = V[cand].copy()
+        done = K.relocate_pass(*S.args(), rows[keep], P_at[rows[keep], step[keep]], fresh)
         total += done
         if not done:
             break
+        moved = np.zeros(n, bool)
+        moved[cand[(V[cand] != was).any(axis=1)]] = True
+        fresh = moved.copy()
+        fresh[E[moved[E[:, 1]], 0]] = True
+        fresh[E[moved[E[:, 0]], 1]] = True
     return total
 
 
