@@ -375,8 +375,6 @@ def _stub_imports(stubs_dir: str) -> set[str]:
 
 def _imports_in(body) -> set[str]:
     """The absolute modules (and ``module.name`` of ``from module import name``) the statements ``body`` import."""
-    import ast
-
     names = set()
     for node in body:
         if isinstance(node, ast.Import):
@@ -390,8 +388,6 @@ def _imports_in(body) -> set[str]:
 def _top_imports(folder: str) -> set[str]:
     """The absolute modules the ``.py`` files of ``folder`` import at their top level (parsed here,
     never kept as the course's stubs: the folder is graded code)."""
-    import ast
-
     names = set()
     for path in Path(folder).glob("*.py"):
         try:
@@ -578,16 +574,7 @@ KERNEL_ZYGOTE_WAIT_S = 20.0
 
 def _uses_numba(folder: str) -> bool:
     """Whether a module of the lab folder imports numba (or :mod:`geomlib.jit`) at its top level."""
-    try:
-        for path in sorted(Path(folder).glob("*.py")):
-            for node in ast.parse(path.read_bytes()).body:
-                if isinstance(node, ast.Import | ast.ImportFrom) and not getattr(node, "level", 0):
-                    names = [node.module or ""] if isinstance(node, ast.ImportFrom) else [a.name for a in node.names]
-                    if any(n.split(".")[0] == "numba" or n == "geomlib.jit" for n in names):
-                        return True
-    except (OSError, SyntaxError, ValueError):
-        pass
-    return False
+    return any(n.split(".")[0] == "numba" or n == "geomlib.jit" for n in _top_imports(folder))
 
 
 def _kernel_key(req: dict) -> tuple | None:
