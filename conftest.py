@@ -68,7 +68,6 @@ class _OpenGLOnlyOnAHeadlessPlatform:
 #: tests compile a lab's kernels in one sandbox. In the quiet CI run of 2026-11-27 (869 s) the 18
 #: notebook runs, about 520 s, ran on one worker as one module.
 SPLIT = {
-    "tests/test_notebooks.py",
     "tests/test_course.py",
     "tests/framework/test_audit.py",
     "tests/framework/test_batch.py",
@@ -78,8 +77,9 @@ SPLIT = {
     "tests/solutions/test_simplification.py",
 }
 #: Modules whose module fixture is built per value of one parameter (the figures of one lab, drawn
-#: once for the comparison and the captions): one unit per value.
-SPLIT_BY = {"tests/test_figures_reproduce.py": "lab"}
+#: once for the comparison and the captions; one kernel running a notebook on the stubs and the
+#: solutions): one unit per value.
+SPLIT_BY = {"tests/test_figures_reproduce.py": "lab", "tests/test_notebooks.py": "path"}
 
 #: Seconds a unit of work (:func:`work_unit`) takes: its tests' durations in the quiet CI run of
 #: 2026-11-27 (869 s; modules and tests below its 30 slowest estimated from the loaded run). Only the
@@ -89,39 +89,31 @@ SPLIT_BY = {"tests/test_figures_reproduce.py": "lab"}
 SECONDS: dict[str, float] = {
     "tests/solutions/test_deterministic.py": 105,
     "tests/framework/test_release_course.py": 80,
-    "tests/test_notebooks.py::test_notebook_executes[remeshing]": 75,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[remeshing]": 58,
-    "tests/test_notebooks.py::test_notebook_executes[shadows]": 51,
+    # a notebook's two runs, stubs and solutions, in one kernel (sum of the two tests before)
+    "tests/test_notebooks.py:remeshing": 133,
+    "tests/test_notebooks.py:shadows": 89,
+    "tests/test_notebooks.py:sdf": 59,
+    "tests/test_notebooks.py:maps": 49,
+    "tests/test_notebooks.py:vdm": 44,
+    "tests/test_notebooks.py:relief": 41,
+    "tests/test_notebooks.py:denoise": 39,
+    "tests/test_notebooks.py:subdivision": 35,
+    "tests/test_notebooks.py:simplification": 32,
     "tests/graded/remeshing": 55,  # test_remeshing.py 50 s and its hidden tests
     "tests/framework/test_planted_labs.py::test_relief_hanging_shader_time_out_names_the_shader_the_task_and_the_cause": 43,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[shadows]": 38,
-    "tests/test_notebooks.py::test_notebook_executes[vdm]": 32,
-    "tests/test_notebooks.py::test_notebook_executes[sdf]": 31,
     "tests/framework/test_fresh_root.py": 29,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[sdf]": 28,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[maps]": 26,
     "tests/framework/test_batch.py::test_grade_all_as_root_on_the_documented_path_runs_student_code_as_the_sandbox_user": 25,
     "tests/solutions/test_sdf.py": 25,
-    "tests/test_notebooks.py::test_notebook_executes[denoise]": 24,
-    "tests/test_notebooks.py::test_notebook_executes[subdivision]": 23,
-    "tests/test_notebooks.py::test_notebook_executes[maps]": 23,
-    "tests/test_notebooks.py::test_notebook_executes[relief]": 22,
     "tests/framework/test_fresh_student.py": 21,
-    "tests/test_notebooks.py::test_notebook_executes[simplification]": 20,
     "tests/framework/test_hostile.py::test_detached_children_forged_lines_and_tampering_do_not_survive_the_call": 20,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[relief]": 19,
     "tests/test_figures_reproduce.py:sdf": 18,
     "tests/test_figures_reproduce.py:relief": 18,
     "tests/test_figures_reproduce.py:remeshing": 16,
     "tests/framework/test_course_object.py": 10,
     "tests/test_figures_reproduce.py:simplification": 15,
     "tests/framework/test_audit.py::test_every_mutant_changes_one_block_only_and_compiles[remeshing]": 15,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[denoise]": 15,
     "tests/test_course.py::test_solutions_reproduce_the_stored_references": 15,
     "tests/test_figures_reproduce.py:vdm": 12,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[simplification]": 12,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[subdivision]": 12,
-    "tests/test_notebooks.py::test_notebook_runs_on_the_stubs[vdm]": 12,
     "tests/test_figures_reproduce.py:shadows": 10,
 }
 

@@ -14,9 +14,13 @@ notebook.
 On the stubs, the figures cell's pictures are checked as ``tests/test_lab_contracts.py`` checks the
 stubs' figures (each names a task not implemented yet): the suite draws them once, here.
 
-A kernel runs its ``check()`` cells in one process: each is one pytest session, and they share one
-grading sandbox (the zygote, started by the first, with what it preloaded for the lab) and the
-kernels compiled earlier (:mod:`geomlib.grading.kernelcache`), as in a student's notebook.
+One kernel runs a notebook twice: on the stubs first, as in a student's fresh kernel, then, after a
+``%reset`` that drops every name the first run defined (:data:`_SWITCH`), on the solutions. The two
+runs share the kernel's start and the imports of the set-up and figures cells (about 2 s of CPU a
+notebook), and in :data:`PASSING_REPORT_IN` the grading sandbox. A kernel runs its ``check()`` cells
+in one process: each is one pytest session, and they share one grading sandbox (the zygote, started
+by the first, with what it preloaded for the lab) and the kernels compiled earlier
+(:mod:`geomlib.grading.kernelcache`), as in a student's notebook.
 """
 
 from __future__ import annotations
@@ -70,13 +74,13 @@ class _Kernel(KernelManager):
         return cmd
 
 
-def _figures(nb) -> list[tuple[str, str, np.ndarray]]:
+def _figures(cells) -> list[tuple[str, str, np.ndarray]]:
     """``(file name, caption, RGB pixels)`` of the figures the figures cell showed: a Markdown line
     ``**name.png** — caption``, then the picture."""
     from PIL import Image
 
     out, caption = [], None
-    for c in nb.cells:
+    for c in cells:
         for o in c.get("outputs", []) if c.cell_type == "code" else []:
             data = o.get("data", {})
             m = re.match(r"\*\*(\S+\.png)\*\* — (.*)", data.get("text/markdown", ""), re.S)
@@ -95,56 +99,116 @@ def _check_task(lab: str, source: str) -> int | None:
     return int(m.group(1)) if m else None
 
 
-def _execute(path: Path, *, solutions: bool) -> tuple[str, dict[int, dict], list]:
-    """Run the notebook in a fresh kernel; return its cells' printed text, ``{task: results}`` of
-    its check() cells and the figures it showed (:func:`_figures`). ``solutions``: the check()
-    cells are left out, but for the first one in the notebook of :data:`PASSING_REPORT_IN`."""
+#: The cell between the two runs of one kernel (:func:`_execute`): the state a student's fresh kernel
+#: would not have goes (every name the notebook defined or imported, ``Out``), and the second run
+#: grades and loads the other implementation (``open_lab`` and ``check()`` read ``GEOMLIB_IMPL``).
+_SWITCH = """\
+get_ipython().run_line_magic("reset", "-f")
+__import__("os").environ["GEOMLIB_IMPL"] = {impl!r}
+"""
+
+#: The two runs of every notebook, in the order one kernel runs them: the stubs (a student's fresh
+#: kernel), then the solutions.
+RUNS = ("labs", "solutions")
+
+
+def _cells(cells: list, lab: str, impl: str) -> list:
+    """The notebook's cells for a run on ``impl``: on the solutions, the check() cells are left out
+    but for the first one in the notebook of :data:`PASSING_REPORT_IN`."""
+    if impl == "solutions":
+        checks = [c for c in cells if c.cell_type == "code" and _check_task(lab, c.source) is not None]
+        keep = checks[:1] if lab == PASSING_REPORT_IN else []
+        cells = [c for c in cells if c not in checks or c in keep]
+    return cells
+
+
+_RUNS: dict[str, dict[str, tuple[str, dict[int, dict], list]]] = {}
+
+
+def _execute(path: Path, impl: str) -> tuple[str, dict[int, dict], list]:
+    """The notebook's run on ``impl`` (``"labs"`` or ``"solutions"``): its cells' printed text,
+    ``{task: results}`` of its check() cells and the figures it showed (:func:`_figures`).
+
+    Both runs of a notebook share one kernel, started once (a kernel and the notebook's imports:
+    about 2 s of CPU; the grading sandbox too, where both runs grade): the stubs run first, as in a
+    student's fresh kernel, then :data:`_SWITCH` and the run on the solutions (:func:`_cells`).
+    A cell that fails in either run fails both tests of the notebook (nbclient's error names the
+    cell)."""
+    if path.stem not in _RUNS:
+        _RUNS[path.stem] = _execute_both(path)
+    runs = _RUNS[path.stem]
+    got = runs.pop(impl)
+    if not runs:
+        del _RUNS[path.stem]
+    return got
+
+
+def _execute_both(path: Path) -> dict[str, tuple[str, dict[int, dict], list]]:
+    import copy
+    import os
+
     import nbformat
     from nbclient import NotebookClient
 
     lab = path.stem
     nb = nbformat.read(path, as_version=4)
     assert not any(c.get("outputs") for c in nb.cells if c.cell_type == "code"), f"{path.name} is stored with outputs"
-    if solutions:
-        checks = [c for c in nb.cells if c.cell_type == "code" and _check_task(lab, c.source) is not None]
-        keep = checks[:1] if lab == PASSING_REPORT_IN else []
-        nb.cells = [c for c in nb.cells if c not in checks or c in keep]
-    nb.cells.append(nbformat.v4.new_code_cell(_REPORTS))
+    parts = {}
+    cells = []
+    for impl in RUNS:
+        switch = [nbformat.v4.new_code_cell(_SWITCH.format(impl=impl))] if cells else []
+        run = [copy.deepcopy(c) for c in _cells(nb.cells, lab, impl)]
+        reports = nbformat.v4.new_code_cell(_REPORTS)
+        parts[impl] = (run, reports)
+        cells += [*switch, *run, reports]
+    nb.cells = cells
     scratch = Path(tempfile.gettempdir())
     before = set(scratch.glob(f"{lab}_*"))
-    NotebookClient(
-        nb,
-        timeout=CELL_TIMEOUT,
-        kernel_name="python3",
-        kernel_manager_class=_Kernel,
-        resources={"metadata": {"path": str(ROOT / "notebooks")}},
-    ).execute()
+    saved = {k: os.environ.get(k) for k in ("GEOMLIB_IMPL", "GEOMLIB_NO_FEEDBACK_PICTURES")}
+    os.environ["GEOMLIB_IMPL"] = RUNS[0]
+    os.environ["GEOMLIB_NO_FEEDBACK_PICTURES"] = "1"  # none expected; none left in notebooks/
+    try:
+        NotebookClient(
+            nb,
+            timeout=CELL_TIMEOUT,
+            kernel_name="python3",
+            kernel_manager_class=_Kernel,
+            resources={"metadata": {"path": str(ROOT / "notebooks")}},
+        ).execute()
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
     # A folder the kernel's last cells still wrote into goes when the kernel process exits (the
     # TemporaryDirectory's finaliser), which nbclient does not wait for: wait for that, for hangs only.
     deadline = time.monotonic() + 60
     while (left := sorted(set(scratch.glob(f"{lab}_*")) - before)) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not left, f"{path.name} leaves {[str(p) for p in left]} behind (a student runs it again and again)"
-    last = "".join(o.get("text", "") for o in nb.cells.pop().outputs)
-    by_count = json.loads(last.split("@@reports", 1)[1])
-    reports = {}
-    for c in nb.cells:
-        task = _check_task(lab, c.source) if c.cell_type == "code" else None
-        if task is not None:
-            assert str(c.execution_count) in by_count, f"{path.name}: check(task={task}) returned no report"
-            reports[task] = by_count[str(c.execution_count)]
-    text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
-    return text, reports, _figures(nb)
+    out = {}
+    for impl in RUNS:
+        run, reports_cell = parts[impl]
+        last = "".join(o.get("text", "") for o in reports_cell.outputs)
+        by_count = json.loads(last.split("@@reports", 1)[1])
+        reports = {}
+        for c in run:
+            task = _check_task(lab, c.source) if c.cell_type == "code" else None
+            if task is not None:
+                assert str(c.execution_count) in by_count, f"{path.name}: check(task={task}) returned no report"
+                reports[task] = by_count[str(c.execution_count)]
+        text = "".join(o.get("text", "") for c in run if c.cell_type == "code" for o in c.get("outputs", []))
+        out[impl] = (text, reports, _figures(run))
+    return out
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
-def test_notebook_executes(path, monkeypatch):
+def test_notebook_executes(path):
     """On the solutions: every cell but the check() cells runs; in one notebook the first check()
     cell runs too and reports full marks."""
-    monkeypatch.setenv("GEOMLIB_IMPL", "solutions")
-    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
-    _, reports, figures = _execute(path, solutions=True)
+    _, reports, figures = _execute(path, "solutions")
     assert figures, f"{path.name}: the figures cell showed no figure"
     missing = [f"{name}: {caption[:200]}" for name, caption, _ in figures if "not implemented yet" in caption]
     assert not missing, f"{path.name}: figures of the solutions with a missing task:\n" + "\n".join(missing)
@@ -160,7 +224,7 @@ def test_notebook_executes(path, monkeypatch):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
-def test_notebook_runs_on_the_stubs(path, monkeypatch):
+def test_notebook_runs_on_the_stubs(path):
     """As in the student bundle before any work: every cell runs, the missing tasks are named (in
     the figures too: :func:`tests.test_lab_contracts.untouched_stub_figure_problems`), and
     every task's check() scores 0 with no failure other than "not implemented yet" (a stub that
@@ -169,11 +233,9 @@ def test_notebook_runs_on_the_stubs(path, monkeypatch):
     from geomlib.grading.results import validate_results
 
     lab = path.stem
-    monkeypatch.setenv("GEOMLIB_IMPL", "labs")
-    monkeypatch.setenv("GEOMLIB_NO_FEEDBACK_PICTURES", "1")  # none expected; none left in notebooks/
     from tests.test_lab_contracts import untouched_stub_figure_problems
 
-    text, reports, figures = _execute(path, solutions=False)
+    text, reports, figures = _execute(path, "labs")
     assert "not implemented yet" in text
     problems = untouched_stub_figure_problems(lab, figures)
     assert not problems, f"{path.name}, figures cell:\n" + "\n".join(problems)

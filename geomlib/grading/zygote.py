@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import ast
 import ctypes
+import gc
 import importlib
 import json
 import os
@@ -497,11 +498,16 @@ def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
             os.close(out_fd)
             send_msg(sock, {"refused": True})
             continue
+        # The worker inherits every object of this process frozen: its garbage collections walk only
+        # what it made itself. Walking the inherited ones wrote to each of their pages, which the
+        # kernel then copied (measured: 0.25 -> 0.12 s of CPU per call of shadows' stubs).
+        gc.freeze()
         pid = os.fork()
         if pid == 0:
             sock.close()
             _worker_main(req, blob, result_fd, out_fd)
             os._exit(0)
+        gc.unfreeze()  # here they stay collectable: this process lives for a whole grading run
         os.close(result_fd)
         os.close(out_fd)
         send_msg(sock, {"pid": pid})
