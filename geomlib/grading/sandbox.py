@@ -687,19 +687,16 @@ def _resolved(path: str) -> Path:
     return resolved(path)
 
 
-def _stubs_path(lab: str) -> Path:
-    """Where the course's stubs of ``lab`` are (``GEOMLIB_STUBS``, else the course's ``labs/``)."""
+def _stubs_dir(lab: str, lab_dir: Path) -> tuple[Path | None, bool]:
+    """``(stubs, in_place)``: the course's stubs of ``lab`` (``GEOMLIB_STUBS``, else the course's
+    ``labs/``) to merge with ``lab_dir``, None when there are none or ``lab_dir`` is those stubs
+    themselves; ``in_place``: ``lab_dir`` is the course's stubs (a student's ``labs/<lab>``)."""
     base = setting("GEOMLIB_STUBS")
     from geomlib.grading.course import course
 
-    return Path(base) / lab if base else course().lab(lab).stubs
-
-
-def _stubs_dir(lab: str, lab_dir: Path) -> Path | None:
-    stubs = _stubs_path(lab)
-    if not stubs.is_dir() or _resolved(str(stubs)) == lab_dir.resolve():
-        return None
-    return stubs
+    stubs = Path(base) / lab if base else course().lab(lab).stubs
+    in_place = _resolved(str(stubs)) == lab_dir.resolve()
+    return (None if in_place or not stubs.is_dir() else stubs), in_place
 
 
 def _trusted(lab: str, lab_dir: Path, stubs: Path | None) -> bool:
@@ -775,7 +772,7 @@ def call(
     except Exception as e:  # noqa: BLE001
         raise GraderError(f"grader problem (not your code): cannot pass the inputs of {function} ({e})") from None
     lab_dir = Path(lab_dir)
-    stubs = _stubs_dir(lab, lab_dir)
+    stubs, in_place = _stubs_dir(lab, lab_dir)
     snap, jit = z.snapshot(lab_dir, stubs, trusted=_trusted(lab, lab_dir, stubs))
     max_bytes = max(tolerances.RESULT_MIN_MB << 20, tolerances.RESULT_INPUT_FACTOR * _input_bytes(args, kwargs))
     req = z.request(
@@ -787,9 +784,7 @@ def call(
             "stubs_dir": str(stubs) if stubs else None,
             # The stubs graded in place (a student's labs/<lab>, `--impl labs`): the zygote preloads
             # what their own imports use (zygote._preload_for), not numba & co. for every lab.
-            "preload_from": str(snap)
-            if stubs is None and _resolved(str(_stubs_path(lab))) == lab_dir.resolve()
-            else None,
+            "preload_from": str(snap) if in_place else None,
             "memory_mb": memory_mb,
             "cpu_s": timeout,
             "cwd": str(snap),
