@@ -12,8 +12,10 @@ or without FMA.
 
 What is the same everywhere are the IEEE-754 operations ``+ - * /`` and ``sqrt`` (correctly
 rounded), ``rint`` and ``ldexp`` (exact), each applied by a separate NumPy call (so no compiler can
-fuse a multiply and an add). Every function here is built from those alone: argument reduction and
-a Taylor polynomial of fixed degree, evaluated in a fixed order. Accuracy is within a few ulps of
+fuse a multiply and an add). Every function here is built from those alone: the elementary
+functions by argument reduction and a Taylor polynomial of fixed degree, evaluated in a fixed order;
+the sums of products (:func:`norm`, :func:`matmul`, the rasterizer's interpolation) by one row-wise
+:func:`dot` in index order. Accuracy is within a few ulps of
 the true value (the tests compare with NumPy's), for arguments of moderate size (``|x| < 1e5`` for
 ``sin`` and ``cos``: the reduction by pi/2 uses a three-part constant).
 """
@@ -24,7 +26,7 @@ import math
 
 import numpy as np
 
-__all__ = ["sin", "cos", "tan", "exp", "arctan2", "hypot", "matmul", "norm"]
+__all__ = ["sin", "cos", "tan", "exp", "arctan2", "hypot", "dot", "matmul", "norm"]
 
 # pi/2 in three parts of 33 bits (fdlibm's __ieee754_rem_pio2): k * part is exact for |k| < 2**20.
 _PIO2 = (1.57079632673412561417e00, 6.07710050630396597660e-11, 2.02226624871116645580e-21)
@@ -116,26 +118,38 @@ def hypot(x, y) -> np.ndarray:
     return np.sqrt(x * x + y * y)
 
 
+def dot(a, b, axis: int = -1) -> np.ndarray:
+    """``sum_i a[..., i] * b[..., i]`` along ``axis`` (``a`` and ``b`` broadcast), float64: the one
+    row-wise dot product behind :func:`norm`, :func:`matmul` and the rasterizer's and atlas's sums.
+
+    Why not ``(a * b).sum(axis)``, ``einsum``, ``np.dot`` or ``@``: BLAS picks its kernels per CPU
+    and sums in their order, an ``einsum`` may fuse a multiply and an add where the CPU has FMA,
+    and a reduction's order is numpy's business. Here the summation order is fixed (index order,
+    starting from the first product, so ``-0.0`` products keep their sign), and every product and
+    every sum is a separate NumPy call (nothing can contract them into an FMA): the result is the
+    same bits on every CPU. For short sums (3-vectors, 4×4 matrices, a triangle's corners): one
+    NumPy call per term.
+    """
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
+    a, b = np.moveaxis(a, axis, -1), np.moveaxis(b, axis, -1)  # views: no copy of a broadcast operand
+    out = a[..., 0] * b[..., 0]
+    for i in range(1, a.shape[-1]):
+        out = out + a[..., i] * b[..., i]
+    return out
+
+
 def norm(v, axis: int = -1) -> np.ndarray:
-    """Euclidean length along ``axis`` (a float for a 1-D ``v``), summed in index order without BLAS."""
-    v = np.asarray(v, dtype=np.float64)
-    v = np.moveaxis(v, axis, -1)
-    out = v[..., 0] * v[..., 0]
-    for i in range(1, v.shape[-1]):
-        out = out + v[..., i] * v[..., i]
-    out = np.sqrt(out)
+    """Euclidean length along ``axis`` (a float for a 1-D ``v``): ``sqrt(dot(v, v, axis))``."""
+    out = np.sqrt(dot(v, v, axis))
     return float(out) if out.ndim == 0 else out
 
 
 def matmul(A, B) -> np.ndarray:
-    """``A @ B`` for a 2-D ``A`` and a 1-D or 2-D ``B``, summed in index order without BLAS (small
-    inner dimension: camera matrices, points times a matrix)."""
+    """``A @ B`` for a 2-D ``A`` and a 1-D or 2-D ``B``, by :func:`dot` (no BLAS; small inner
+    dimension: camera matrices, points times a matrix)."""
     A, B = np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64)
     if A.ndim != 2 or B.ndim not in (1, 2) or A.shape[1] != B.shape[0]:
         raise ValueError(f"matmul: shapes {A.shape} and {B.shape} do not multiply (A 2-D, B 1-D or 2-D)")
     if B.ndim == 1:
-        return matmul(A, B[:, None])[:, 0]
-    out = A[:, 0, None] * B[0]
-    for k in range(1, A.shape[1]):
-        out = out + A[:, k, None] * B[k]
-    return out
+        return dot(A, B)
+    return dot(A[:, :, None], B[None], axis=1)

@@ -144,13 +144,6 @@ def _vertex_values(values, n: int, name: str, where: str) -> np.ndarray:
     return A
 
 
-def _weighted_corners(w: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """``sum_i w[:, i] * X[:, i]`` for weights ``(p, 3)`` and corner values ``(p, 3, ...)``, summed in
-    corner order by separate multiplies and adds (an ``einsum`` may fuse them where the CPU has FMA)."""
-    w = w.reshape(w.shape + (1,) * (X.ndim - 2))
-    return w[:, 0] * X[:, 0] + w[:, 1] * X[:, 1] + w[:, 2] * X[:, 2]
-
-
 def _interpolate(A: np.ndarray, F: np.ndarray, face_id: np.ndarray, bary: np.ndarray, mask: np.ndarray) -> np.ndarray:
     """``sum_i bary[..., i] * A[F[face_id, i]]`` on covered pixels, zero elsewhere; blockwise for memory."""
     out = np.zeros((mask.size,) + A.shape[1:])
@@ -158,7 +151,8 @@ def _interpolate(A: np.ndarray, F: np.ndarray, face_id: np.ndarray, bary: np.nda
     fid, b = face_id.reshape(-1), bary.reshape(-1, 3)
     for a in range(0, len(pix), _PIX_BLOCK):
         p = pix[a : a + _PIX_BLOCK]
-        out[p] = _weighted_corners(b[p], A[F[fid[p]]])
+        w = b[p].reshape((len(p), 3) + (1,) * (A.ndim - 1))  # corner weights against (p, 3, k) corner values
+        out[p] = portable.dot(w, A[F[fid[p]]], axis=1)  # not einsum: no FMA (same bits on every CPU)
     return out.reshape(mask.shape + A.shape[1:])
 
 
@@ -584,6 +578,6 @@ def _barycentrics(pix: np.ndarray, tri: np.ndarray, S: dict, width: int) -> np.n
     q /= q.sum(axis=1, keepdims=True)
     if S["B"] is None:
         return q
-    b = _weighted_corners(q, S["B"][tri])
+    b = portable.dot(q[:, :, None], S["B"][tri], axis=1)  # clipped corners' weights; same bits on every CPU
     np.clip(b, 0.0, None, out=b)
     return b / b.sum(axis=1, keepdims=True)

@@ -354,7 +354,7 @@ def triangle_atlas(
     l0 = np.linalg.norm(e0, axis=1)
     ok = l0 > 0
     ex = np.where(ok[:, None], e0 / np.where(ok, l0, 1.0)[:, None], 0.0)
-    x2 = e1[:, 0] * ex[:, 0] + e1[:, 1] * ex[:, 1] + e1[:, 2] * ex[:, 2]  # not einsum: no FMA (same bits everywhere)
+    x2 = portable.dot(e1, ex)  # not einsum: no FMA (same bits everywhere)
     y2 = np.linalg.norm(e1 - x2[:, None] * ex, axis=1)
     loc = np.zeros((m, 3, 2))
     loc[:, 1, 0] = l0

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from geomlib import portable
 from geomlib.topology import boundary_edges, edge_faces
 from geomlib.validate import check_choice, check_float, check_mesh
 
@@ -168,19 +169,19 @@ def crease_quadrics(V, F, angle_deg: float = 30.0, weight: float = 1.0) -> np.nd
     E, EF = E[inner], EF[inner]
     P, _ = face_planes(V, F)
     N1, N2 = P[EF[:, 0], :3], P[EF[:, 1], :3]
-    # Products and sums written out: which edges are creases must not depend on the CPU's SIMD paths.
-    cos = N1[:, 0] * N2[:, 0] + N1[:, 1] * N2[:, 1] + N1[:, 2] * N2[:, 2]
+    # geomlib.portable's dot (not einsum or BLAS): which edges are creases must not depend on the CPU.
+    cos = portable.dot(N1, N2)
     sharp = cos < np.cos(np.radians(angle_deg))
     if weight == 0 or not sharp.any():
         return Q
     E, EF = E[sharp], EF[sharp]
     a, e = V[E[:, 0]], V[E[:, 1]] - V[E[:, 0]]
-    e2 = e[:, 0] * e[:, 0] + e[:, 1] * e[:, 1] + e[:, 2] * e[:, 2]
+    e2 = portable.dot(e, e)
     for side in (0, 1):  # the constraint plane of each of the two faces
         m = np.cross(e, P[EF[:, side], :3])
-        length = np.sqrt(m[:, 0] * m[:, 0] + m[:, 1] * m[:, 1] + m[:, 2] * m[:, 2])
+        length = portable.norm(m)
         m = np.divide(m, length[:, None], out=np.zeros_like(m), where=length[:, None] > 0)
-        q = np.concatenate([m, -(m[:, 0] * a[:, 0] + m[:, 1] * a[:, 1] + m[:, 2] * a[:, 2])[:, None]], axis=1)
+        q = np.concatenate([m, -portable.dot(m, a)[:, None]], axis=1)
         K = (weight * e2)[:, None, None] * q[:, :, None] * q[:, None, :]
         np.add.at(Q, E[:, 0], K)
         np.add.at(Q, E[:, 1], K)

@@ -50,10 +50,15 @@ def test_arctan2_is_within_a_few_ulps_of_numpy_in_every_quadrant(rng):
     np.testing.assert_allclose(portable.arctan2(axes_y, axes_x), np.arctan2(axes_y, axes_x), rtol=1e-15, atol=0)
 
 
-def test_norm_hypot_and_matmul_agree_with_numpy(rng):
+def test_dot_norm_hypot_and_matmul_agree_with_numpy(rng):
     A, B, v = rng.normal(size=(7, 4)), rng.normal(size=(4, 3)), rng.normal(size=4)
     np.testing.assert_allclose(portable.matmul(A, B), A @ B, rtol=0, atol=1e-14)
     np.testing.assert_allclose(portable.matmul(A, v), A @ v, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(portable.dot(A, A[::-1], axis=1), np.einsum("ij,ij->i", A, A[::-1]), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(portable.dot(A, v), A @ v, rtol=0, atol=1e-14)  # broadcast
+    np.testing.assert_allclose(portable.dot(A, A, axis=0), np.einsum("ij,ij->j", A, A), rtol=0, atol=1e-14)
+    # Index order from the first product (not from +0.0): a single -0.0 product keeps its sign.
+    assert np.signbit(portable.dot([-0.0], [1.0])) and np.signbit(portable.dot([-0.0, 0.0], [1.0, -1.0]))
     np.testing.assert_allclose(portable.norm(A, axis=1), np.linalg.norm(A, axis=1), rtol=1e-15)
     assert portable.norm([3.0, 4.0]) == 5.0 and isinstance(portable.norm(v), float)
     np.testing.assert_allclose(portable.hypot(A[:, 0], A[:, 1]), np.hypot(A[:, 0], A[:, 1]), rtol=1e-15)
