@@ -44,7 +44,7 @@ Loaded once per grading process (:func:`kernels_in`, :func:`load_cached`): a wor
 kernels from the cache itself spends 0.03-0.1 s of CPU per call on it (reading numba's index,
 unpickling, linking the machine code) and on importing the lab; the grading process makes dozens
 of calls per lab. For the same trusted snapshots, the zygote forks a *kernel zygote*
-(:mod:`geomlib.grading.zygote`) that imports the lab and loads every kernel compiled for it from
+(:mod:`geomlib.grading.kernelzygote`) that imports the lab and loads every kernel compiled for it from
 the workers' private cache folder (only the grader and that snapshot's own workers can write it,
 as for :func:`publish`) once, then forks that snapshot's workers: they start with the kernels loaded.
 

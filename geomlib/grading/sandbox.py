@@ -305,7 +305,8 @@ class _Zygote:
         env.setdefault("OPENBLAS_NUM_THREADS", "1")
         env.setdefault("OMP_NUM_THREADS", "1")
         env.setdefault("MKL_NUM_THREADS", "1")
-        code = "import sys; from geomlib.grading.zygote import main; main()"
+        # the zygote, with its kernel zygotes for the course's own code of numba labs
+        code = "import sys; from geomlib.grading import kernelzygote; from geomlib.grading.zygote import main; main(kernelzygote)"
         self.proc = subprocess.Popen(
             [sys.executable, "-s", "-c", code, str(child.fileno())],
             pass_fds=[child.fileno()],
@@ -791,7 +792,7 @@ def call(
             "read": [str(snap)] + ([str(stubs)] if stubs else []),
             "not_allowed": _not_allowed(lab),
             "jit_cache": str(jit),
-            # the course's own code in its persistent snapshot: served by a kernel zygote (zygote.py)
+            # the course's own code in its persistent snapshot: served by a kernel zygote (kernelzygote.py)
             "trusted_kernels": z.shares_kernels(lab_dir),
         }
     )

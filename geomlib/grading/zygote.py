@@ -24,21 +24,10 @@ The zygote is a child subreaper: anything the student's code started and detache
 to it, and after each call it kills and reaps every remaining descendant before it tells the grader
 the call is over.
 
-Kernel zygotes. The course's own code (``solutions/<lab>``, ``labs/<lab>``: the snapshots that
-:mod:`geomlib.grading.kernelcache` trusts, graded with workers running as the grading user) of a
-numba lab is served by a fork of the zygote that has imported the lab's modules and loaded their
-compiled kernels once (:func:`_kernel_main`); it forks that snapshot's workers as the zygote does,
-which then start with the kernels loaded instead of loading them from disk at every call (0.03-0.1 s
-of CPU each). The zygote itself never imports a lab, so the workers of any other code (a
-submission, another snapshot) start as before: nothing of the course's solution in their memory,
-no machine code of it in their JIT. One kernel zygote at a time, for the last trusted snapshot;
-it starts no thread (parallel kernels are left to the workers) and imports only modules that define
-things and use no library the zygote has not loaded (:func:`worker.preload_lab`), so what a call
-prints or raises is the same.
-
-Longer than most modules (about 720 lines) on purpose: the zygote and the kernel zygotes run the
-same loop (fork, wait, kill what is left) and relay the same framed messages; split, the relay
-would need the loop's private state.
+Kernel zygotes (:mod:`geomlib.grading.kernelzygote`): the course's own code of a numba lab is
+served by a fork of the zygote that keeps the lab's compiled kernels loaded; it runs this module's
+loop (:func:`serve_calls`), and this loop hands it the calls of its snapshot (``kernels``). The
+zygote itself never imports a lab.
 """
 
 from __future__ import annotations
@@ -56,10 +45,9 @@ import socket
 import struct
 import sys
 import time
-import warnings
 from pathlib import Path
 
-from geomlib.grading import blacklist, kernelcache, landlock, seccomp
+from geomlib.grading import blacklist, landlock, seccomp
 from geomlib.grading import worker as _worker
 
 _PR_SET_PDEATHSIG = 1
@@ -439,7 +427,12 @@ def _warm_numba() -> None:
 # ---------------------------------------------------------------------------------- the server
 
 
-def serve(sock: socket.socket) -> None:
+def serve(sock: socket.socket, kernels=None) -> None:
+    """The zygote: set up, say it is ready, serve the grader's calls on ``sock`` until it closes.
+
+    ``kernels``: what hands the calls of trusted snapshots to kernel zygotes
+    (:mod:`geomlib.grading.kernelzygote`: its ``relayed`` and ``pids``), or None: every call is
+    served here."""
     _prctl(_PR_SET_CHILD_SUBREAPER, 1)  # without prctl (macOS): platform_notes says what is lost
     _prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM))
 
@@ -463,13 +456,18 @@ def serve(sock: socket.socket) -> None:
             "notes": platform_notes(),
         },
     )
-    _loop(sock, kernel_zygotes=True)
+    serve_calls(sock, kernels=kernels)
     kill_descendants()
 
 
-def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
-    """Serve the calls that come on ``sock`` until it closes: the zygote's, and a kernel zygote's
-    (``kernel_zygotes=False``: it relays nothing)."""
+def serve_calls(sock: socket.socket, *, kernels=None, before_fork=None) -> None:
+    """Serve the calls that come on ``sock`` until it closes: fork a worker per call, wait for it,
+    kill what it left. The zygote's loop, and a kernel zygote's.
+
+    ``kernels``: the zygote's kernel zygotes (see :func:`serve`); ``kernels.relayed(sock, req, blob,
+    fds)`` is True when one of them served the call, and their pids are kept when the leftovers of
+    a call are killed. ``before_fork``: a kernel zygote's check before each fork (False: it refuses
+    the call, and the zygote serves it itself)."""
     while True:
         try:
             req, blob, fds = recv_msg(sock, with_fds=True)
@@ -479,7 +477,7 @@ def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
             for fd in fds:
                 os.close(fd)
             break
-        if kernel_zygotes and _relayed(sock, req, blob, fds):
+        if kernels is not None and kernels.relayed(sock, req, blob, fds):
             continue
         result_fd, out_fd = fds
         t0 = time.monotonic()
@@ -493,8 +491,8 @@ def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
             blacklist.prepare(req.get("not_allowed"))  # where the lab's forbidden functions are referenced
         except Exception:  # noqa: BLE001 - each worker searches every module itself
             pass
-        if not kernel_zygotes and (_threads() != 1 or not _refresh_kernels()):
-            os.close(result_fd)  # a thread would not survive the fork: the zygote serves the call itself
+        if before_fork is not None and not before_fork():
+            os.close(result_fd)  # e.g. a thread would not survive the fork: the zygote serves the call itself
             os.close(out_fd)
             send_msg(sock, {"refused": True})
             continue
@@ -516,7 +514,7 @@ def _loop(sock: socket.socket, *, kernel_zygotes: bool) -> None:
             os.killpg(pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
-        leftovers = kill_descendants(keep=tuple(k.pid for k in _KERNELS.values()))
+        leftovers = kill_descendants(keep=kernels.pids() if kernels is not None else ())
         send_msg(sock, {"done": True, "status": status, "leftovers": leftovers, "seconds": time.monotonic() - t0})
 
 
@@ -541,207 +539,11 @@ def _prepare(req: dict) -> None:
         pass
 
 
-# ---------------------------------------------------------------------------------- kernel zygotes
-
-
-def _threads() -> int:
-    """This process's threads (1 where /proc cannot say: Linux is the only system with kernel zygotes)."""
-    try:
-        return len(os.listdir("/proc/self/task"))
-    except OSError:
-        return 1
-
-
-class _KernelZygote:
-    """The zygote's side of a kernel zygote: its pid, the socket to it and the snapshot it serves."""
-
-    def __init__(self, key: tuple, pid: int, sock: socket.socket):
-        self.key, self.pid, self.sock = key, pid, sock
-
-    def close(self) -> None:
-        self.sock.close()
-        try:
-            os.kill(self.pid, signal.SIGKILL)
-            os.waitpid(self.pid, 0)
-        except (ProcessLookupError, ChildProcessError):
-            pass
-
-
-#: The kernel zygotes of the last trusted snapshots called, most recent last (at most
-#: :data:`KERNEL_ZYGOTES`: a process that grades the solutions and the stubs of a lab in turn keeps
-#: both); the snapshots that may have one (True) and those that cannot (False: no numba, or it failed).
-_KERNELS: dict[tuple, _KernelZygote] = {}
-KERNEL_ZYGOTES = 2
-_KERNEL_USE: dict = {}
-#: How long the zygote waits for a kernel zygote (to import its lab, to fork a worker) before it
-#: kills it and serves the snapshot itself (the grader waits 60 s for a worker's pid).
-KERNEL_ZYGOTE_WAIT_S = 20.0
-
-
-def _uses_numba(folder: str) -> bool:
-    """Whether a module of the lab folder imports numba (or :mod:`geomlib.jit`) at its top level."""
-    return any(n.split(".")[0] == "numba" or n == "geomlib.jit" for n in _top_imports(folder))
-
-
-def _kernel_key(req: dict) -> tuple | None:
-    """The snapshot a kernel zygote would serve this call of, or None: only calls the grader marks
-    ``trusted_kernels`` (the course's own code, :mod:`geomlib.grading.kernelcache`) of a lab that
-    uses numba, with the JIT on, on Linux. A trusted snapshot's folder is named by its content."""
-    if req.get("op") != "call" or not req.get("trusted_kernels") or not req.get("jit_cache") or sys.platform != "linux":
-        return None
-    key = (req["lab"], req["lab_dir"], req.get("stubs_dir"), req["jit_cache"])
-    if key not in _KERNEL_USE:
-        _KERNEL_USE[key] = _uses_numba(req.get("stubs_dir") or req["lab_dir"])
-    if not _KERNEL_USE[key]:
-        return None
-    # Not before something was compiled for it (in an earlier run, or by an earlier call): a kernel
-    # zygote with nothing to load costs its start (simplification's graded calls use no kernel).
-    return key if key in _KERNELS or any(Path(req["jit_cache"]).rglob("*.nbi")) else None
-
-
-def _drop_kernel_zygote(key: tuple, *, for_good: bool) -> None:
-    """Kill the kernel zygote of ``key`` and any worker it left (they come back to the zygote); with
-    ``for_good``, that snapshot's calls are served by the zygote from now on."""
-    k = _KERNELS.pop(key, None)
-    if k is not None:
-        k.close()
-        kill_descendants(keep=tuple(k.pid for k in _KERNELS.values()))
-    if for_good:
-        _KERNEL_USE[key] = False
-
-
-def _relayed(sock: socket.socket, req: dict, blob: bytes, fds: list[int]) -> bool:
-    """Have the kernel zygote of the call's trusted snapshot serve it (started when there is none):
-    True when it did (the grader got its replies), False when the zygote must serve the call itself."""
-    key = _kernel_key(req)
-    if key is None:
-        return False
-    if key not in _KERNELS:
-        for old in list(_KERNELS)[: max(0, len(_KERNELS) - KERNEL_ZYGOTES + 1)]:
-            _drop_kernel_zygote(old, for_good=False)
-        _prepare(req)
-        if "numba" not in sys.modules:  # built here once, for every later kernel zygote
-            importlib.import_module("numba")
-            _warm_numba()
-        import numba
-
-        if numba.config.DISABLE_JIT or _threads() != 1:
-            _KERNEL_USE[key] = False
-            return False
-        k = _start_kernel_zygote(key, req, sock)
-        if k is None:
-            _KERNEL_USE[key] = False
-            return False
-        _KERNELS[key] = k
-    k = _KERNELS[key] = _KERNELS.pop(key)  # the most recent last
-    try:
-        k.sock.settimeout(KERNEL_ZYGOTE_WAIT_S)
-        send_msg(k.sock, req, blob, fds=fds)
-        head, _, _ = recv_msg(k.sock)
-        k.sock.settimeout(None)
-    except (OSError, EOFError, ValueError):
-        head = {}
-    if "pid" not in head:  # it refused (a thread), hung or died: the zygote serves this snapshot from now on
-        _drop_kernel_zygote(key, for_good=True)
-        return False
-    for fd in fds:
-        os.close(fd)
-    send_msg(sock, head)
-    try:
-        done, _, _ = recv_msg(k.sock)
-    except (OSError, EOFError, ValueError):  # it died during the call: its worker came back to us
-        _drop_kernel_zygote(key, for_good=True)
-        done = {"done": True, "status": 0, "leftovers": 0, "seconds": 0.0}
-    send_msg(sock, done)
-    return True
-
-
-def _start_kernel_zygote(key: tuple, req: dict, grader: socket.socket) -> _KernelZygote | None:
-    """Fork a kernel zygote for ``req``'s snapshot and wait until it is ready; None when it is not."""
-    ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
-    parent = os.getpid()
-    pid = os.fork()
-    if pid == 0:
-        try:
-            ours.close()
-            grader.close()
-            for other in _KERNELS.values():  # its siblings are the zygote's
-                other.sock.close()
-            _KERNELS.clear()
-            _kernel_main(theirs, req, parent)
-        finally:
-            os._exit(0)
-    theirs.close()
-    k = _KernelZygote(key, pid, ours)
-    ours.settimeout(KERNEL_ZYGOTE_WAIT_S)
-    try:
-        ready, _, _ = recv_msg(ours)
-    except (OSError, EOFError, ValueError):
-        ready = {}
-    if not ready.get("ready"):
-        k.close()
-        return None
-    return k
-
-
-#: A kernel zygote's snapshot (``req``), its modules' number, kernels and the index files it read.
-_KERNEL_STATE: dict = {}
-
-
-def _kernel_main(sock: socket.socket, req: dict, parent: int) -> None:
-    """A kernel zygote: import the trusted snapshot's modules, load their compiled kernels, serve."""
-    _prctl(_PR_SET_CHILD_SUBREAPER, 1)  # its workers' orphans come back to it
-    _prctl(_PR_SET_PDEATHSIG, int(signal.SIGTERM))
-    if os.getppid() != parent:
-        return
-    os.environ["NUMBA_CACHE_DIR"] = req["jit_cache"]  # the workers' own folder: the decorators read it
-    try:
-        importlib.import_module("geomlib.jit")
-        _KERNEL_STATE.update(req=req, modules=-1, kernels=[], seen={})
-        ready = _refresh_kernels()
-    except Exception:  # noqa: BLE001 - then it is not ready, and the zygote serves the calls
-        ready = False
-    send_msg(sock, {"ready": ready})
-    if ready:
-        _loop(sock, kernel_zygotes=False)
-        kill_descendants()
-
-
-def _refresh_kernels() -> bool:
-    """In a kernel zygote, before each fork: import the lab's modules that became importable (a call
-    imported a library they use) and load what was compiled for its kernels since it last looked.
-    False when a thread is running (then no worker may be forked from here), or when that issued a
-    warning (a ``SyntaxWarning`` of a lab file, say): a worker would have printed it, in the call's
-    output; then the zygote serves the snapshot itself."""
-    with warnings.catch_warnings(record=True) as issued:
-        _load_lab()
-    return _threads() == 1 and not issued
-
-
-def _load_lab() -> None:
-    """:func:`_refresh_kernels`' imports and loads."""
-    st = _KERNEL_STATE
-    if st and st["modules"] != len(sys.modules):
-        req = st["req"]
-        stubs = req.get("stubs_dir")
-        # the call's memory limit, as a worker's (soft: the workers set their own), while it imports
-        old = resource.getrlimit(resource.RLIMIT_AS)
-        if req.get("memory_mb"):
-            _set_limit("AS", _worker.vm_size_bytes() + int(req["memory_mb"]) * 2**20, old[1])
-        try:
-            modules = _worker.preload_lab(Path(req["lab_dir"]), req["lab"], Path(stubs) if stubs else None)
-        finally:
-            _set_limit("AS", *old)
-        st["kernels"] = kernelcache.kernels_in(modules)
-        st["modules"] = len(sys.modules)
-    if st:
-        kernelcache.load_cached(st["kernels"], st["seen"])
-
-
-def main() -> None:
+def main(kernels=None) -> None:
+    """The zygote process (``python -c``, the socket's descriptor in ``argv[1]``); ``kernels``: see :func:`serve`."""
     fd = int(sys.argv[1])
     sock = socket.socket(fileno=fd)
-    serve(sock)
+    serve(sock, kernels)
 
 
 if __name__ == "__main__":
