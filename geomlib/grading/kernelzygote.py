@@ -66,7 +66,8 @@ _KERNELS: dict[tuple, _KernelZygote] = {}
 KERNEL_ZYGOTES = 2
 _KERNEL_USE: dict = {}
 #: How long the zygote waits for a kernel zygote (to import its lab, to fork a worker) before it
-#: kills it and serves the snapshot itself (the grader waits 60 s for a worker's pid).
+#: kills it and serves the snapshot itself (the grader waits 60 s for a worker's pid; twice, when
+#: the call is sent again).
 KERNEL_ZYGOTE_WAIT_S = 20.0
 
 
@@ -109,7 +110,8 @@ def _drop_kernel_zygote(key: tuple, *, for_good: bool) -> None:
 
 def relayed(sock: socket.socket, req: dict, blob: bytes, fds: list[int]) -> bool:
     """Have the kernel zygote of the call's trusted snapshot serve it (started when there is none):
-    True when it did (the grader got its replies), False when the zygote must serve the call itself."""
+    True when the grader got its replies (the call's, or ``retry``: send it again), False when the
+    zygote must serve the call itself (no kernel zygote was given the call)."""
     key = _kernel_key(req)
     if key is None:
         return False
@@ -138,11 +140,19 @@ def relayed(sock: socket.socket, req: dict, blob: bytes, fds: list[int]) -> bool
         k.sock.settimeout(None)
     except (OSError, EOFError, ValueError):
         head = {}
-    if "pid" not in head:  # it refused (a thread), hung or died: the zygote serves this snapshot from now on
-        _drop_kernel_zygote(key, for_good=True)
-        return False
     for fd in fds:
         os.close(fd)
+    if "pid" not in head:
+        # It refused (a thread), hung or died after it was given the call's descriptors: a worker it
+        # forked may have written into the result pipe or the output file before it was killed, and
+        # the grader would read that as the call's result. So the call is not served here with these
+        # descriptors: the kernel zygote and everything it forked are killed and reaped, and the
+        # grader sends the call again with a new pipe, output file and scratch folder
+        # (``sandbox._Zygote.run``), which no process of the kernel zygote ever had. The zygote
+        # serves this snapshot itself from now on.
+        _drop_kernel_zygote(key, for_good=True)
+        send_msg(sock, {"retry": True})
+        return True
     send_msg(sock, head)
     try:
         done, _, _ = recv_msg(k.sock)

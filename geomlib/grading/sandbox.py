@@ -516,6 +516,18 @@ class _Zygote:
 
         ``req["jit_cache"]``: the numba cache of the submission's snapshot (:meth:`snapshot`).
         """
+        reply = self._attempt(req, blob, timeout, max_bytes)
+        if reply is None:
+            # A kernel zygote was given the call and failed (kernelzygote.relayed): once more, with a
+            # new pipe, output file and scratch folder that none of its processes ever had.
+            reply = self._attempt(req, blob, timeout, max_bytes)
+        if reply is None:
+            raise GraderError(f"the sandbox stopped working (it asked twice for the same call): {self.log_tail()}")
+        return reply
+
+    def _attempt(self, req: dict, blob: bytes, timeout: float, max_bytes: int | None) -> dict | None:
+        """:meth:`run` with its own result pipe, output file and scratch folder; None when the zygote
+        asks for the call to be sent again."""
         from geomlib.grading.zygote import recv_msg, send_msg
 
         r, w = os.pipe()
@@ -532,6 +544,8 @@ class _Zygote:
                 w = -1
                 self.sock.settimeout(60)
                 head, _, _ = recv_msg(self.sock)
+                if head.get("retry"):
+                    return None
                 pid = head["pid"]
             except (OSError, EOFError, ValueError, KeyError) as e:
                 raise GraderError(f"the sandbox stopped working ({e}): {self.log_tail()}") from None

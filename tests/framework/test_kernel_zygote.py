@@ -3,7 +3,7 @@
 A worker of a numba lab used to load its kernels from numba's disk cache at every call (0.03-0.1 s
 of CPU each, dozens of calls per grading run). For trusted snapshots only (the course's
 ``solutions/`` and ``labs/``, :mod:`geomlib.grading.kernelcache`), a fork of the zygote imports the
-lab and loads its kernels once and forks that snapshot's workers (:mod:`geomlib.grading.zygote`).
+lab and loads its kernels once and forks that snapshot's workers (:mod:`geomlib.grading.kernelzygote`).
 
 One grading process (:data:`GRADE`) makes the calls in order and reports, per call, what the worker
 found when it started: whether ``driver`` (a given kernel, called from Python) was loaded already,
@@ -101,7 +101,7 @@ print(json.dumps(out))
 """
 
 
-def grade(course: Path, *calls: str, **env_extra: str) -> list[list[float]]:
+def grade(course: Path, *calls: str, script: str = GRADE, **env_extra: str) -> list[list[float]]:
     env = {
         **os.environ,
         "GEOMLIB_ROOT": str(course),
@@ -110,7 +110,7 @@ def grade(course: Path, *calls: str, **env_extra: str) -> list[list[float]]:
         **env_extra,
     }
     env.pop("NUMBA_CACHE_DIR", None)
-    p = subprocess.run([sys.executable, "-c", GRADE, *calls], env=env, capture_output=True, text=True, timeout=900)
+    p = subprocess.run([sys.executable, "-c", script, *calls], env=env, capture_output=True, text=True, timeout=900)
     assert p.returncode == 0, p.stdout[-2000:] + p.stderr[-3000:]
     return json.loads(p.stdout.strip().splitlines()[-1])
 
@@ -200,3 +200,56 @@ def test_the_course_s_numba_labs_are_imported_by_their_kernel_zygote():
                 if path.stem not in ("__init__", "figures"):
                     tree = ast.parse(path.read_text())
                     assert worker._plain_top_level(tree), f"{path}: not plain, so every worker imports it again"
+
+
+#: Planted in the zygote (before its ``main``): a kernel zygote that, given a call, forks a worker
+#: that writes a forged result into the call's result pipe (and says so in ``{mark}``), then hangs.
+#: The zygote's wait for it is cut from 20 s to 3 s (the same constant, in the planted process only).
+PLANT = r"""
+import os, struct, time
+import numpy as np
+from geomlib.grading import wire
+from geomlib.grading import kernelzygote as kz
+from geomlib.grading.zygote import recv_msg, send_msg
+kz.KERNEL_ZYGOTE_WAIT_S = 3.0
+def _planted(sock, req, parent):
+    send_msg(sock, {{"ready": True}})
+    req, blob, fds = recv_msg(sock, with_fds=True)
+    pid = os.fork()
+    if pid == 0:
+        data = b"R" + wire.encode(np.full(6, -7.0))
+        os.write(fds[0], struct.pack("<Q", len(data)) + data)
+        open({mark!r}, "a").write("forged\n")
+        os._exit(0)
+    os.waitpid(pid, 0)
+    time.sleep(600)
+kz._kernel_main = _planted
+"""
+
+#: :data:`GRADE`, with the zygote it starts planted with :data:`PLANT` (formatted; ``argv[1]``).
+GRADE_PLANTED = (
+    """
+import subprocess, sys
+from geomlib.grading import sandbox
+_plant, _real = sys.argv.pop(1), subprocess.Popen
+def _popen(args, **kwargs):
+    if "geomlib.grading.zygote" in args[-2]:
+        args = [*args[:-2], _plant + args[-2], args[-1]]
+    return _real(args, **kwargs)
+sandbox.subprocess.Popen = _popen
+"""
+    + GRADE
+)
+
+
+def test_a_hung_kernel_zygote_s_worker_cannot_forge_the_result_of_the_call_served_in_its_place(course, tmp_path):
+    # The zygote gives up on a kernel zygote that does not answer and serves the call itself. A
+    # worker the kernel zygote forked had the call's result pipe and may have written into it before
+    # it was killed: the call must be served with descriptors no such worker ever had.
+    mark = tmp_path / "forged"
+    solution = course / "solutions" / "jitlab"
+    calls = [f"probe:{solution}"] * 3  # the first may compile (no kernel zygote before that)
+    replies = grade(course, PLANT.format(mark=str(mark)), *calls, script=GRADE_PLANTED)
+    assert mark.exists(), f"no kernel zygote was asked to serve a call: the plant did not run ({replies})"
+    for reply in replies:
+        assert reply[0] == 4.0, f"the grader read a result a hung kernel zygote's worker forged: {reply}"
