@@ -119,7 +119,7 @@ def hypot(x, y) -> np.ndarray:
 
 
 def dot(a, b, axis: int = -1) -> np.ndarray:
-    """``sum_i a[..., i] * b[..., i]`` along ``axis`` (``a`` and ``b`` broadcast), float64: the one
+    """``sum_i a[..., i] * b[..., i]`` along ``axis`` (the other axes broadcast), float64: the one
     row-wise dot product behind :func:`norm`, :func:`matmul` and the rasterizer's and atlas's sums.
 
     Why not ``(a * b).sum(axis)``, ``einsum``, ``np.dot`` or ``@``: BLAS picks its kernels per CPU
@@ -130,8 +130,12 @@ def dot(a, b, axis: int = -1) -> np.ndarray:
     same bits on every CPU. For short sums (3-vectors, 4×4 matrices, a triangle's corners): one
     NumPy call per term.
     """
-    a, b = np.broadcast_arrays(np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64))
-    a, b = np.moveaxis(a, axis, -1), np.moveaxis(b, axis, -1)  # views: no copy of a broadcast operand
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    ndim = max(a.ndim, b.ndim)  # align the shapes from the right, as broadcasting does (no copies)
+    a, b = a.reshape((1,) * (ndim - a.ndim) + a.shape), b.reshape((1,) * (ndim - b.ndim) + b.shape)
+    a, b = np.moveaxis(a, axis, -1), np.moveaxis(b, axis, -1)
+    if a.shape[-1] != b.shape[-1]:
+        raise ValueError(f"dot: {a.shape[-1]} and {b.shape[-1]} terms along axis {axis} (shapes {a.shape}, {b.shape})")
     out = a[..., 0] * b[..., 0]
     for i in range(1, a.shape[-1]):
         out = out + a[..., i] * b[..., i]

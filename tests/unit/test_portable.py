@@ -64,6 +64,8 @@ def test_dot_norm_hypot_and_matmul_agree_with_numpy(rng):
     np.testing.assert_allclose(portable.hypot(A[:, 0], A[:, 1]), np.hypot(A[:, 0], A[:, 1]), rtol=1e-15)
     with pytest.raises(ValueError, match="do not multiply"):
         portable.matmul(A, A)
+    with pytest.raises(ValueError, match="4 and 3 terms"):
+        portable.dot(A, B, axis=1)
 
 
 def test_integer_multiples_of_quarter_turns_are_exact_where_the_meshes_need_it():
