@@ -80,16 +80,29 @@ def mesh_visibility(V, F, P, light_center, light_radius, *, n: int = 256, seed: 
 
     Casts ``n`` stratified rays per point into the light's cone with
     :func:`geomlib.geometry.ray_cast` (watertight); a ray is blocked when it hits the mesh before
-    reaching the light. Standard error about ``sqrt(V (1 - V) / n)``.
+    reaching the light. Standard error about ``sqrt(V (1 - V) / n)``. The rays of a point whose cone
+    misses the mesh's bounding sphere are not cast (they would all miss): the same numbers, sooner.
     """
     where = "mesh_visibility"
     V, F = check_mesh(V, F, where=where, allow_duplicate=True)
     P, L, D, alpha = _light_cone(P, light_center, light_radius, where)
     n = check_int(n, "n", minimum=1, where=where)
-    Dir = cone_directions(L, alpha, n, seed).reshape(-1, 3)
-    O = np.repeat(P, n, axis=0)
-    tmax = np.repeat(D - float(light_radius), n)  # stop at the light's near side (no self-hits there)
+    Dir = cone_directions(L, alpha, n, seed)  # every point's directions, so the random stream is the same
+    # A point whose whole cone misses the mesh's bounding sphere (with a margin far above rounding) sees
+    # the whole light: its rays would all miss, so they are not cast (most points, under a small occluder).
+    c = 0.5 * (V.max(axis=0) + V.min(axis=0))
+    r = np.sqrt(((V - c) ** 2).sum(axis=1).max()) * (1 + 1e-6) + 1e-12
+    to_c = c - P
+    dc = np.linalg.norm(to_c, axis=1)
+    cos_ac = np.clip((to_c * L).sum(axis=1) / (dc * D), -1.0, 1.0)
+    misses = dc > r
+    misses[misses] = np.arccos(cos_ac[misses]) > alpha[misses] + np.arcsin(r / dc[misses]) + 1e-6
+    cast = np.flatnonzero(~misses)
+    Dir = Dir[cast].reshape(-1, 3)
+    O = np.repeat(P[cast], n, axis=0)
+    tmax = np.repeat(D[cast] - float(light_radius), n)  # stop at the light's near side (no self-hits there)
     eps = 1e-6 * float(np.linalg.norm(V.max(0) - V.min(0))) if t_min is None else t_min
     _, t, face, _ = ray_cast(V, F, O, Dir, t_min=eps)
-    blocked = (face >= 0) & (t < tmax)
-    return 1.0 - blocked.reshape(len(P), n).mean(axis=1)
+    blocked = np.zeros((len(P), n), bool)
+    blocked[cast] = ((face >= 0) & (t < tmax)).reshape(len(cast), n)
+    return 1.0 - blocked.mean(axis=1)

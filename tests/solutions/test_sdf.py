@@ -269,6 +269,29 @@ def test_soft_shadow_of_a_mesh_against_monte_carlo():
     assert np.all(est[truth > 0.999] > 0.95)
 
 
+def test_mesh_visibility_casts_every_ray_that_could_hit():
+    """``mesh_visibility`` casts only the rays of points whose cone meets the mesh's bounding sphere:
+    the same numbers, bit for bit, as casting every ray with ``geomlib.geometry.ray_cast``, on a grid
+    whose points lie in the light, in the penumbra, in the umbra and just beside the cone's edge."""
+    from geomlib.geometry import ray_cast
+    from solutions.sdf.truth import cone_directions
+
+    V, F = datasets.icosphere(2, radius=0.5)
+    V = V + [0, 0, 0.9]
+    xs = np.linspace(-2.0, 2.0, 41)
+    X, Y = np.meshgrid(xs, xs)
+    P = np.c_[X.ravel(), Y.ravel(), np.full(X.size, 1e-3)]
+    light, R, n = np.array([0.8, -0.5, 3.2]), 0.5, 16
+    got = mesh_visibility(V, F, P, light, R, n=n)
+    L = light - P
+    D = np.linalg.norm(L, axis=1)
+    Dir = cone_directions(L, np.arcsin(R / D), n, 0).reshape(-1, 3)
+    _, t, face, _ = ray_cast(V, F, np.repeat(P, n, axis=0), Dir, t_min=1e-6 * bbox_diagonal(V))
+    every = 1.0 - ((face >= 0) & (t < np.repeat(D - R, n))).reshape(len(P), n).mean(axis=1)
+    assert 0.2 < np.mean(every == 1.0) < 0.95 and (every == 0).any(), "the grid must hold lit, penumbra and umbra"
+    assert got.tobytes() == every.tobytes(), np.flatnonzero(got != every)[:10]
+
+
 def test_push_out_leaves_points_outside():
     sc = make_scene(spheres=[[0, 0, 0, 1.0]])
     P = np.random.default_rng(12).uniform(-0.7, 0.7, size=(200, 3))
