@@ -87,7 +87,8 @@ def test_every_task_of_the_handout_selects_tests_and_every_test_has_a_task(lab, 
     tests = selected[lab]
     assert tests, lab
     for n in sorted(numbers):
-        assert any(n in t or n in r for t, r, _ in tests.values()), f"--task {n} selects no graded test of {lab}"
+        own = [name for name, (t, _, _) in tests.items() if _tasks.selects(t, n)]
+        assert own or any(n in t or n in r for t, r, _ in tests.values()), f"--task {n} selects no graded test of {lab}"
     orphans = sorted(name for name, (t, _, _) in tests.items() if not t)
     assert not orphans, f"{lab}: no --task selects {orphans}"
 
@@ -104,7 +105,11 @@ def test_remeshing_local_operations_and_relief_shaders_are_their_tasks(selected)
         "test_flip_refuses_boundary_and_tetrahedron_edges": (3,),
     }
     assert {k: mesh[k][0] for k in expected} == expected
-    assert 4 in mesh["test_references[split-bumpy-sphere]"][0]
+    # split_long_edges runs Task 1's split through Task 4's pass: Task 4's test, not Task 1's
+    from geomlib.grading.tasks import selects
+
+    split = mesh["test_references[split-bumpy-sphere]"][0]
+    assert 4 in split and selects(split, 4) and not selects(split, 1)
     # the collapse and flip passes are graded through the loop only: --task 5 and 6 run its tests
     loop = mesh["test_references[remesh-bumpy-sphere]"]
     assert loop[0] == (10,) and {5, 6} <= set(loop[1])
@@ -122,6 +127,8 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     cli = run_geomlib(ROOT, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "1", cwd=tmp_path).stdout
     assert "no graded test" not in cli, cli
     assert "Task 1 (edge split)" in cli, cli
+    # only Task 1's tests: not the split pass's (Task 4), which runs split too
+    assert "split_long_edges" not in cli and "Task 4" not in cli, cli
     code = "from geomlib.grading import check\nprint(check('remeshing', task=1, impl='labs'))"
     env = {"GEOMLIB_ROOT": str(ROOT), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
     p = subprocess.run(
@@ -129,6 +136,38 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     )
     assert p.returncode == 0, p.stderr[-3000:]
     assert p.stdout.strip().splitlines() == cli.strip().splitlines()
+
+
+_STUBS = r"""
+import json, os, sys
+os.environ["GEOMLIB_NO_FEEDBACK_PICTURES"] = "1"
+from geomlib.grading import grade as G
+records = []
+G.grade("labs", sys.argv[1:], feedback_dir="", records_out=records)
+print(json.dumps({r.nodeid: r.message for r in records if r.not_implemented}))
+"""
+
+
+def test_a_task_on_the_untouched_stubs_names_no_later_task(selected):
+    """``--task N`` on the stubs of every lab: no selected test says that a later task is not
+    implemented yet (a student working in order has not reached it). Remeshing's split-bumpy-sphere
+    runs Task 1's split through Task 4's split_long_edges and said "Task 4" under ``--task 1``."""
+    from geomlib.grading.tasks import selects
+    from geomlib.taskref import find_task
+
+    labs = _impl.lab_names()
+    p = subprocess.run([sys.executable, "-c", _STUBS, *labs], capture_output=True, text=True, timeout=900, cwd=ROOT)
+    assert p.returncode == 0, p.stderr[-3000:]
+    messages = json.loads(p.stdout.strip().splitlines()[-1])
+    assert messages, "no test of the stubs said 'not implemented yet'"
+    problems = []
+    for nodeid, msg in messages.items():
+        lab, name = nodeid.split("/")[2], nodeid.split("::", 1)[1]
+        tasks = selected[lab][name][0]
+        m = find_task(msg)
+        for n in (n for n in tasks if selects(tasks, n) and m is not None and m.number > n):
+            problems.append(f"{lab}: --task {n} runs {name}, which says: {msg[:150]}")
+    assert not problems, "\n".join(problems)
 
 
 def _student_copy(lab: str, dest: Path) -> Path:

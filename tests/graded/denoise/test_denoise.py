@@ -461,7 +461,7 @@ def test_welded_uv_sphere_is_closed(lab):
     )  # fmt: skip
 
 
-@graded(points=1, part="seam fix")
+@graded(points=1, part="seam fix", tasks=(1, 6))  # weld=True runs Task 6's weld_seams
 def test_welded_offsets_match_the_seamless_torus(lab):
     """laplacian_offsets(weld=True) on the cut UV torus equals the offsets of the seamless torus (needs Task 1)"""
     Vu, Fu, _ = datasets.uv_torus(24, 12)
@@ -489,7 +489,7 @@ def test_welded_offsets_match_the_seamless_torus(lab):
     )  # fmt: skip
 
 
-@graded(points=1, part="seam fix")
+@graded(points=1, part="seam fix", tasks=(3, 6))  # weld=True (the default) runs Task 6's seam fix
 def test_direct_route_keeps_seams_closed(lab):
     """denoise_vertices(weld=True) moves the copies of every seam vertex identically (needs Task 3)"""
     V, F, _ = datasets.uv_sphere(12, 24)
