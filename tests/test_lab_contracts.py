@@ -174,9 +174,9 @@ def _panels_drawn(figures_module, out_dir) -> dict:
 
 
 def _stand_in(img: np.ndarray) -> bool:
-    """A ``missing_panel`` (light grey, a line of text; a colour bar may sit beside it): it says "not
-    implemented yet" itself."""
-    return bool((img == 225).all(axis=-1).mean() > 0.5)
+    """A ``missing_panel`` (light grey with a line of dark text; a colour bar may sit beside it): it
+    says "not implemented yet" itself. A crop of one (all grey, no text) says nothing."""
+    return bool((img == 225).all(axis=-1).mean() > 0.5 and (img.max(axis=-1) < 120).any())
 
 
 def _says_missing(label: str) -> bool:
