@@ -9,16 +9,14 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from geomlib.grading import impl as _impl
 
-from .course import run_geomlib
+from .course import run_geomlib, student_copy
 
 ROOT = _impl.course_root()
 
@@ -170,28 +168,10 @@ def test_a_task_on_the_untouched_stubs_names_no_later_task(selected):
     assert not problems, "\n".join(problems)
 
 
-def _student_copy(lab: str, dest: Path) -> Path:
-    """What a student's bundle holds of ``lab``: its stubs, public graded tests and references (no
-    hidden material, no solutions), with the grader, in ``dest``."""
-    from geomlib.grading.course import Course
-
-    hidden = shutil.ignore_patterns("__pycache__", "*hidden*")
-    for rel in ("geomlib", f"labs/{lab}", f"tests/graded/{lab}", f"tests/reference/{lab}"):
-        shutil.copytree(ROOT / rel, dest / rel, ignore=hidden)
-    for rel in (
-        "pyproject.toml",
-        "tests/conftest.py",
-        *(p.relative_to(ROOT) for p in (ROOT / "tests/graded").glob("*.py")),
-    ):
-        shutil.copy2(ROOT / rel, dest / rel)
-    assert not Course(dest).hidden_paths(), "the copy must hold no hidden material"
-    return dest
-
-
 def test_a_task_graded_through_the_loop_runs_the_loop_tests_and_says_so(tmp_path):
     """In the student's bundle, remeshing's Task 6 (equalize valences) has no public test of its own
     (its own checks are hidden): ``--task 6`` runs the loop's tests that call it, and says so."""
-    root = _student_copy("remeshing", tmp_path / "course")
+    root = student_copy("remeshing", tmp_path / "course")
     out = run_geomlib(root, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "6", cwd=tmp_path).stdout
     assert out.startswith("Task 6: equalize valences has no test of its own"), out
     assert "Task 10 (the loop)" in out, out
@@ -207,3 +187,26 @@ def _env() -> dict:
     import os
 
     return dict(os.environ)
+
+
+def test_public_graded_tests_do_not_import_the_hidden_cases():
+    """A student's bundle has no ``cases_hidden.py``: a public test that looks a case up by id among
+    public and hidden cases goes through ``common.hidden_cases`` (shadows' and maps' GLSL tests and
+    denoise's imported ``.cases_hidden`` and failed there with ModuleNotFoundError)."""
+    graded = ROOT / "tests" / "graded"
+    offenders = [
+        str(p.relative_to(ROOT))
+        for p in sorted(graded.glob("*/*.py"))
+        if "hidden" not in p.name
+        and re.search(r"^\s*(from\s+\.cases_hidden\s+import|import\s+.*cases_hidden)", p.read_text(), re.M)
+    ]
+    assert not offenders, f"public graded tests import the hidden cases: {offenders}"
+
+
+def test_a_public_glsl_test_runs_in_the_students_bundle(tmp_path):
+    """shadows' GLSL light pass (Task 9) graded in a student's bundle, on the solution: it passes."""
+    root = student_copy("shadows", tmp_path / "course")
+    out = run_geomlib(
+        root, "grade", "--impl", str(ROOT / "solutions"), "--lab", "shadows", "--task", "9", cwd=tmp_path
+    ).stdout
+    assert "ModuleNotFoundError" not in out and "What to fix" not in out, out

@@ -20,7 +20,7 @@ from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 from geomlib.textures import rasterize_uv
 
-from ..common import expect_rejected, expect_true
+from ..common import expect_rejected, expect_true, hidden_cases
 from .cases import CASES
 from .support import (
     PYRAMID_F,
@@ -603,9 +603,7 @@ def check_glsl_denoise(lab, case_id: str) -> None:
     """``glsl_denoise_with_map`` (shaders/denoise.vert, the vertex stage) on a map case: its stored reference."""
     from geomlib.grading.cases import load_reference
 
-    from .cases_hidden import CASES as HIDDEN
-
-    case = {c.id: c for c in (*CASES, *HIDDEN)}[case_id]
+    case = {c.id: c for c in (*CASES, *hidden_cases(__package__))}[case_id]
     inp = case.inputs()
     got = np.asarray(lab.glsl_denoise_with_map(**inp, **case.params), float)
     expected = load_reference("denoise", case)["V"]
