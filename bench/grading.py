@@ -5,8 +5,10 @@ speed while a task is wrong (issue #26 item 4).
 Feedback speed: a planted wrong task in three labs (subdivision's odd weight 3/8 -> 0.3, Task 1;
 vdm's sample_surface 1 % off, Task 2; shadows' light_uvz shifted in u, Task 3) graded as a student
 does, warm (a first run writes the bytecode and numba caches), with the default pictures (the first
-failure's). Targets: ``geomlib grade --task N`` and a notebook's ``check(lab, task=N)`` <= 3 s, the
-whole lab <= 10 s. Printed per run: wall time, the CPU time of the run (every process it started:
+failure's), in a student's bundle (the lab's stubs, public tests and references: hidden cases run
+only on the autograder, so the whole lab with them is printed too, without a target). Targets:
+``geomlib grade --task N`` and a notebook's ``check(lab, task=N)`` <= 3 s, the whole lab <= 10 s.
+Printed per run: wall time, the CPU time of the run (every process it started:
 this bench is a child subreaper, so orphans such as the zygote count too; a loaded machine shows up
 as wall >> CPU) and the load average.
 
@@ -117,10 +119,24 @@ def planted(lab: str) -> Path:
     return planted_solution(lab, edit).parent
 
 
-def _student_env() -> dict:
+def student_bundle(lab: str) -> Path:
+    """What a student grades: a copy of the course holding ``lab``'s stubs, public tests and
+    references only (no hidden cases: those run on the autograder), with the grader."""
+    sys.path.insert(0, str(ROOT))
+    from tests.framework.course import student_copy
+
+    base = Path(tempfile.mkdtemp(prefix=f"geomlib-bench-bundle-{lab}-"))
+    os.chmod(base, 0o755)  # the sandbox may run student code as another user, who reads the stubs
+    return student_copy(lab, base)
+
+
+def _student_env(root: Path = ROOT) -> dict:
     # A student's Python writes bytecode (this machine's sessions may not: that would time compiling).
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONDONTWRITEBYTECODE", "GEOMLIB_NO_FEEDBACK_PICTURES")}
     env.pop("GEOMLIB_MAX_FEEDBACK_PICTURES", None)
+    if root != ROOT:  # the bundle's own grader and tests
+        env["GEOMLIB_ROOT"] = str(root)
+        env["PYTHONPATH"] = str(root)
     return env
 
 
@@ -165,7 +181,7 @@ def verdict(wall: float, cpu: float, target: float) -> tuple[str, bool | None]:
     return "not shown under load (target < CPU <= 2 x target)", None
 
 
-def cli_run(impl: Path, lab: str, task: int | None, feedback: Path) -> tuple[float, float, str]:
+def cli_run(impl: Path, lab: str, task: int | None, feedback: Path, root: Path = ROOT) -> tuple[float, float, str]:
     """Wall and CPU seconds of ``geomlib grade`` as a student types it, and its report."""
     args = [
         sys.executable,
@@ -182,7 +198,7 @@ def cli_run(impl: Path, lab: str, task: int | None, feedback: Path) -> tuple[flo
     if task is not None:
         args += ["--task", str(task)]
     cpu0, t = _children_cpu(), time.perf_counter()
-    p = subprocess.run(args, cwd=ROOT, env=_student_env(), capture_output=True, text=True)
+    p = subprocess.run(args, cwd=root, env=_student_env(root), capture_output=True, text=True)
     return time.perf_counter() - t, _children_cpu() - cpu0, p.stdout + p.stderr
 
 
@@ -209,12 +225,12 @@ print(time.perf_counter() - t, cpu() - c0, sum(1 for line in r if line.strip().e
 """
 
 
-def notebook_run(impl: Path, lab: str, task: int, feedback: Path) -> tuple[float, float, int]:
+def notebook_run(impl: Path, lab: str, task: int, feedback: Path, root: Path = ROOT) -> tuple[float, float, int]:
     """Wall and CPU seconds of a second ``check(lab, task=N)`` in one live process (a notebook kernel)."""
     p = subprocess.run(
         [sys.executable, "-c", _NOTEBOOK, str(impl), lab, str(task), str(feedback)],
-        cwd=ROOT,
-        env=_student_env(),
+        cwd=root,
+        env=_student_env(root),
         capture_output=True,
         text=True,
         check=True,
@@ -237,19 +253,34 @@ def feedback_speed(labs: list[str] | None = None) -> bool:
         if labs and lab not in labs:
             continue
         impl = planted(lab)
+        bundle = student_bundle(lab)
         feedback = Path(tempfile.mkdtemp(prefix="geomlib-bench-feedback-"))
         try:
-            cli_run(impl, lab, task, feedback)  # warm-up: bytecode, numba caches
+            for root in (bundle, ROOT):
+                cli_run(impl, lab, task, feedback, root)  # warm-up: bytecode, numba caches
             rows = []
-            for what, n in ((f"grade --task {task}", task), ("grade (whole lab)", None)):
+            # What a student runs (the bundle: public tests), then the whole lab with the hidden
+            # cases as the autograder runs it (no target: students never run those).
+            for what, n, root in (
+                (f"grade --task {task}", task, bundle),
+                ("grade (whole lab)", None, bundle),
+                ("grade (whole lab + hidden)", None, ROOT),
+            ):
                 load = os.getloadavg()[0]
-                wall, cpu, report = cli_run(impl, lab, n, feedback)
+                wall, cpu, report = cli_run(impl, lab, n, feedback, root)
                 failing = next((ln for ln in report.splitlines() if ln.startswith("What to fix")), "What to fix (?)")
-                rows.append((what, wall, cpu, load, TARGET_TASK_S if n else TARGET_LAB_S, _pictures(report), failing))
+                target = None if root == ROOT else TARGET_TASK_S if n else TARGET_LAB_S
+                rows.append((what, wall, cpu, load, target, _pictures(report), failing))
             load = os.getloadavg()[0]
-            wall, cpu, pics = notebook_run(impl, lab, task, feedback)
+            wall, cpu, pics = notebook_run(impl, lab, task, feedback, bundle)
             rows.insert(1, (f"check({lab!r}, task={task})", wall, cpu, load, TARGET_TASK_S, pics, ""))
             for what, wall, cpu, load, target, pics, failing in rows:
+                if target is None:
+                    print(
+                        f"  {lab:<12} {what:<28} {wall:5.1f} s wall, {cpu:5.1f} s CPU  (no target; load {load:.1f}) "
+                        + failing.rstrip(":")
+                    )
+                    continue
                 text, met = verdict(wall, cpu, target)
                 ok &= met is True
                 print(
@@ -259,6 +290,7 @@ def feedback_speed(labs: list[str] | None = None) -> bool:
                 )
         finally:
             shutil.rmtree(impl, ignore_errors=True)
+            shutil.rmtree(bundle, ignore_errors=True)
             shutil.rmtree(feedback, ignore_errors=True)
     return ok
 

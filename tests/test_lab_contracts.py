@@ -144,3 +144,68 @@ def test_make_figures_draws_the_lab_it_is_given(tmp_path):
     with pytest.raises(Exception, match="lab must be a module"):
         figures.make_figures(tmp_path, lab="vdm", quick=True)
     assert isinstance(stubs, types.ModuleType)
+
+
+def _panels_drawn(figures_module, out_dir) -> dict:
+    """``{(figure title, panel index): [(RGB panel, label), ...]}`` of every ``panels`` call that
+    ``figures_module.make_figures(out_dir, quick=True)`` makes (the lab's figures and the given
+    placeholders both lay their pictures out with ``geomlib.plot.panels``)."""
+    import sys
+
+    from geomlib import plot
+
+    real, drawn = plot.panels, {}
+
+    def spy(images, captions=None, *args, **kwargs):
+        title = kwargs.get("title", args[1] if len(args) > 1 else None)
+        for i, img in enumerate(images):
+            drawn.setdefault((title, i), []).append((plot.to_rgb8(img), captions[i] if captions else ""))
+        return real(images, captions, *args, **kwargs)
+
+    users = [m for m in list(sys.modules.values()) if getattr(m, "panels", None) is real and m is not plot]
+    for m in users:
+        m.panels = spy
+    try:
+        figures_module.make_figures(out_dir, quick=True)
+    finally:
+        for m in users:
+            m.panels = real
+    return drawn
+
+
+def _stand_in(img: np.ndarray) -> bool:
+    """A ``missing_panel`` (light grey with a line of dark text; a colour bar may sit beside it): it
+    says "not implemented yet" itself. A crop of one (all grey, no text) says nothing."""
+    return bool((img == 225).all(axis=-1).mean() > 0.5 and (img.max(axis=-1) < 120).any())
+
+
+def _says_missing(label: str) -> bool:
+    """A panel label that says a task is missing: "... (not implemented yet: Task 3)", or a
+    placeholder's stub message "Task 3 (height to normals): ..."."""
+    from geomlib.taskref import task_at_start
+
+    return "not implemented" in label or task_at_start(label) is not None
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing(lab, tmp_path):
+    """A panel of a figure drawn from the untouched stubs either shows what the solution's shows, or
+    says that a task is missing (a grey stand-in, or "not implemented yet" in its label): no blank
+    or wrong panel passes for a result (relief's x3 close-up cropped two stand-ins into a blank
+    panel; its silhouette outlines compared the cylinder with itself)."""
+    stub = _panels_drawn(importlib.import_module(f"labs.{lab}.figures"), tmp_path / "labs")
+    unsaid = [
+        (key, i, img, label)
+        for key, items in stub.items()
+        for i, (img, label) in enumerate(items)
+        if not _says_missing(label) and not _stand_in(img)
+    ]
+    if not unsaid:  # every panel is a stand-in or says what it lacks: no need to draw the solution's
+        return
+    solution = _panels_drawn(importlib.import_module(f"solutions.{lab}.figures"), tmp_path / "solutions")
+    problems = []
+    for key, i, img, label in unsaid:
+        ref = solution.get(key, [])
+        if not (i < len(ref) and ref[i][0].shape == img.shape and np.array_equal(ref[i][0], img)):
+            problems.append(f"{lab}: panel {key[1]} of {key[0]!r} ({label!r}) differs from the solution's")
+    assert not problems, "\n".join(problems)

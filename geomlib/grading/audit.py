@@ -728,7 +728,7 @@ def _worker_main() -> int:
             records: list = []
             data = grade(
                 req["impl"], [req["lab"]], task=req["task"], feedback_dir="", extra_args=["-p", "geomlib.grading.audit"],
-                records_out=records,
+                records_out=records, every_test=True,
             )  # fmt: skip
             ids = [r.nodeid for r in records]
             ids = ids if len(ids) == len(data["tests"]) else [""] * len(data["tests"])

@@ -80,6 +80,10 @@ class Case:
     trivial_outputs : dict, optional
         ``{output: why}`` for outputs that are uninformative in an otherwise informative case
         (e.g. a handedness that is +1 on a mesh without mirrored UVs).
+    tasks : tuple of int, optional
+        Every task the case needs, where its part and function do not say them all (a parameter
+        that runs a later task: ``adaptive=True``); ``--task N`` selects it under the latest
+        (:func:`geomlib.grading.tasks.test_tasks`).
     """
 
     id: str
@@ -95,6 +99,7 @@ class Case:
     timeout: float | None = None
     trivial: str | None = None
     trivial_outputs: dict = field(default_factory=dict)
+    tasks: tuple = ()
 
     def __post_init__(self):
         if self.visibility not in VISIBILITIES:
@@ -136,14 +141,24 @@ class Case:
 
 
 def graded(
-    points: float, part: str, visibility: str = "visible", *, timeout: float | None = None, memory_mb: int | None = None
+    points: float,
+    part: str,
+    visibility: str = "visible",
+    *,
+    timeout: float | None = None,
+    memory_mb: int | None = None,
+    tasks: tuple = (),
 ):
-    """Mark a test as graded: its points, its part and its Gradescope visibility."""
+    """Mark a test as graded: its points, its part and its Gradescope visibility; ``tasks``: every
+    task it needs, where its part and the lab functions it calls do not say them all (as
+    :attr:`Case.tasks`)."""
     if visibility not in VISIBILITIES:
         raise ValueError(f"visibility must be one of {VISIBILITIES}")
     import pytest  # graded tests run under pytest; importing this module does not need it
 
-    return pytest.mark.graded(points=points, part=part, visibility=visibility, timeout=timeout, memory_mb=memory_mb)
+    return pytest.mark.graded(
+        points=points, part=part, visibility=visibility, timeout=timeout, memory_mb=memory_mb, tasks=tuple(tasks)
+    )
 
 
 def inputs_digest(inputs: dict, params: dict) -> str:

@@ -32,10 +32,15 @@ __all__ = ["grade", "check", "Report", "report_lines"]
 @dataclass
 class _Selection:
     """A pytest plugin (passed to ``pytest.main``): keeps the graded tests of one task or part,
-    and remembers the task of every graded test."""
+    and remembers the task of every graded test.
+
+    ``task``: the tests whose latest task it is (:func:`geomlib.grading.tasks.selects`), so a
+    student doing the tasks in order sees no test that needs a later one; ``every_test``: every test
+    that needs the task, whatever else it needs (the mutation audit: every test a bug can fail)."""
 
     task: int | None = None
     part: str | None = None
+    every_test: bool = False
     tasks: dict = field(default_factory=dict)  # nodeid -> tuple of task numbers
     titles: dict = field(default_factory=dict)  # lab -> TaskTable
     deselected: int = 0
@@ -64,7 +69,7 @@ class _Selection:
             except Exception:
                 t = ()
             self.tasks[item.nodeid] = t
-            ok = (self.task is None or self.task in t) and (
+            ok = (self.task is None or _tasks.selects(t, self.task, self.every_test)) and (
                 self.part is None or part.strip().lower() == self.part.strip().lower()
             )
             (keep if ok else drop).append(item)
@@ -72,7 +77,9 @@ class _Selection:
             for item in drop:  # the task has no test of its own: which tests run it (parsed only now)
                 if item.nodeid in self.tasks:
                     try:
-                        runs[item.nodeid] = self.task in _tasks.test_runs(item, self.titles[plugin.lab_of(item.path)])
+                        runs[item.nodeid] = self.task in self.tasks[item.nodeid] or self.task in _tasks.test_runs(
+                            item, self.titles[plugin.lab_of(item.path)]
+                        )
                     except Exception:
                         runs[item.nodeid] = False
         if self.task is not None and not [i for i in keep if i.nodeid in self.tasks] and any(runs.values()):
@@ -102,13 +109,19 @@ def grade(
     part: str | None = None,
     pictures: str | None = None,
     records_out: list | None = None,
+    every_test: bool = False,
 ) -> dict:
     """Grade ``impl`` (``solutions``, ``labs`` or a submission path) on ``labs`` (default: all).
 
     Parameters
     ----------
     task : int, optional
-        Only the graded tests of this task (``Task 2`` in the stubs).
+        Only the graded tests of this task (``Task 2`` in the stubs): those whose latest task it is,
+        so a student working in order meets no later task's test (a task without such a test: the
+        tests that run it, and the report says so).
+    every_test : bool
+        With ``task``: every graded test that needs the task, also with later ones (the mutation
+        audit's question: which tests can a bug of this task fail).
     part : str, optional
         Only the graded tests of this part (``"boundary rules"``), as in the score table.
     verbose : bool
@@ -161,7 +174,7 @@ def grade(
     ]
     args += extra_args or []
     run = plugin.GradingRun(GradingSettings.build(impl=impl, feedback_dir=feedback_dir))
-    selection = _Selection(task=task, part=part)
+    selection = _Selection(task=task, part=part, every_test=every_test)
     owners = _PictureOwners()
     _start_sandbox_early()
     t0 = time.time()

@@ -10,9 +10,11 @@ Students edit the stubs, so the markers disappear as they work: each lab therefo
 table in ``tests/graded/<lab>/diagnose.py`` (``TASKS``, ``TITLES``, ``COMPOSITES``), and a framework
 test checks that the declaration matches what :func:`derive` reads from the solutions.
 
-A graded test's task: the task whose title is the test's part ("boundary rules" is Task 4), else
-the main tasks of the lab functions it calls (``Case.function``, or ``lab.<name>(...)`` in a
-hand-written test).
+A graded test's tasks: those it declares (``Case(tasks=...)``, ``graded(tasks=...)``: where a
+parameter runs a later task), else the task whose title is the test's part ("boundary rules" is
+Task 4), else the main tasks of the lab functions it calls (``Case.function``, or
+``lab.<name>(...)`` in a hand-written test). ``--task N`` runs the tests whose latest task is N
+(:func:`selects`).
 """
 
 from __future__ import annotations
@@ -29,7 +31,17 @@ from geomlib.grading.course import course
 from geomlib.grading.registry import graded_module
 from geomlib.taskref import find_task
 
-__all__ = ["TaskTable", "derive", "table", "lab_calls", "named_functions", "test_functions", "test_tasks", "test_runs"]
+__all__ = [
+    "TaskTable",
+    "derive",
+    "table",
+    "lab_calls",
+    "named_functions",
+    "test_functions",
+    "test_tasks",
+    "test_runs",
+    "selects",
+]
 
 #: A shader named in a lab function: ``"parallax"`` (``shaders/parallax.frag``) or ``"tbn.vert"``.
 _SHADER = re.compile(r"[A-Za-z_]\w*(\.(?:frag|vert))?")
@@ -303,19 +315,30 @@ def test_functions(item, tab: TaskTable) -> list[str]:
 
 def test_tasks(item, tab: TaskTable, part: str) -> tuple[int, ...]:
     """The tasks of a collected graded pytest item (see the module docstring)."""
+    marker = item.get_closest_marker("graded")
+    callspec = getattr(item, "callspec", None)
+    case = callspec.params.get("case") if callspec is not None else None
+    declared = getattr(case, "tasks", ()) or (marker.kwargs.get("tasks", ()) if marker is not None else ())
+    if declared:
+        return tuple(sorted(int(t) for t in declared))
     n = tab.of_part(part)
     if n is not None:
         return (n,)
-    callspec = getattr(item, "callspec", None)
-    case = callspec.params.get("case") if callspec is not None else None
-    if case is not None and getattr(case, "task", None):
-        return (int(case.task),)
     out: list[int] = []
     for name in test_functions(item, tab):
         for t in tab.of_function(name):
             if t not in out:
                 out.append(t)
     return tuple(sorted(out))
+
+
+def selects(tasks: tuple[int, ...], n: int, every_test: bool = False) -> bool:
+    """Whether ``--task n`` selects a graded test of ``tasks`` (:func:`test_tasks`): the tests whose
+    latest task is ``n``, the ones a student who does the tasks in order can pass once Task ``n`` is
+    done. A test that needs a later task too is that task's (remeshing's ``split_long_edges`` case runs
+    Task 1's ``split`` through Task 4's pass: Task 4's), so ``--task 1`` on the stubs names no later
+    task's "not implemented". ``every_test``: every test that needs ``n`` (the mutation audit)."""
+    return n in tasks if every_test else bool(tasks) and max(tasks) == n
 
 
 def test_runs(item, tab: TaskTable) -> tuple[int, ...]:

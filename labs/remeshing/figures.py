@@ -224,14 +224,17 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
         result = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its))
         if result is None:
             imgs.append(_blank(size))
-            caps.append("isotropic_remesh: not implemented yet")
+            caps.append(f"isotropic_remesh: not implemented yet (Task {missing[-1]})")
         else:
             imgs.append(render(*result, **valence_dots(*result), **kw))
             caps.append(f"remeshed, L = {L}: {_summary(quality(*result))}")
         meshes = [(V, F)] + ([result] if result is not None else [])
         hist_size = (max(size[0] + 40, 360), max(size[1], 280))
         imgs.append(_histogram(meshes, ["input", "remeshed"][: len(meshes)], hist_size, "angles (60° = equilateral)"))
-        caps.append(f"corner angles of the {name.split(' (')[0]}")
+        caps.append(
+            f"corner angles of the {name.split(' (')[0]}"
+            + ("" if result is not None else f" (remeshed: not implemented yet, Task {missing[-1]})")
+        )
     img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {DOTS_TITLE}")
     return Drawn(
         img,

@@ -94,17 +94,19 @@ def _try(fn, size):
 
 
 def _method_panels(H, kind, size, dropped: dict):
-    """The method panels and their labels; ``dropped`` receives where the discard pass cut (pixel counts)."""
+    """The method panels, their labels and, per panel, the "not implemented yet" note of a panel left out
+    (else None); ``dropped`` receives where the discard pass cut (pixel counts)."""
     mask, uv, view, _, _ = quad_gbuffer(size)
     m = mask
     up = np.zeros_like(view)
     up[..., 2] = 1.0
-    imgs, caps = [], []
+    imgs, caps, notes = [], [], []
 
     def add(label, make):
         out, note = _try(make, size)
         imgs.append(out if out is not None else _missing(size))
         caps.append(label + (note or ""))
+        notes.append(note)
 
     add("flat", lambda: shade(H, kind, m, uv, up))
     add("bump (Blinn)", lambda: shade(H, kind, m, uv, bump_normal(H, uv, strength=SCALE)))
@@ -140,7 +142,7 @@ def _method_panels(H, kind, size, dropped: dict):
     truth, _ = exact_uv(H, uv, view, scale=SCALE, samples=1024)
     add("exact ray / height-field hit", lambda: shifted(truth))
     add("true displaced geometry (rasterized grid)", lambda: _displaced(H, kind, size))
-    return imgs, caps
+    return imgs, caps, notes
 
 
 def _displaced(H, kind, size):
@@ -165,16 +167,23 @@ def _fig_methods(out: Path, quick: bool) -> list[Figure]:
     figs = []
     for kind, H in (("bricks", bricks(128 if quick else 256)), ("bumps", bumps(128 if quick else 256))):
         dropped: dict = {}
-        imgs, caps = _method_panels(H, kind, size, dropped)
+        imgs, caps, notes = _method_panels(H, kind, size, dropped)
         mask, _, view, _, _ = quad_gbuffer(size)
         deg = np.degrees(np.arccos(view[mask][:, 2]))
         # A close-up of the far, grazing edge, where the methods differ most: steep parallax over POM (secant).
         rows = np.nonzero(mask.any(axis=1))[0]
         r0, h, c0, w = rows.min() + 2, size // 7, size // 3, size // 3
-        crops = [np.asarray(imgs[i], float)[r0 : r0 + h, c0 : c0 + w] for i in (4, 6)]
-        gap = np.ones((4, w, 3))
-        imgs.append(np.repeat(np.repeat(np.vstack([crops[0], gap, crops[1]]), ZOOM, 0), ZOOM, 1))
-        caps.append(f"x{ZOOM} close-up of the far edge: steep (top, one band per layer) and POM secant (bottom)")
+        shown = (4, 6)
+        note = next((notes[i] for i in shown if notes[i]), None)  # a crop of a stand-in panel would be blank
+        if note:
+            imgs.append(missing_panel((2 * h + 4) * ZOOM, w * ZOOM) / 255.0)
+        else:
+            crops = [np.asarray(imgs[i], float)[r0 : r0 + h, c0 : c0 + w] for i in shown]
+            gap = np.ones((4, w, 3))
+            imgs.append(np.repeat(np.repeat(np.vstack([crops[0], gap, crops[1]]), ZOOM, 0), ZOOM, 1))
+        caps.append(
+            f"x{ZOOM} close-up of the far edge: steep (top, one band per layer) and POM secant (bottom)" + (note or "")
+        )
         img = panels(
             imgs,
             caps,
@@ -431,7 +440,7 @@ def _fig_silhouette(out: Path, quick: bool) -> Drawn:
     )
     up = np.zeros(true_uv.shape[:2] + (3,))
     up[..., 2] = 1.0
-    bumped, _ = _try(lambda: bump_normal(H, true_uv, strength=strength), size)
+    bumped, bump_note = _try(lambda: bump_normal(H, true_uv, strength=strength), size)
     true_img = _arc_shade(H, true_mask, true_uv, up if bumped is None else bumped)
     # Outline comparison: grey where both cover the pixel, red where only POM does (the notches the
     # real relief cuts into the outline), blue where only the displaced mesh does.
@@ -441,21 +450,29 @@ def _fig_silhouette(out: Path, quick: bool) -> Drawn:
     cmp[~pom_mask & true_mask] = (0.15, 0.35, 0.85)
     only_pom = int((pom_mask & ~true_mask).sum())
     only_true = int((~pom_mask & true_mask).sum())
+    outlines = f"outlines: both (grey), POM only (red, {only_pom} px), displaced only (blue, {only_true} px)"
     img = panels(
-        [pom_img, true_img, cmp],
+        [pom_img, true_img, cmp if note is None else _missing(size)],  # no POM outline to compare yet
         [
             "POM (secant) + discard, on the smooth half cylinder" + (note or ""),
-            "true geometry: the cylinder displaced by the bumps",
-            f"outlines: both (grey), POM only (red, {only_pom} px), displaced only (blue, {only_true} px)",
+            "true geometry: the cylinder displaced by the bumps" + (f", flat shaded{bump_note}" if bump_note else ""),
+            outlines if note is None else "outlines of POM and of the displaced cylinder" + note,
         ],
         title="Silhouette on a curved mesh: relief mapping cannot change the outline",
     )
-    return Drawn.claimed(
-        img,
+    template = (
         "Smooth bumps, up to {depth} deep, on a half cylinder of radius {radius} seen from the side: the far top "
         "edge is the silhouette. Relief mapping only moves the texture inside the triangles that are drawn, so its "
         "outline stays the straight top line of the cylinder, while the truly displaced surface dips between the "
-        "bumps and its outline is wavy (red, {only_pom} pixels: POM draws them, they are empty in reality). "
+        "bumps and its outline is wavy"
+    )
+    if note is not None:  # the pixel counts compare POM's outline, not drawn yet
+        return Drawn.claimed(
+            img, template + ". Shell mapping would give the relief a volume.", depth=_ARC_DEPTH, radius=_ARC_R
+        )
+    return Drawn.claimed(
+        img,
+        template + " (red, {only_pom} pixels: POM draws them, they are empty in reality). "
         "Discarding uv outside [0, 1] carves only at the patch's ends (blue, {only_true} pixels: the displaced "
         "surface is there, POM discarded them). Shell mapping would give the relief a volume.",
         depth=_ARC_DEPTH,

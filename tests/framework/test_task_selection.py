@@ -9,16 +9,14 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from geomlib.grading import impl as _impl
 
-from .course import run_geomlib
+from .course import run_geomlib, student_copy
 
 ROOT = _impl.course_root()
 
@@ -87,7 +85,8 @@ def test_every_task_of_the_handout_selects_tests_and_every_test_has_a_task(lab, 
     tests = selected[lab]
     assert tests, lab
     for n in sorted(numbers):
-        assert any(n in t or n in r for t, r, _ in tests.values()), f"--task {n} selects no graded test of {lab}"
+        own = [name for name, (t, _, _) in tests.items() if _tasks.selects(t, n)]
+        assert own or any(n in t or n in r for t, r, _ in tests.values()), f"--task {n} selects no graded test of {lab}"
     orphans = sorted(name for name, (t, _, _) in tests.items() if not t)
     assert not orphans, f"{lab}: no --task selects {orphans}"
 
@@ -104,7 +103,11 @@ def test_remeshing_local_operations_and_relief_shaders_are_their_tasks(selected)
         "test_flip_refuses_boundary_and_tetrahedron_edges": (3,),
     }
     assert {k: mesh[k][0] for k in expected} == expected
-    assert 4 in mesh["test_references[split-bumpy-sphere]"][0]
+    # split_long_edges runs Task 1's split through Task 4's pass: Task 4's test, not Task 1's
+    from geomlib.grading.tasks import selects
+
+    split = mesh["test_references[split-bumpy-sphere]"][0]
+    assert 4 in split and selects(split, 4) and not selects(split, 1)
     # the collapse and flip passes are graded through the loop only: --task 5 and 6 run its tests
     loop = mesh["test_references[remesh-bumpy-sphere]"]
     assert loop[0] == (10,) and {5, 6} <= set(loop[1])
@@ -122,6 +125,8 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     cli = run_geomlib(ROOT, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "1", cwd=tmp_path).stdout
     assert "no graded test" not in cli, cli
     assert "Task 1 (edge split)" in cli, cli
+    # only Task 1's tests: not the split pass's (Task 4), which runs split too
+    assert "split_long_edges" not in cli and "Task 4" not in cli, cli
     code = "from geomlib.grading import check\nprint(check('remeshing', task=1, impl='labs'))"
     env = {"GEOMLIB_ROOT": str(ROOT), "GEOMLIB_NO_FEEDBACK_PICTURES": "1"}
     p = subprocess.run(
@@ -131,28 +136,42 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     assert p.stdout.strip().splitlines() == cli.strip().splitlines()
 
 
-def _student_copy(lab: str, dest: Path) -> Path:
-    """What a student's bundle holds of ``lab``: its stubs, public graded tests and references (no
-    hidden material, no solutions), with the grader, in ``dest``."""
-    from geomlib.grading.course import Course
+_STUBS = r"""
+import json, os, sys
+os.environ["GEOMLIB_NO_FEEDBACK_PICTURES"] = "1"
+from geomlib.grading import grade as G
+records = []
+G.grade("labs", sys.argv[1:], feedback_dir="", records_out=records)
+print(json.dumps({r.nodeid: r.message for r in records if r.not_implemented}))
+"""
 
-    hidden = shutil.ignore_patterns("__pycache__", "*hidden*")
-    for rel in ("geomlib", f"labs/{lab}", f"tests/graded/{lab}", f"tests/reference/{lab}"):
-        shutil.copytree(ROOT / rel, dest / rel, ignore=hidden)
-    for rel in (
-        "pyproject.toml",
-        "tests/conftest.py",
-        *(p.relative_to(ROOT) for p in (ROOT / "tests/graded").glob("*.py")),
-    ):
-        shutil.copy2(ROOT / rel, dest / rel)
-    assert not Course(dest).hidden_paths(), "the copy must hold no hidden material"
-    return dest
+
+def test_a_task_on_the_untouched_stubs_names_no_later_task(selected):
+    """``--task N`` on the stubs of every lab: no selected test says that a later task is not
+    implemented yet (a student working in order has not reached it). Remeshing's split-bumpy-sphere
+    runs Task 1's split through Task 4's split_long_edges and said "Task 4" under ``--task 1``."""
+    from geomlib.grading.tasks import selects
+    from geomlib.taskref import find_task
+
+    labs = _impl.lab_names()
+    p = subprocess.run([sys.executable, "-c", _STUBS, *labs], capture_output=True, text=True, timeout=900, cwd=ROOT)
+    assert p.returncode == 0, p.stderr[-3000:]
+    messages = json.loads(p.stdout.strip().splitlines()[-1])
+    assert messages, "no test of the stubs said 'not implemented yet'"
+    problems = []
+    for nodeid, msg in messages.items():
+        lab, name = nodeid.split("/")[2], nodeid.split("::", 1)[1]
+        tasks = selected[lab][name][0]
+        m = find_task(msg)
+        for n in (n for n in tasks if selects(tasks, n) and m is not None and m.number > n):
+            problems.append(f"{lab}: --task {n} runs {name}, which says: {msg[:150]}")
+    assert not problems, "\n".join(problems)
 
 
 def test_a_task_graded_through_the_loop_runs_the_loop_tests_and_says_so(tmp_path):
     """In the student's bundle, remeshing's Task 6 (equalize valences) has no public test of its own
     (its own checks are hidden): ``--task 6`` runs the loop's tests that call it, and says so."""
-    root = _student_copy("remeshing", tmp_path / "course")
+    root = student_copy("remeshing", tmp_path / "course")
     out = run_geomlib(root, "grade", "--impl", "labs", "--lab", "remeshing", "--task", "6", cwd=tmp_path).stdout
     assert out.startswith("Task 6: equalize valences has no test of its own"), out
     assert "Task 10 (the loop)" in out, out
@@ -168,3 +187,26 @@ def _env() -> dict:
     import os
 
     return dict(os.environ)
+
+
+def test_public_graded_tests_do_not_import_the_hidden_cases():
+    """A student's bundle has no ``cases_hidden.py``: a public test that looks a case up by id among
+    public and hidden cases goes through ``common.hidden_cases`` (shadows' and maps' GLSL tests and
+    denoise's imported ``.cases_hidden`` and failed there with ModuleNotFoundError)."""
+    graded = ROOT / "tests" / "graded"
+    offenders = [
+        str(p.relative_to(ROOT))
+        for p in sorted(graded.glob("*/*.py"))
+        if "hidden" not in p.name
+        and re.search(r"^\s*(from\s+\.cases_hidden\s+import|import\s+.*cases_hidden)", p.read_text(), re.M)
+    ]
+    assert not offenders, f"public graded tests import the hidden cases: {offenders}"
+
+
+def test_a_public_glsl_test_runs_in_the_students_bundle(tmp_path):
+    """shadows' GLSL light pass (Task 9) graded in a student's bundle, on the solution: it passes."""
+    root = student_copy("shadows", tmp_path / "course")
+    out = run_geomlib(
+        root, "grade", "--impl", str(ROOT / "solutions"), "--lab", "shadows", "--task", "9", cwd=tmp_path
+    ).stdout
+    assert "ModuleNotFoundError" not in out and "What to fix" not in out, out

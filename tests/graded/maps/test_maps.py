@@ -14,7 +14,7 @@ from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture, marked_picture
 
-from ..common import expect_rejected
+from ..common import expect_rejected, hidden_cases
 from .cases import CASES, LIGHT, quad_gbuffer, texel_uv, unit_vectors, wave
 
 test_references = reference_tests(CASES)
@@ -438,9 +438,7 @@ STAGE = {
 
 
 def _case(case_id: str):
-    from .cases_hidden import CASES as HIDDEN
-
-    return {c.id: c for c in (*CASES, *HIDDEN)}[case_id]
+    return {c.id: c for c in (*CASES, *hidden_cases(__package__))}[case_id]
 
 
 def expect_glsl_rows(label: str, got, expected, atol: float, mesh=None, name: str = "output") -> None:

@@ -166,6 +166,7 @@ CASES = [
             mesh(spheroid), targets="adaptive-targets-spheroid", min_angle=12.0, hausdorff=0.006, tip_ratio=0.9
         ),
         part="adaptive",
+        tasks=(10, 11),  # adaptive=True runs Task 11's target lengths
         points=1,
         hint="an edge's bounds use the smaller target of its two ends; a vertex takes the target of its projection",
     ),

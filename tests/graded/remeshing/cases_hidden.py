@@ -84,6 +84,7 @@ CASES = [
         outputs=("V",),
         check=checks.Allclose(atol=tol.EXACT),
         part="features",
+        tasks=(7, 8),  # Task 8's relaxation, with features
         points=1,
         visibility="hidden",
     ),
@@ -196,6 +197,7 @@ CASES = [
             tip_ratio=0.9,
         ),
         part="adaptive",
+        tasks=(10, 11),  # adaptive=True runs Task 11's target lengths
         points=2,
         visibility="hidden",
     ),

@@ -26,6 +26,7 @@ from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
+from ..common import hidden_cases
 from .cases import CASES
 from .cases_glsl import STORED, STORED_HIDDEN, eye_points
 from .support import small_scene
@@ -38,9 +39,7 @@ SHADOW_LABEL = "glsl_shadow_visibility (shaders/shadow.frag, the shadow pass's f
 
 
 def _case(case_id: str):
-    from .cases_hidden import CASES as HIDDEN
-
-    return {c.id: c for c in (*CASES, *HIDDEN, *STORED, *STORED_HIDDEN)}[case_id]
+    return {c.id: c for c in (*CASES, *hidden_cases(__package__), *STORED, *STORED_HIDDEN)}[case_id]
 
 
 def expect_depth_map(label: str, got, expected) -> None:

@@ -252,6 +252,7 @@ CASES = [
         outputs=("EP",),
         check=checks.Allclose(),
         part="boundary rules",
+        tasks=(4, 7),  # the boundary branch of Task 7's function
         points=1,
         hint="Catmull-Clark boundary edge -> its midpoint (the face points are given)",
     ),
@@ -262,6 +263,7 @@ CASES = [
         outputs=("VP",),
         check=checks.Allclose(),
         part="boundary rules",
+        tasks=(4, 8),  # the boundary branch of Task 8's function
         points=1,
         hint="Catmull-Clark boundary vertex -> 3/4 P + 1/8 (its two boundary neighbours)",
     ),

@@ -251,7 +251,7 @@ def test_square_interior_edge_between_boundary_vertices(lab):
         )
 
 
-@graded(points=1, part="boundary rules")
+@graded(points=1, part="boundary rules", tasks=(4, 7, 8))  # the boundary branches of Tasks 7 and 8's functions
 def test_one_quad_boundary_points(lab):
     """one quad: Catmull-Clark edge points are the midpoints, vertex points 3/4 P + 1/8 (two neighbours)"""
     fp = centroids(QUAD_V, QUAD_F)
