@@ -94,6 +94,28 @@ def test_root_installs_libgl_when_only_osmesa_is_there(tmp_path):
     assert "libgl1 libxrender1" in err and "administrator" in err, err
 
 
+def test_root_without_python3_installs_it_before_the_bootstrap(tmp_path):
+    """A minimal Debian 12 (the debian:bookworm image) has no python3: walked as root, ./run installed
+    the OpenGL libraries and then stopped at "no python3 on this machine" (issue 26). As root it now
+    installs python3 first, as the autograder's setup.sh does."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in TOOLS:
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1"):
+        (libs / lib).write_text("")
+    log = tmp_path / "calls.log"
+    for name, body in {"id": "echo 0", "apt-get": f'echo "apt-get $*" >> {log}'}.items():
+        (fake / name).write_text(f"#!{shutil.which('bash')}\n{body}\n")
+        (fake / name).chmod(0o755)
+    env = {"PATH": f"{fake}:{tools}", "HOME": str(tmp_path), "GEOMLIB_LIB_DIRS": str(libs)}
+    p = subprocess.run([str(ROOT / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1 and "no python3 on this machine" in p.stderr, p.stderr  # the fake apt-get installs nothing
+    installs = [c for c in log.read_text().splitlines() if c.startswith("apt-get install")]
+    assert len(installs) == 1 and "python3" in installs[0].split(), installs
+
+
 def test_only_the_whole_suite_installs_the_browser(tmp_path):
     for args, wants_browser in ((("setup",), False), (("figures",), False), (("tests",), True)):
         d = tmp_path / "-".join(args)
