@@ -21,6 +21,11 @@ export PATH="$PATH:/usr/sbin:/sbin"
 # harness; EGL with Mesa's software driver as the fallback platform), a Python 3 (for uv's bootstrap).
 need=()
 ldconfig -p 2>/dev/null | grep -q 'libOSMesa\.so' || need+=(libosmesa6)
+# libGL and libXrender too: pyrender imports pyglet's viewer, which loads both even to render off
+# screen (a Debian 12 root with the OSMesa/EGL packages only: `import pyrender` -> 'Library "GL" not
+# found', then "'NoneType' object has no attribute 'XRenderFindVisualFormat'").
+ldconfig -p 2>/dev/null | grep -q 'libGL\.so\.1' || need+=(libgl1)
+ldconfig -p 2>/dev/null | grep -q 'libXrender\.so\.1' || need+=(libxrender1)
 ldconfig -p 2>/dev/null | grep -q 'libEGL\.so' || need+=(libegl1)
 ldconfig -p 2>/dev/null | grep -q 'libEGL_mesa\.so' || need+=(libegl-mesa0)
 compgen -G "${GEOMLIB_DRI_DIR:-/usr/lib/*/dri}/swrast_dri.so" >/dev/null || need+=(libgl1-mesa-dri)
@@ -34,6 +39,12 @@ fi
 # uv as ./run gets it (geomlib/grading/bootstrap.py: the one on the PATH, else its pinned PyPI wheel,
 # sha256 checked, unpacked into root's home): never pip into the system Python (PEP 668).
 UV="$(python3 "$SRC/geomlib/grading/bootstrap.py" uv)"
+# uv reaches PyPI with the system's certificate store too, as under ./run: a TLS-intercepting proxy's
+# CA (a campus or company network building the dev container) is installed there, and uv's own
+# bundled roots do not have it (measured: a Debian 12 root behind such a proxy failed here with
+# "invalid peer certificate: UnknownIssuer" while the bootstrap's download, which uses the system
+# store, had worked).
+export UV_SYSTEM_CERTS="${UV_SYSTEM_CERTS-1}"
 uv() { "$UV" "$@"; }
 
 # A Python the sandbox user can read (not one under /root, which it cannot open): the one named by

@@ -9,6 +9,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import zipfile
 from pathlib import Path
@@ -192,8 +193,59 @@ def _setup_packages(tmp_path: Path, libraries: str, dri: bool) -> list[str]:
 
 
 def test_setup_installs_what_osmesa_and_egl_need_only_when_missing(tmp_path):
-    everything = "libOSMesa.so.8 libEGL.so.1 libEGL_mesa.so.0"
+    everything = "libOSMesa.so.8 libGL.so.1 libXrender.so.1 libEGL.so.1 libEGL_mesa.so.0"
     assert _setup_packages(tmp_path / "a", everything, dri=True) == []
     wanted = _setup_packages(tmp_path / "b", "libc.so.6", dri=False)
-    assert {"libosmesa6", "libegl1", "libegl-mesa0", "libgl1-mesa-dri"} <= set(wanted)
-    assert _setup_packages(tmp_path / "c", "libOSMesa.so.8 libEGL.so.1", dri=True) == ["libegl-mesa0"]
+    assert {"libosmesa6", "libgl1", "libxrender1", "libegl1", "libegl-mesa0", "libgl1-mesa-dri"} <= set(wanted)
+    assert _setup_packages(tmp_path / "c", "libOSMesa.so.8 libGL.so.1 libXrender.so.1 libEGL.so.1", dri=True) == [
+        "libegl-mesa0"
+    ]
+    # pyrender's import loads libGL and libXrender (pyglet's viewer): a Debian 12 root without them
+    # could not render
+    only_gl = "libOSMesa.so.8 libEGL.so.1 libEGL_mesa.so.0"
+    assert _setup_packages(tmp_path / "d", only_gl, dri=True) == ["libgl1", "libxrender1"]
+
+
+def test_setup_syncs_with_the_system_certificate_store(tmp_path):
+    """setup.sh's ``uv sync`` trusts the system's certificate store, as ``./run``'s does (issue 26).
+
+    Walked in a Debian 12 root built like the dev container's image behind a TLS-intercepting proxy
+    whose CA is in the system store: the bootstrap's download of uv (Python, system store) worked,
+    then ``uv sync`` (its own bundled roots) failed with "invalid peer certificate: UnknownIssuer".
+    Here the whole script runs with a fake ``uv`` that records its environment, and with no
+    certificate variable of this machine (SSL_CERT_FILE, ...) to help it."""
+    from geomlib.grading.release import SETUP_SH
+
+    src = tmp_path / "ag" / "source"
+    (src / "geomlib" / "grading").mkdir(parents=True)
+    shutil.copy(
+        Path(__file__).resolve().parents[2] / "geomlib" / "grading" / "bootstrap.py", src / "geomlib" / "grading"
+    )
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    log = tmp_path / "uv.log"
+    (bin_dir / "ldconfig").write_text(
+        "#!/bin/sh\necho libOSMesa.so.8 libGL.so.1 libXrender.so.1 libEGL.so.1 libEGL_mesa.so.0\n"
+    )
+    (bin_dir / "apt-get").write_text("#!/bin/sh\nexit 1\n")
+    (bin_dir / "uv").write_text(
+        f'#!/bin/sh\nif [ "$1" = --version ]; then echo "uv 99.0.0"; exit 0; fi\n'
+        f'echo "$1 UV_SYSTEM_CERTS=${{UV_SYSTEM_CERTS:-}}" >> {log}\nexit 3\n'
+    )
+    for f in bin_dir.iterdir():
+        f.chmod(0o755)
+    dri_dir = tmp_path / "dri"
+    dri_dir.mkdir()
+    (dri_dir / "swrast_dri.so").write_text("")
+    env = {k: v for k, v in os.environ.items() if not any(w in k for w in ("CERT", "CA_BUNDLE", "UV_"))}
+    env.update(
+        PATH=f"{bin_dir}:{os.environ['PATH']}",
+        GEOMLIB_DRI_DIR=str(dri_dir),
+        GEOMLIB_AUTOGRADER_ROOT=str(tmp_path / "ag"),
+        GEOMLIB_AUTOGRADER_PYTHON=sys.executable,
+        GEOMLIB_UV=str(bin_dir / "uv"),
+        GEOMLIB_SANDBOX_USER="",
+    )
+    p = subprocess.run(["bash", "-c", SETUP_SH], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 3, p.stdout + p.stderr  # stopped by the fake uv's sync, nothing before it
+    assert log.read_text().splitlines() == ["sync UV_SYSTEM_CERTS=1"]

@@ -19,7 +19,9 @@ ROOT = Path(__file__).resolve().parents[2]
 TOOLS = ("bash", "grep", "mktemp", "cat", "rm", "uname", "tr", "dirname", "true")
 
 
-def _run(tmp_path: Path, *args: str, uid: int, has_osmesa: bool, sudo_ok: bool = False) -> tuple[str, list[str]]:
+def _run(
+    tmp_path: Path, *args: str, uid: int, has_osmesa: bool, sudo_ok: bool = False, has_libgl: bool | None = None
+) -> tuple[str, list[str]]:
     fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
     for d in (fake, tools, libs):
         d.mkdir()
@@ -28,8 +30,12 @@ def _run(tmp_path: Path, *args: str, uid: int, has_osmesa: bool, sudo_ok: bool =
         if not found:
             pytest.skip(f"{t} is not installed")
         (tools / t).symlink_to(found)
+    (libs / "libfribidi.so.0").write_text("")  # Pillow's text layout (the committed figures')
     if has_osmesa:
         (libs / "libOSMesa.so.8").write_text("")
+    if has_osmesa if has_libgl is None else has_libgl:
+        (libs / "libGL.so.1").write_text("")
+        (libs / "libXrender.so.1").write_text("")
     log = tmp_path / "calls.log"
     scripts = {
         "id": f'[ "$1" = -u ] && echo {uid} || echo "uid={uid}"',
@@ -74,6 +80,43 @@ def test_root_installs_the_missing_library_quietly_and_no_browser_for_a_students
     assert "chromium" not in err, err
 
 
+def test_root_installs_libgl_when_only_osmesa_is_there(tmp_path):
+    """pyrender imports pyglet's viewer, which loads libGL.so.1 and libXrender.so.1 even to render off
+    screen: walked in a Debian 12 root that had libosmesa6 only, `import pyrender` failed with
+    'Library "GL" not found' (issue 26). As root ./run installs them; an ordinary user is told to ask."""
+    (tmp_path / "root").mkdir()
+    (tmp_path / "user").mkdir()
+    err, calls = _run(tmp_path / "root", "setup", uid=0, has_osmesa=True, has_libgl=False)
+    installs = [c for c in calls if c.startswith("apt-get install")]
+    assert len(installs) == 1 and "libosmesa6" not in installs[0], calls
+    assert {"libgl1", "libxrender1"} <= set(installs[0].split()), calls
+    err, calls = _run(tmp_path / "user", "setup", uid=1000, has_osmesa=True, has_libgl=False)
+    assert [c for c in calls if c != "sudo -n true"] == [], calls
+    assert "libgl1 libxrender1" in err and "administrator" in err, err
+
+
+def test_root_without_python3_installs_it_before_the_bootstrap(tmp_path):
+    """A minimal Debian 12 (the debian:bookworm image) has no python3: walked as root, ./run installed
+    the OpenGL libraries and then stopped at "no python3 on this machine" (issue 26). As root it now
+    installs python3 first, as the autograder's setup.sh does."""
+    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, tools, libs):
+        d.mkdir()
+    for t in TOOLS:
+        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1"):  # no libfribidi.so.0
+        (libs / lib).write_text("")
+    log = tmp_path / "calls.log"
+    for name, body in {"id": "echo 0", "apt-get": f'echo "apt-get $*" >> {log}'}.items():
+        (fake / name).write_text(f"#!{shutil.which('bash')}\n{body}\n")
+        (fake / name).chmod(0o755)
+    env = {"PATH": f"{fake}:{tools}", "HOME": str(tmp_path), "GEOMLIB_LIB_DIRS": str(libs)}
+    p = subprocess.run([str(ROOT / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 1 and "no python3 on this machine" in p.stderr, p.stderr  # the fake apt-get installs nothing
+    installs = [c for c in log.read_text().splitlines() if c.startswith("apt-get install")]
+    assert len(installs) == 1 and {"python3", "libfribidi0"} <= set(installs[0].split()), installs
+
+
 def test_only_the_whole_suite_installs_the_browser(tmp_path):
     for args, wants_browser in ((("setup",), False), (("figures",), False), (("tests",), True)):
         d = tmp_path / "-".join(args)
@@ -114,7 +157,8 @@ def _fake_root_with_osmesa(tmp_path: Path, *, uv: str, apt_get: str) -> dict[str
         d.mkdir()
     for t in (*TOOLS, "python3"):
         (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    (libs / "libOSMesa.so.8").write_text("")
+    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1", "libfribidi.so.0"):  # OpenGL, text layout
+        (libs / lib).write_text("")
     bash = shutil.which("bash")
     for name, body in {"id": "echo 0", "uv": uv, "apt-get": apt_get}.items():
         (fake / name).write_text(f"#!{bash}\n{body}")
@@ -158,7 +202,8 @@ def _root_with_a_private_uv(tmp_path: Path, uv_body: str) -> dict[str, str]:
         d.mkdir()
     for t in (*TOOLS, "python3", "mkdir", "ln"):
         (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    (libs / "libOSMesa.so.8").write_text("")
+    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1", "libfribidi.so.0"):  # OpenGL, text layout
+        (libs / lib).write_text("")
     bash = shutil.which("bash")
     (fake / "id").write_text(f"#!{bash}\necho 0")
     (private / "uv").write_text(f"#!{bash}\n{uv_body}")
@@ -201,7 +246,8 @@ def test_the_set_up_of_a_one_lab_bundle_names_its_lab(tmp_path):
         (course / "uv").write_text(f"#!{bash}\nexit 0")
         (course / "uv").chmod(0o755)
         (course / "lib").mkdir()
-        (course / "lib" / "libOSMesa.so.8").write_text("")
+        for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1", "libfribidi.so.0"):  # OpenGL, text layout
+            (course / "lib" / lib).write_text("")
         env = {
             "PATH": f"{Path(shutil.which('python3')).parent}:/usr/bin:/bin",
             "HOME": str(course),
