@@ -924,7 +924,9 @@ def relocate_targets(V, F, E, deg, cls, fresh, min_angle, search_angle, step, di
 
 
 @njit(cache=True)
-def relocate_moves(V, F, T, VH, val, cls, feat, falive, cnt, E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh):
+def relocate_moves(
+    V, F, T, VH, val, cls, feat, falive, cnt, E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh
+):
     """The rest of a relocation pass, after :func:`relocate_targets` and the projection ``P`` of ``Q``.
 
     Keeps each fresh point (``P_at[v, kind]``) and whether the surface stays within a quarter of
@@ -935,10 +937,11 @@ def relocate_moves(V, F, T, VH, val, cls, feat, falive, cnt, E, cand, worst, row
     """
     for i in range(len(rows)):
         px, py, pz = P[i, 0] - Q[i, 0], P[i, 1] - Q[i, 1], P[i, 2] - Q[i, 2]
+        dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
         v, k = rows[i], kinds[i]
         for x in range(3):
             P_at[v, k, x] = P[i, x]
-        flat_at[v, k] = dot3(px, py, pz, px, py, pz) <= 0.0625 * dot3(D[i, 0], D[i, 1], D[i, 2], D[i, 0], D[i, 1], D[i, 2])
+        flat_at[v, k] = dot3(px, py, pz, px, py, pz) <= 0.0625 * dot3(dx, dy, dz, dx, dy, dz)
     m = 0
     for k in range(flat_at.shape[1]):
         for j in range(len(cand)):
