@@ -858,17 +858,7 @@ def relocate_targets(V, F, E, deg, cls, fresh, min_angle, search_angle, step, di
         for x in range(3):
             s0[i, x] += V[j, x]
             s1[j, x] += V[i, x]
-    N = np.zeros((n, 3))
-    for f in range(len(F)):
-        a, b, c = F[f, 0], F[f, 1], F[f, 2]
-        ux, uy, uz = V[b, 0] - V[a, 0], V[b, 1] - V[a, 1], V[b, 2] - V[a, 2]
-        wx, wy, wz = V[c, 0] - V[a, 0], V[c, 1] - V[a, 1], V[c, 2] - V[a, 2]
-        cx, cy, cz = uy * wz - uz * wy, uz * wx - ux * wz, ux * wy - uy * wx
-        for k in range(3):
-            v = F[f, k]
-            N[v, 0] += cx
-            N[v, 1] += cy
-            N[v, 2] += cz
+    N = face_sums(V, F, n)[:, 4:]  # Σ of the faces' cross products at every vertex
     r = np.zeros(n)  # the search's step at the worst candidates: SEARCH_STEP times the mean edge
     if nsearch:
         l0 = np.zeros(n)
