@@ -89,11 +89,8 @@ def _collapse_all(S: RemeshState) -> int:
     boundary. gpytoolbox's remesher keeps its boundary vertices out of every collapse the same way.
     The boundary is still split and its vertices still slide along it.
     """
-    m = S.cnt[1]
-    h = np.flatnonzero((S.T[: 3 * m] < 0) & np.repeat(S.falive[:m], 3))
-    ends = np.unique(np.r_[S.F.ravel()[h], S.F[h // 3, (h % 3 + 1) % 3]])
-    ends = ends[S.cls[ends] > 0]  # the preserved boundary (a free boundary may move and collapse)
-    keep = S.low[ends].copy()
+    ends = K.preserved_boundary(S.F, S.T, S.cls, S.falive, S.cnt)  # a free boundary may move and collapse
+    keep = S.low[ends]
     S.low[ends] = 0.0  # an edge is short below the smaller bound of its ends: never at these
     total = 0
     while True:
@@ -164,60 +161,24 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     key = np.unique(np.minimum(a, b) * n + np.maximum(a, b))  # no new structure
     E = np.c_[key // n, key % n]
     deg = np.bincount(E.ravel(), minlength=n)
-    xyz = np.arange(3)
-    # bincount indices of 3-vectors summed at an edge's first / second end and at a face's corners
-    at0, at1, at_corner = ((I[..., None] * 3 + xyz).ravel() for I in (E[:, 0], E[:, 1], Fl))
     # A vertex's candidates depend on its faces only: one whose faces did not move in the last pass
     # (not fresh) gets the points it got then (P_at, flat_at: centroid, then the search's steps)
     fresh = np.ones(n, bool)
     P_at = np.empty((n, 1 + len(SEARCH_DIRECTIONS), 3))
     flat_at = np.zeros((n, 1 + len(SEARCH_DIRECTIONS)), bool)
-    for _ in range(passes):
-        V = S.V[:n]
-        angle = K.faces_min_angle(V, Fl)
-        cand = np.unique(Fl[angle < np.radians(min_angle)])
-        cand = cand[S.cls[cand] == 0]
-        if not fresh[cand].any():  # nothing around them moved: the last pass's answers stand
+    directions = np.array(SEARCH_DIRECTIONS)
+    below, search_below = np.radians(min_angle), np.radians(SEARCH_ANGLE)
+    for _ in range(passes):  # a pass: its points (kernel), their projection (libigl), the moves (kernel)
+        cand, worst, rows, kinds, Q, D = K.relocate_targets(
+            S.V, Fl, E, deg, S.cls, fresh, below, search_below, SEARCH_STEP, directions
+        )
+        if not len(rows):  # nothing around the candidates moved: the last pass's answers stand
             break
-        worst = np.isin(cand, Fl[angle < np.radians(SEARCH_ANGLE)])
-        new, search = cand[fresh[cand]], worst[fresh[cand]]
-        c = (np.bincount(at0, V[E[:, 1]].ravel(), 3 * n) + np.bincount(at1, V[E[:, 0]].ravel(), 3 * n)).reshape(n, 3)
-        X = _cross(V[Fl[:, 1]] - V[Fl[:, 0]], V[Fl[:, 2]] - V[Fl[:, 0]])
-        N = np.bincount(at_corner, np.repeat(X, 3, axis=0).ravel(), 3 * n).reshape(n, 3)[new]
-        N /= np.maximum(np.sqrt(np.einsum("ij,ij->i", N, N)), 1e-300)[:, None]
-        D = c[new] / np.maximum(deg[new], 1)[:, None] - V[new]
-        D -= np.einsum("ij,ij->i", D, N)[:, None] * N
-        rows = new
-        if search.any():  # the pattern search, after the centroid moves
-            w, Nw = new[search], N[search]
-            u = _cross(Nw, np.where(np.abs(Nw[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
-            u /= np.maximum(np.sqrt(np.einsum("ij,ij->i", u, u)), 1e-300)[:, None]
-            v = _cross(Nw, u)
-            d = V[E[:, 0]] - V[E[:, 1]]
-            length = np.sqrt(np.einsum("ij,ij->i", d, d))
-            r = SEARCH_STEP * (np.bincount(E[:, 0], length, n) + np.bincount(E[:, 1], length, n))[w] / deg[w]
-            D = np.concatenate([D] + [r[:, None] * (x * u + y * v) for x, y in SEARCH_DIRECTIONS])
-            rows = np.r_[new, np.tile(w, len(SEARCH_DIRECTIONS))]
-        Q = V[rows] + D
-        P = project(Q)
-        # where the surface bends away within the step (a tip, a ridge) the move would cut it: skip
-        flat = np.einsum("ij,ij->i", P - Q, P - Q) <= 0.0625 * np.einsum("ij,ij->i", D, D)
-        step = np.repeat(np.arange(1 + len(SEARCH_DIRECTIONS)), [len(new)] + [search.sum()] * len(SEARCH_DIRECTIONS))
-        P_at[rows, step], flat_at[rows, step] = P, flat
-        w = cand[worst]  # every candidate's points, in the order: centroids, then each step of the search
-        rows = np.r_[cand, np.tile(w, len(SEARCH_DIRECTIONS))]
-        step = np.repeat(np.arange(1 + len(SEARCH_DIRECTIONS)), [len(cand)] + [len(w)] * len(SEARCH_DIRECTIONS))
-        keep = flat_at[rows, step]
-        was = V[cand].copy()
-        done = K.relocate_pass(*S.args(), rows[keep], P_at[rows[keep], step[keep]], fresh)
+        P = np.ascontiguousarray(project(Q), dtype=np.float64)
+        done = K.relocate_moves(*S.args(), E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh)
         total += done
         if not done:
             break
-        moved = np.zeros(n, bool)
-        moved[cand[(V[cand] != was).any(axis=1)]] = True
-        fresh = moved.copy()
-        fresh[E[moved[E[:, 1]], 0]] = True
-        fresh[E[moved[E[:, 0]], 1]] = True
     return total
 
 

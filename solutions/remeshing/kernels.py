@@ -771,3 +771,223 @@ def faces_min_angle(V, F):
     for f in range(len(F)):
         out[f] = face_min_angle(V, F[f, 0], F[f, 1], F[f, 2])
     return out
+
+
+# --------------------------------------------------------------------------------------------
+# the relocation step of the clean-up (given): one pass of :func:`..stages._relocate` in two
+# kernels around the projection (a libigl call). In NumPy a pass was about sixty calls, most of a
+# small mesh's remeshing time (spot's cage: 14 of 28 ms). The sums are those of the NumPy version,
+# in its order: ``np.bincount`` adds in index order, and ``np.einsum("ij,ij->i")`` over three
+# columns adds ``(x0 y0 + x2 y2) + x1 y1`` (:func:`dot3`).
+
+
+@njit(cache=True)
+def dot3(x0, x1, x2, y0, y1, y2):
+    """``x · y`` summed as ``np.einsum("ij,ij->i")`` sums three columns (two SIMD lanes, then the third)."""
+    return (x0 * y0 + x2 * y2) + x1 * y1
+
+
+@njit(cache=True)
+def at_least(x, lo):
+    """``np.maximum(x, lo)`` for one number (NaN stays NaN)."""
+    return lo if x < lo else x
+
+
+@njit(cache=True)
+def relocate_targets(V, F, E, deg, cls, fresh, min_angle, search_angle, step, directions):
+    """The points one relocation pass tries (before projection onto the surface).
+
+    ``F`` the live faces, ``E`` their edges (sorted pairs, rows in order), ``deg`` the edges at
+    every vertex (``n = len(deg)`` vertices). Candidates: the free vertices of the faces with an
+    angle below ``min_angle`` (radians), in order; ``worst``: those also on a face below
+    ``search_angle``. For every *fresh* candidate, its points: the centroid of its neighbours
+    (moved into its tangent plane), then for a worst one a step of ``step`` times its mean edge in
+    each of ``directions`` ((k, 2), coordinates in its tangent plane).
+
+    Returns
+    -------
+    cand (c,) int64, worst (c,) bool
+    rows (q,) int64, kinds (q,) int64
+        The vertex and the kind of each point: 0 the centroid, ``1 + i`` the step in ``directions[i]``;
+        all centroids first, then direction by direction.
+    Q, D : (q, 3) float
+        The points (``V[rows] + D``) and the moves.
+    """
+    n = len(deg)
+    angle = faces_min_angle(V, F)
+    below = np.zeros(n, np.bool_)
+    bad = np.zeros(n, np.bool_)
+    for f in range(len(F)):
+        for k in range(3):
+            if angle[f] < min_angle:
+                below[F[f, k]] = True
+            if angle[f] < search_angle:
+                bad[F[f, k]] = True
+    nc = 0
+    for v in range(n):
+        if below[v] and cls[v] == 0:
+            nc += 1
+    cand = np.empty(nc, np.int64)
+    worst = np.empty(nc, np.bool_)
+    nc, nnew, nsearch = 0, 0, 0
+    for v in range(n):
+        if below[v] and cls[v] == 0:
+            cand[nc], worst[nc] = v, bad[v]
+            nc += 1
+            if fresh[v]:
+                nnew += 1
+                nsearch += 1 if bad[v] else 0
+    new = np.empty(nnew, np.int64)
+    k = 0
+    for v in cand:
+        if fresh[v]:
+            new[k] = v
+            k += 1
+    q = nnew + len(directions) * nsearch
+    rows = np.empty(q, np.int64)
+    kinds = np.zeros(q, np.int64)
+    Q = np.empty((q, 3))
+    D = np.empty((q, 3))
+    if nnew == 0:
+        return cand, worst, rows, kinds, Q, D
+    # the neighbours' sums (edges from their first end, then from their second) and the normals
+    s0 = np.zeros((n, 3))
+    s1 = np.zeros((n, 3))
+    for e in range(len(E)):
+        i, j = E[e, 0], E[e, 1]
+        for x in range(3):
+            s0[i, x] += V[j, x]
+            s1[j, x] += V[i, x]
+    N = face_sums(V, F, n)[:, 4:]  # Σ of the faces' cross products at every vertex
+    r = np.zeros(n)  # the search's step at the worst candidates: SEARCH_STEP times the mean edge
+    if nsearch:
+        l0 = np.zeros(n)
+        l1 = np.zeros(n)
+        for e in range(len(E)):
+            i, j = E[e, 0], E[e, 1]
+            dx, dy, dz = V[i, 0] - V[j, 0], V[i, 1] - V[j, 1], V[i, 2] - V[j, 2]
+            length = np.sqrt(dot3(dx, dy, dz, dx, dy, dz))
+            l0[i] += length
+            l1[j] += length
+        for v in new:
+            if bad[v]:
+                r[v] = step * (l0[v] + l1[v]) / deg[v]
+    U = np.empty((nsearch, 3))  # the tangent frame (u, w) of each worst fresh candidate
+    W = np.empty((nsearch, 3))
+    ks = 0
+    for i in range(nnew):
+        v = new[i]
+        nx_, ny, nz = N[v, 0], N[v, 1], N[v, 2]
+        s = at_least(np.sqrt(dot3(nx_, ny, nz, nx_, ny, nz)), 1e-300)
+        nx_, ny, nz = nx_ / s, ny / s, nz / s
+        d = max(deg[v], 1)
+        dx = (s0[v, 0] + s1[v, 0]) / d - V[v, 0]
+        dy = (s0[v, 1] + s1[v, 1]) / d - V[v, 1]
+        dz = (s0[v, 2] + s1[v, 2]) / d - V[v, 2]
+        t = dot3(dx, dy, dz, nx_, ny, nz)
+        D[i, 0], D[i, 1], D[i, 2] = dx - t * nx_, dy - t * ny, dz - t * nz
+        rows[i] = v
+        if bad[v]:
+            ex, ey = (1.0, 0.0) if np.abs(nx_) < 0.9 else (0.0, 1.0)
+            ux, uy, uz = ny * 0.0 - nz * ey, nz * ex - nx_ * 0.0, nx_ * ey - ny * ex
+            s = at_least(np.sqrt(dot3(ux, uy, uz, ux, uy, uz)), 1e-300)
+            ux, uy, uz = ux / s, uy / s, uz / s
+            U[ks, 0], U[ks, 1], U[ks, 2] = ux, uy, uz
+            W[ks, 0], W[ks, 1], W[ks, 2] = ny * uz - nz * uy, nz * ux - nx_ * uz, nx_ * uy - ny * ux
+            ks += 1
+    i = nnew
+    for k in range(len(directions)):
+        along_u, along_w = directions[k, 0], directions[k, 1]
+        ks = 0
+        for v in new:
+            if not bad[v]:
+                continue
+            for x in range(3):
+                D[i, x] = r[v] * (along_u * U[ks, x] + along_w * W[ks, x])
+            rows[i], kinds[i] = v, 1 + k
+            ks += 1
+            i += 1
+    for i in range(q):
+        for x in range(3):
+            Q[i, x] = V[rows[i], x] + D[i, x]
+    return cand, worst, rows, kinds, Q, D
+
+
+@njit(cache=True)
+def relocate_moves(
+    V, F, T, VH, val, cls, feat, falive, cnt, E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh
+):
+    """The rest of a relocation pass, after :func:`relocate_targets` and the projection ``P`` of ``Q``.
+
+    Keeps each fresh point (``P_at[v, kind]``) and whether the surface stays within a quarter of
+    the move from it (``flat_at``: where it bends away within the step, a tip or a ridge, the move
+    would cut it); tries every candidate's kept points with :func:`relocate_pass` (the centroids,
+    then direction by direction); marks ``fresh`` the vertices that moved and their neighbours.
+    Returns the number of moves.
+    """
+    for i in range(len(rows)):
+        px, py, pz = P[i, 0] - Q[i, 0], P[i, 1] - Q[i, 1], P[i, 2] - Q[i, 2]
+        dx, dy, dz = D[i, 0], D[i, 1], D[i, 2]
+        v, k = rows[i], kinds[i]
+        for x in range(3):
+            P_at[v, k, x] = P[i, x]
+        flat_at[v, k] = dot3(px, py, pz, px, py, pz) <= 0.0625 * dot3(dx, dy, dz, dx, dy, dz)
+    m = 0
+    for k in range(flat_at.shape[1]):
+        for j in range(len(cand)):
+            if (k == 0 or worst[j]) and flat_at[cand[j], k]:
+                m += 1
+    who = np.empty(m, np.int64)
+    to = np.empty((m, 3))
+    m = 0
+    for k in range(flat_at.shape[1]):
+        for j in range(len(cand)):
+            v = cand[j]
+            if (k == 0 or worst[j]) and flat_at[v, k]:
+                who[m] = v
+                to[m] = P_at[v, k]
+                m += 1
+    was = np.empty((len(cand), 3))
+    for j in range(len(cand)):
+        was[j] = V[cand[j]]
+    done = relocate_pass(V, F, T, VH, val, cls, feat, falive, cnt, who, to, fresh)
+    if not done:
+        return 0
+    moved = np.zeros(len(fresh), np.bool_)
+    for j in range(len(cand)):
+        v = cand[j]
+        if V[v, 0] != was[j, 0] or V[v, 1] != was[j, 1] or V[v, 2] != was[j, 2]:
+            moved[v] = True
+    fresh[:] = moved
+    for e in range(len(E)):
+        if moved[E[e, 1]]:
+            fresh[E[e, 0]] = True
+    for e in range(len(E)):
+        if moved[E[e, 0]]:
+            fresh[E[e, 1]] = True
+    return done
+
+
+@njit(cache=True)
+def preserved_boundary(F, T, cls, falive, cnt):
+    """The constrained vertices (``cls > 0``) on a boundary edge of the live faces, in order (given).
+
+    The loop's collapse stage (:func:`..stages._collapse_all`) keeps them out of every collapse.
+    """
+    n = cnt[0]
+    on = np.zeros(n, np.bool_)
+    for h in range(3 * cnt[1]):
+        if T[h] < 0 and falive[h // 3]:
+            on[org(F, h)] = True
+            on[dst(F, h)] = True
+    k = 0
+    for v in range(n):
+        if on[v] and cls[v] > 0:
+            k += 1
+    out = np.empty(k, np.int64)
+    k = 0
+    for v in range(n):
+        if on[v] and cls[v] > 0:
+            out[k] = v
+            k += 1
+    return out

@@ -78,8 +78,10 @@ class RemeshState:
     def feature_edges(self) -> np.ndarray:
         """The feature edges of the live faces: sorted vertex pairs ``(k, 2)``, rows in lexicographic order."""
         h = self.feature_halfedges()
+        if not len(h):
+            return np.zeros((0, 2), np.int64)
         a, b = self.F[h // 3, h % 3], self.F[h // 3, (h % 3 + 1) % 3]
-        return np.unique(np.sort(np.c_[a, b], axis=1), axis=0) if len(h) else np.zeros((0, 2), np.int64)
+        return np.unique(np.sort(np.c_[a, b], axis=1), axis=0)
 
 
 def _edge_lookup(F: np.ndarray, n: int, pairs: np.ndarray) -> np.ndarray:
