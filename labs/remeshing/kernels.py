@@ -468,6 +468,26 @@ def relocate_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, P, fresh):
 
 
 @njit(cache=True)
+def cover_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, P, floor):
+    """Move vertex ``cand[i]`` to ``P[i]`` (a point on the surface) when the smallest angle of the
+    faces around it stays at least ``floor`` (radians) and none turns over; the rows of a vertex in
+    order of preference, the first allowed one wins, each test on the positions so far. Returns the
+    number of moves (:func:`.stages._cover`)."""
+    hes = np.empty(RING, np.int64)
+    moved = np.zeros(len(V), np.bool_)
+    done = 0
+    for i in range(len(cand)):
+        v = cand[i]
+        if VH[v] < 0 or cls[v] != 0 or moved[v]:
+            continue
+        if _ring_min_angle(V, F, T, VH, v, P[i, 0], P[i, 1], P[i, 2], hes) >= floor:
+            V[v, 0], V[v, 1], V[v, 2] = P[i, 0], P[i, 1], P[i, 2]
+            moved[v] = True
+            done += 1
+    return done
+
+
+@njit(cache=True)
 def face_sums(V, F, n):
     """``(n, 7)``: at every vertex, ``Σ A_f``, ``Σ A_f c_f`` and ``Σ X_f`` over its faces (``X_f`` the
     cross product of two edges, ``|X_f| = 2 A_f``; ``c_f`` the centroid), the sums of the tangential

@@ -72,7 +72,9 @@ def isotropic_remesh(
     the last iteration, :func:`~.stages.clean_slivers` flips or collapses away the faces with an
     angle below 35° where that raises the smallest angle around them, then moves the vertices of
     faces below 50° toward the centroid of their neighbours (on the surface), and those of faces
-    below 40° by short steps in the tangent plane, each where that raises it.
+    below 40° by short steps in the tangent plane, each where that raises it; last, it pulls the
+    nearest free vertex toward each input vertex left farther than a quarter of ``L`` from the
+    result (a tip), where the smallest angle around stays at least the result's smallest.
 
     With a target per vertex (an array, or ``adaptive=True``), an edge's ``L`` is the smaller of its
     two ends'; the loop's vertices take the target of their closest point on the input (linear

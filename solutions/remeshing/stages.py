@@ -126,7 +126,9 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
     where that raises the smallest angle around it (:func:`_relocate`): the last iteration's flips
     leave their faces unrelaxed, and a few of them are the mesh's smallest angles. The vertices of
     the faces below 40° also try short steps in eight directions of their tangent plane (a pattern
-    search), where the centroid is no better.
+    search), where the centroid is no better. Last, the input vertices the result lost (tips thinner
+    than the target length) each pull their nearest free vertex toward them, on the surface, where
+    the smallest angle around it stays at least the result's smallest angle (:func:`_cover`).
     """
     total = 0
     for _ in range(passes):
@@ -136,6 +138,7 @@ def clean_slivers(S: RemeshState, min_angle: float = SLIVER_ANGLE, passes: int =
             break
     if project is not None:
         total += _relocate(S, project, RELOCATE_ANGLE, passes)
+        total += _cover(S, project, COVER_PASSES)
     return total
 
 
@@ -186,6 +189,68 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
         total += done
         if not done:
             break
+    return total
+
+
+#: An input vertex farther from the result than this fraction of the split bound (a quarter of the
+#: target length: a flat part's remesh stays within a few hundredths of it) is uncovered (:func:`_cover`).
+COVER_DISTANCE = 0.25 / 1.4
+#: How far toward an uncovered input vertex its nearest free vertex is tried, in order (:func:`_cover`).
+COVER_STEPS = (1.0, 0.75, 0.5, 0.25)
+#: Passes of :func:`_cover` (each moves a vertex at most once; the next ones climb further up a tip).
+COVER_PASSES = 5
+
+
+def _cover(S: RemeshState, project, passes: int) -> int:
+    """Bring the result back to the tips of the input it lost (the loop's last step, given).
+
+    Where the input ends in a tip thinner than the target length (the cow's horns), each
+    relaxation moves the vertices near it toward their neighbours, down from the tip, and the
+    projection (closest point) cannot bring them back: the tip recedes a little every iteration
+    (cow at 0.75x its mean edge: its farthest input vertex 0.8 h from the result after one, 2.1 h
+    after ten). Here every input vertex farther
+    from the result than :data:`COVER_DISTANCE` times the split bound pulls its nearest free vertex
+    (a corner of the result's face closest to it) toward it: to the closest point on the surface of
+    the fractions :data:`COVER_STEPS` of the way, the first one where the smallest angle of the
+    faces around stays at least the result's smallest angle before this step and none turns over
+    (:func:`.kernels.cover_pass`); the farthest input vertex first. Over the passes a vertex climbs
+    toward the tip; the smallest angle of the result does not fall. The first pass measures every
+    input vertex (libigl's AABB tree of the result); the next ones the still uncovered vertices,
+    against the result's faces near them.
+    """
+    n = S.cnt[0]
+    Fl = S.faces()  # the passes move vertices only
+    X = project.V0
+    floor = K.faces_min_angle(S.V[:n], Fl).min() if len(Fl) else 0.0
+    U, reach = np.arange(len(X)), np.inf
+    steps = np.asarray(COVER_STEPS)
+    total = 0
+    for _ in range(passes):
+        V = S.V[:n]
+        sub = np.arange(len(Fl))
+        if np.isfinite(reach):  # only the faces that can hold the closest point of an uncovered vertex
+            near = np.isfinite(cKDTree(X[U]).query(V, distance_upper_bound=reach)[0])
+            sub = np.flatnonzero(near[Fl].any(axis=1))
+        tree = igl.AABB()
+        tree.init(V, Fl[sub])
+        d2, face, _ = tree.squared_distance(V, Fl[sub], X[U])
+        d, corners = np.sqrt(np.asarray(d2).ravel()), Fl[sub[np.asarray(face, np.int64).ravel()]]
+        far = np.flatnonzero(d > COVER_DISTANCE * S.high[corners[:, 0]])
+        if not len(far):
+            break
+        far = far[np.argsort(-d[far], kind="stable")]  # the farthest first
+        U, d, corners = U[far], d[far], corners[far]
+        g = V[corners] - X[U][:, None, :]
+        g2 = g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1] + g[..., 2] * g[..., 2]
+        w = corners[np.arange(len(U)), g2.argmin(axis=1)]
+        Q = V[w][:, None, :] + steps[None, :, None] * (X[U] - V[w])[:, None, :]
+        done = K.cover_pass(*S.args(), np.repeat(w, len(steps)), project(Q.reshape(-1, 3)), floor)
+        total += done
+        if not done:
+            break
+        # the next pass: the input vertices near these (a move may uncover the place it left)
+        reach = d[0] + 2.0 * S.high[:n].max()  # a face's corners are within this of its points' vertices
+        U = np.flatnonzero(np.isfinite(cKDTree(X[U]).query(X, distance_upper_bound=reach)[0]))
     return total
 
 
