@@ -202,7 +202,7 @@ def test_a_lab_added_by_the_documented_steps_appears_everywhere():
             root,
             {
                 "tests/framework/test_points.py": ("test_handout_grading_table_matches_the_tests and extra", 1),
-                "tests/test_lab_contracts.py": ("extra", 4),
+                "tests/test_lab_contracts.py": ("extra", 5),
             },
         )
         # release: the student bundle and the lab's own autograder
