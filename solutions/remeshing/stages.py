@@ -15,6 +15,7 @@ from scipy.spatial import cKDTree
 from geomlib import topology
 from geomlib.errors import MeshError
 from geomlib.geometry import closest_points
+from geomlib.portable import dot
 from geomlib.validate import check_float, check_mesh
 
 from . import kernels as K
@@ -241,8 +242,7 @@ def _cover(S: RemeshState, project, passes: int) -> int:
         far = far[np.argsort(-d[far], kind="stable")]  # the farthest first
         U, d, corners = U[far], d[far], corners[far]
         g = V[corners] - X[U][:, None, :]
-        g2 = g[..., 0] * g[..., 0] + g[..., 1] * g[..., 1] + g[..., 2] * g[..., 2]
-        w = corners[np.arange(len(U)), g2.argmin(axis=1)]
+        w = corners[np.arange(len(U)), dot(g, g).argmin(axis=1)]
         Q = V[w][:, None, :] + steps[None, :, None] * (X[U] - V[w])[:, None, :]
         done = K.cover_pass(*S.args(), np.repeat(w, len(steps)), project(Q.reshape(-1, 3)), floor)
         total += done
@@ -317,15 +317,6 @@ def _line_tangents(V, E_feat, n):
     on = np.unique(E_feat)  # only the line's vertices have a direction
     t[on] = np.linalg.eigh(M[on])[1][:, :, 2]
     return t
-
-
-def _cross(a, b):
-    """Row-wise cross product of (k, 3) arrays (np.cross's arithmetic, without its per-call overhead)."""
-    out = np.empty_like(a)
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
 
 
 def _relax(V, F, cls, E_feat, damping):
