@@ -162,22 +162,14 @@ def sandbox_user_problem(user: str = "nobody") -> str | None:
 
 
 def student_copy(lab: str, dest: Path) -> Path:
-    """What a student's bundle holds of ``lab``: its stubs, public graded tests and references (no
-    hidden material, no solutions), with the grader, in ``dest`` (also bench/grading.py's: what a student
-    grades)."""
+    """What a student's bundle holds of ``lab`` (``geomlib release``'s own list of the student's
+    files: stubs, public graded tests and references, the grader; no hidden material, no solutions),
+    copied into ``dest`` (also bench/grading.py's: what a student grades)."""
     from geomlib.grading import impl as _impl
+    from geomlib.grading import release
     from geomlib.grading.course import Course
 
-    root = _impl.course_root()
-    hidden = shutil.ignore_patterns("__pycache__", "*hidden*")
-    for rel in ("geomlib", f"labs/{lab}", f"tests/graded/{lab}", f"tests/reference/{lab}"):
-        shutil.copytree(root / rel, dest / rel, ignore=hidden)
-    for rel in (
-        "pyproject.toml",
-        "tests/conftest.py",
-        *(p.relative_to(root) for p in (root / "tests/graded").glob("*.py")),
-    ):
-        shutil.copy2(root / rel, dest / rel)
+    release._copy(release.student_files(_impl.course_root(), [lab]), dest)
     assert not Course(dest).hidden_paths(), "the copy must hold no hidden material"
     return dest
 
