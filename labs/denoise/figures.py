@@ -139,13 +139,26 @@ def fig_iterations(out: Path, L, quick: bool) -> Drawn:
 # 3. the offset map
 
 
-@figure_name("offset_map")
-def fig_offset_map(out: Path, L, quick: bool) -> Drawn:
+def _noisy_sphere(L, quick: bool):
+    """The latitude-longitude UV sphere of the offset-map figures (one seam) and its noisy copy:
+    ``V, F, UV`` and ``Vn, N`` of ``make_noisy(V, F, 0.3, seed 0)``."""
     V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
     Vn, N = L.make_noisy(V, F, 0.3, 0)
+    return V, F, UV, Vn, N
+
+
+def _sphere_offset_map(L, quick: bool):
+    """:func:`_noisy_sphere`, its normal offsets ``s`` (no seam fix) and their 16-bit offset map of
+    ``res x res`` texels: ``V, F, UV, Vn, N, s, res, (image, bias, scale)``."""
+    V, F, UV, Vn, N = _noisy_sphere(L, quick)
     s = np.asarray(L.normal_offsets(L.laplacian_offsets(Vn, F), N))
     res = 192 if quick else 256
-    img16, bias, scale = L.bake_offset_map(Vn, F, UV, s, res, 16)
+    return V, F, UV, Vn, N, s, res, L.bake_offset_map(Vn, F, UV, s, res, 16)
+
+
+@figure_name("offset_map")
+def fig_offset_map(out: Path, L, quick: bool) -> Drawn:
+    V, F, UV, Vn, N, s, res, (img16, bias, scale) = _sphere_offset_map(L, quick)
     side = 220 if quick else 256
     grey = np.asarray(img16, np.float64) / 65535.0
     lim = float(np.abs(s).max())
@@ -179,11 +192,8 @@ def fig_offset_map(out: Path, L, quick: bool) -> Drawn:
 @figure_name("denoise_glsl")
 def fig_glsl(out: Path, L, quick: bool) -> Drawn:
     """The map-driven pass by the NumPy route and by ``shaders/denoise.vert`` (task 7), and the difference."""
-    V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
-    Vn, N = L.make_noisy(V, F, 0.3, 0)
-    s = np.asarray(L.normal_offsets(L.laplacian_offsets(Vn, F), N))
-    res, lam = (192 if quick else 256), 1.0
-    img16, bias, scale = L.bake_offset_map(Vn, F, UV, s, res, 16)
+    V, F, UV, Vn, N, s, res, (img16, bias, scale) = _sphere_offset_map(L, quick)
+    lam = 1.0
     X_np = np.asarray(L.denoise_with_map(Vn, F, UV, N, img16, bias, scale, lam), np.float64)
     X_gl = np.asarray(L.glsl_denoise_with_map(Vn, F, UV, N, img16, bias, scale, lam), np.float64)
     h = float(np.linalg.norm(Vn[F[:, 1]] - Vn[F[:, 0]], axis=1).mean())
@@ -223,9 +233,8 @@ def fig_glsl(out: Path, L, quick: bool) -> Drawn:
 
 @figure_name("seam_crack")
 def fig_seam(out: Path, L, quick: bool) -> Drawn:
-    V, F, UV = datasets.uv_sphere(24, 48) if quick else datasets.uv_sphere(32, 64)
+    V, F, UV, Vn, N = _noisy_sphere(L, quick)
     _, _, group = L.weld_seams(V, F)
-    Vn, N = L.make_noisy(V, F, 0.3, 0)
     res = 256 if quick else 512
     size = (260, 260) if quick else (340, 340)
     rows = []

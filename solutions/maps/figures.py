@@ -22,6 +22,10 @@ __all__ = ["make_figures", "make_view", "bump_tiles", "smooth_noise"]
 LAB = "maps"
 ALBEDO = (0.80, 0.66, 0.52)
 BACKGROUND = (1.0, 1.0, 1.0)
+#: Blinn-Phong settings of every shaded picture (NumPy and GLSL routes).
+SHADING = {"background": BACKGROUND, "specular": 0.25, "shininess": 24.0}
+#: Radii (R around, r across) of the bumpy torus and the height ``lambda`` of its bumps.
+TORUS_RADII, BUMP_HEIGHT = (1.0, 0.35), 0.05
 # Two lighting set-ups (directions in which the light travels; z is up in every scene here).
 KEY_LIGHTS = [
     {"direction": (0.6, 0.5, -0.8), "intensity": 0.95},
@@ -62,10 +66,28 @@ def _view(V: np.ndarray, direction, size: int, fov: float = 30.0, margin: float 
     return eye, M
 
 
+def _display(img) -> np.ndarray:
+    """Linear RGB in [0, 1] as 8-bit display values (gamma 2.2)."""
+    return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)
+
+
 def _shaded(L, V, F, eye, M, size, lights, *, N=None, UV=None, tangents=None, normal_map=None, wrap="clamp"):
     g = L.rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tangents)
-    img = L.shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, background=BACKGROUND, specular=0.25, shininess=24.0)
-    return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)  # display gamma
+    return _display(L.shade(g, lights, eye, ALBEDO, normal_map, wrap=wrap, **SHADING))
+
+
+def _bumpy_torus(L, s: int):
+    """The normal-mapped torus of the first and the GLSL figures: ``24 x 8`` bumps (an ``s x s`` height
+    map) on a ``48 x 24`` UV torus. Returns ``H``, its normal map, ``V, F, UV``, the welded normals and
+    the tangents ``(T, w)`` as one ``(n, 4)`` array."""
+    H = bump_tiles(s, 24, 8)
+    R, r, lam = TORUS_RADII + (BUMP_HEIGHT,)
+    # Tangent-space slope of the relief: the UV square spans 2 pi R around and 2 pi r across.
+    nmap = L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
+    V, F, UV = datasets.uv_torus(48, 24, R, r)
+    N = L.welded_vertex_normals(V, F)
+    T, _, _, w = L.tangent_frames(V, F, UV, N)
+    return H, nmap, V, F, UV, N, np.column_stack([T, w])
 
 
 def _grey(H: np.ndarray) -> np.ndarray:
@@ -82,18 +104,10 @@ def _thumb(img: np.ndarray, size: int) -> np.ndarray:
 @figure_name("mapped_vs_displaced")
 def _fig_mapped_vs_displaced(out: Path, L, quick: bool) -> list[Figure]:
     size, s = (160, 256) if quick else (300, 512)
-    nu, nv = 24, 8
-    H = bump_tiles(s, nu, nv)
-    R, r, lam = 1.0, 0.35, 0.05
-    # Tangent-space slope of the relief: the UV square spans 2 pi R around and 2 pi r across.
-    nmap = L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
-    V, F, UV = datasets.uv_torus(48, 24, R, r)
-    N = L.welded_vertex_normals(V, F)
-    T, _, _, w = L.tangent_frames(V, F, UV, N)
-    tg = np.column_stack([T, w])
+    H, nmap, V, F, UV, N, tg = _bumpy_torus(L, s)
     dm, dn = (144, 48) if quick else (384, 128)
-    Vd0, Fd, UVd = datasets.uv_torus(dm, dn, R, r)
-    Vd, Nd = L.displace(Vd0, Fd, UVd, None, H, lam=lam, wrap="repeat", return_normals=True)
+    Vd0, Fd, UVd = datasets.uv_torus(dm, dn, *TORUS_RADII)
+    Vd, Nd = L.displace(Vd0, Fd, UVd, None, H, lam=BUMP_HEIGHT, wrap="repeat", return_normals=True)
     eye, M = _view(Vd, (0.15, -1.0, 0.85), size, margin=0.8)
     figs = []
     for name, lights, label in (
@@ -131,28 +145,18 @@ def _fig_mapped_vs_displaced(out: Path, L, quick: bool) -> list[Figure]:
 def _fig_glsl(out: Path, L, quick: bool) -> Drawn:
     """The normal-mapped torus by the NumPy shader and by ``tbn.vert`` + ``normalmap.frag`` (tasks 7-8)."""
     size, s = (160, 256) if quick else (300, 512)
-    H = bump_tiles(s, 24, 8)
-    R, r, lam = 1.0, 0.35, 0.05
-    nmap = L.height_to_normal_map(H, (lam / (2 * np.pi * R), lam / (2 * np.pi * r)), border="wrap")
-    V, F, UV = datasets.uv_torus(48, 24, R, r)
-    N = L.welded_vertex_normals(V, F)
-    T, _, _, w = L.tangent_frames(V, F, UV, N)
-    tg = np.column_stack([T, w])
+    H, nmap, V, F, UV, N, tg = _bumpy_torus(L, s)
     eye, M = _view(V, (0.15, -1.0, 0.85), size, margin=0.8)
     g = L.rasterize_mesh(V, F, M, size, size, UV=UV, N=N, tangents=tg)
-    opts = dict(wrap="repeat", background=BACKGROUND, specular=0.25, shininess=24.0)
+    opts = dict(wrap="repeat", **SHADING)
     a = np.asarray(L.shade(g, KEY_LIGHTS, eye, ALBEDO, nmap, **opts), np.float64)
     b = np.asarray(L.glsl_shade(g, KEY_LIGHTS, eye, ALBEDO, nmap, **opts), np.float64)
     d = np.abs(a - b).max(axis=2)  # linear RGB in [0, 1], the largest channel
     d8 = d * 255
     hi = max(float(d8.max()), 1e-9)
-
-    def show(img):
-        return (np.clip(img, 0.0, 1.0) ** (1 / 2.2) * 255).round().astype(np.uint8)  # display gamma
-
     images = [
-        show(a),
-        show(b),
+        _display(a),
+        _display(b),
         with_colorbar(
             heatmap_image(d8, "magma_r", 0.0, hi),
             colorbar(0.0, hi, "magma_r", label="|NumPy - GLSL| x 255", height=size),
