@@ -12,6 +12,8 @@ import numpy as np
 
 from geomlib import camera, datasets, portable
 from geomlib.grading.checks import Context, as_output_array, format_vec
+from geomlib.grading.errors import Mismatch
+from geomlib.grading.feedback import failure_picture
 
 from .. import common
 
@@ -174,3 +176,30 @@ class NanClose:
                 f"{self.output}[{r}] expected {format_vec(e[r])}, got {format_vec(g[r])}; "
                 f"{int((diff > self.atol).sum())} of {len(e)} rows off by more than {self.atol:g}"
             )
+
+
+# --------------------------------------------------------------------------------- GLSL routes
+
+
+#: What :func:`gpu_array` says when per-point visibilities come back in another shape.
+VISIBILITY_SHAPES = "the result has shape {got}, expected one visibility per point {expected}"
+
+
+def gpu_array(label: str, got, expected: np.ndarray, shapes: str) -> np.ndarray:
+    """A GLSL route's result ``got`` as a float array shaped like ``expected``; otherwise a
+    :class:`Mismatch` that starts with ``label`` and says ``shapes`` (formatted with the shapes
+    ``got`` and ``expected``)."""
+    try:
+        g = np.asarray(got, float)
+    except (TypeError, ValueError):
+        raise Mismatch(f"{label}: the result is not a numeric array") from None
+    if g.shape != expected.shape:
+        raise Mismatch(f"{label}: " + shapes.format(got=g.shape, expected=expected.shape))
+    return g
+
+
+def visibility_picture(label: str, mask: np.ndarray, got: np.ndarray, expected: np.ndarray, atol: float):
+    """The failure picture of per-point visibilities laid out on the pixels ``mask`` (1, lit, elsewhere)."""
+    img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
+    img_e[mask], img_g[mask] = expected, got
+    return failure_picture(label, img_g, img_e, name="visibility", atol=atol)

@@ -32,6 +32,7 @@ from geomlib.grading.feedback import failure_picture
 
 from .cases_cube_glsl import ROOM_GRID, STORED, STORED_HIDDEN, ties_points
 from .cases_glsl import eye_points
+from .support import VISIBILITY_SHAPES, gpu_array, visibility_picture
 
 CUBE_DEPTH_ATOL = 1e-3
 CUBE_TEXELS_BAD = 1e-3
@@ -59,12 +60,7 @@ def expect_cube_maps(label: str, got, expected) -> None:
     CUBE_DEPTH_ATOL there, except on at most CUBE_TEXELS_BAD of the texels. The message names the face and
     the stage that is likely wrong."""
     e = np.asarray(expected, float)
-    try:
-        g = np.asarray(got, float)
-    except (TypeError, ValueError):
-        raise Mismatch(f"{label}: the result is not a numeric array") from None
-    if g.shape != e.shape:
-        raise Mismatch(f"{label}: the maps have shape {g.shape}, expected {e.shape} (six faces)")
+    g = gpu_array(label, got, e, "the maps have shape {got}, expected {expected} (six faces)")
     empty = _empty(e.shape[1])[None]
     cov_e, cov_g = np.abs(e - empty) > 1e-9, np.abs(g - empty) > 1e-9
     coverage = cov_e != cov_g
@@ -121,20 +117,13 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
     e = stored_input("shadows", case_id)["visibility"]
     opts = ", ".join(f"{k}={v!r}" for k, v in case.params.items()) or "the defaults"
     label = f'{CUBE_SHADOW_LABEL} on "{case_id}" ({opts})'
-    try:
-        g = np.asarray(got, float)
-    except (TypeError, ValueError):
-        raise Mismatch(f"{label}: the result is not a numeric array") from None
-    if g.shape != e.shape:
-        raise Mismatch(f"{label}: the result has shape {g.shape}, expected one visibility per point {e.shape}")
+    g = gpu_array(label, got, e, VISIBILITY_SHAPES)
     bad = ~(np.abs(g - e) <= CUBE_VISIBILITY_ATOL)  # NaN counts as wrong
     if bad.mean() <= CUBE_VISIBILITY_BAD and not np.isnan(g).any():
         return
     room = "-room-" in case_id  # the walls of a room around the light, side by side, instead of the eye view
     ties = "-ties-" in case_id  # 10 points on each of the cube's 12 edges, a row per edge
     mask = np.ones((ROOM_GRID, 6 * ROOM_GRID), bool) if room else ties_points()[0] if ties else eye_points()[0]
-    img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
-    img_e[mask], img_g[mask] = e, g
     i = int(np.flatnonzero(np.isnan(g))[0]) if np.isnan(g).any() else int(np.flatnonzero(bad)[0])
     r, c = (int(x) for x in np.argwhere(mask)[i])
     nan = " (NaN: a division by zero, or a read outside the cube map?)" if np.isnan(g[i]) else ""
@@ -154,7 +143,7 @@ def check_glsl_cube_shadow(lab, case_id: str) -> None:
         f"{label}: {where} expected visibility {e[i]:.6g}, got {g[i]:.6g}{nan}; "
         f"{int(bad.sum())} of {bad.size} points differ by more than {CUBE_VISIBILITY_ATOL:g} (at most "
         f"{CUBE_VISIBILITY_BAD:.1%} may, points on a texel border); by the light's cube face: {per_face}",
-        failure_picture(label, img_g, img_e, name="visibility", atol=CUBE_VISIBILITY_ATOL),
+        visibility_picture(label, mask, g, e, CUBE_VISIBILITY_ATOL),
     )
 
 

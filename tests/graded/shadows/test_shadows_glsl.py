@@ -29,7 +29,7 @@ from geomlib.grading.feedback import failure_picture
 from ..common import hidden_cases
 from .cases import CASES
 from .cases_glsl import STORED, STORED_HIDDEN, eye_points
-from .support import small_scene
+from .support import VISIBILITY_SHAPES, gpu_array, small_scene, visibility_picture
 
 GLSL_DEPTH_ATOL = 1e-3
 GLSL_COVERAGE_BAD = 1e-3
@@ -46,12 +46,7 @@ def expect_depth_map(label: str, got, expected) -> None:
     """A GPU depth map against the NumPy one: the same covered texels (up to GLSL_COVERAGE_BAD of them),
     depths within GLSL_DEPTH_ATOL there, 1.0 elsewhere. The message says which stage is likely wrong."""
     e = np.asarray(expected, float)
-    try:
-        g = np.asarray(got, float)
-    except (TypeError, ValueError):
-        raise Mismatch(f"{label}: the result is not a numeric array") from None
-    if g.shape != e.shape:
-        raise Mismatch(f"{label}: the map has shape {g.shape}, expected {e.shape}")
+    g = gpu_array(label, got, e, "the map has shape {got}, expected {expected}")
     cov_e, cov_g = e < 1.0, g < 1.0
     coverage = cov_e != cov_g
     per = np.where(cov_e & cov_g, np.abs(g - e), np.where(coverage, np.abs(g - e), 0.0))
@@ -107,25 +102,18 @@ def check_glsl_shadow(lab, case_id: str) -> None:
     e = stored_input("shadows", case_id)["visibility"]
     opts = ", ".join(f"{k}={v!r}" for k, v in case.params.items()) or "the defaults"
     label = f'{SHADOW_LABEL} on "{case_id}" ({opts})'
-    try:
-        g = np.asarray(got, float)
-    except (TypeError, ValueError):
-        raise Mismatch(f"{label}: the result is not a numeric array") from None
-    if g.shape != e.shape:
-        raise Mismatch(f"{label}: the result has shape {g.shape}, expected one visibility per point {e.shape}")
+    g = gpu_array(label, got, e, VISIBILITY_SHAPES)
     bad = ~(np.abs(g - e) <= GLSL_VISIBILITY_ATOL)  # NaN counts as wrong
     if not bad.any():
         return
     mask = eye_points()[0]
-    img_e, img_g = np.ones(mask.shape), np.ones(mask.shape)
-    img_e[mask], img_g[mask] = e, g
     r, c = (int(i) for i in np.argwhere(mask)[np.flatnonzero(bad)[0]])
     i = int(np.flatnonzero(bad)[0])
     nan = " (NaN: a division by zero, or a read outside the map?)" if np.isnan(g[i]) else ""
     raise Mismatch(
         f"{label}: pixel [{r}, {c}] of the eye view expected visibility {e[i]:.6g}, got {g[i]:.6g}{nan}; "
         f"{int(bad.sum())} of {bad.size} pixels differ by more than {GLSL_VISIBILITY_ATOL:g}",
-        failure_picture(label, img_g, img_e, name="visibility", atol=GLSL_VISIBILITY_ATOL),
+        visibility_picture(label, mask, g, e, GLSL_VISIBILITY_ATOL),
     )
 
 
