@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -16,6 +17,8 @@ from pathlib import Path
 import pytest
 
 SAMPLE = Path(__file__).parent / "sample_course"
+#: The real course (this checkout).
+COURSE = Path(__file__).resolve().parents[2]
 
 
 def run_geomlib(
@@ -244,6 +247,49 @@ def failure_of(lab: str, edit, run: Callable, error: type[Exception], timeout: f
     with planted_lab(lab, edit, timeout) as proxy, pytest.raises(error) as e:
         run(proxy)
     return str(e.value)
+
+
+# ---------------------------------------------------------------- a lab's shaders (the GLSL routes)
+
+
+def assert_compile_error_names_its_line(lab: str, shader: str, needle: str, typo: str, run: Callable, head: str,
+                                        timeout: float | None = None) -> None:  # fmt: skip
+    """Misspell ``typo`` in the line ``needle`` of the solution's ``shaders/<shader>`` (an undeclared
+    name, which the driver reports on that very line): the first line of the
+    :class:`~geomlib.grading.errors.GradingFailure` that ``run(proxy)`` raises on that copy is ``head``
+    (a regular expression: function, shader, task and stage) then `` did not compile, line N`` with N
+    that line, and names the misspelt identifier, not the Python wrapper."""
+    from geomlib.grading.errors import GradingFailure
+
+    line = shader_line(lab, shader, needle)
+    first = failure_of(lab, misspelt(shader, needle, typo), run, GradingFailure, timeout=timeout).splitlines()[0]
+    m = re.match(rf"{head} did not compile, line (?P<line>\d+)", first)
+    assert m, first
+    assert int(m.group("line")) == line, (first, line)
+    assert f"{typo}_misspelt" in first and "glsl.py" not in first, first
+
+
+def assert_hang_names_its_task(lab: str, shader: str, task: str) -> None:
+    """The shader watchdog's message for a hang in ``labs/<lab>/shaders/<shader>`` names the shader
+    followed by ``(<task>`` and says what a hang usually is."""
+    from geomlib.grading import shader_watch
+
+    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / lab])
+    assert f"shaders/{shader} ({task}" in msg and "a loop that does not end" in msg, msg
+
+
+def stub_error_lines(lab: str, shader: str, task: str) -> list[str]:
+    """The ``#error`` lines of the stub ``labs/<lab>/shaders/<shader>``, after checking that the stub is
+    the solution's shader through :func:`~geomlib.grading.stubs.make_stub` and that it has some, each
+    naming ``task`` (``"Task 7 ("``)."""
+    from geomlib.grading.stubs import make_stub
+
+    solution = (COURSE / "solutions" / lab / "shaders" / shader).read_text()
+    stub = (COURSE / "labs" / lab / "shaders" / shader).read_text()
+    assert stub == make_stub(solution, f"shaders/{shader}")
+    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
+    assert errors and all(e.startswith(f"#error {task}") for e in errors), errors
+    return errors
 
 
 #: A lab's stub ``kernels.py`` with one numba task kernel (``scale``, "Task 1") and one given kernel

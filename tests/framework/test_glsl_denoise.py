@@ -4,38 +4,28 @@ check with the stage named; a hang is named with its task; the stub is the solut
 
 from __future__ import annotations
 
-import re
-from pathlib import Path
-
 import pytest
 
-from geomlib.grading import shader_watch
 from geomlib.grading.cases import load_cases
-from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.stubs import make_stub
+from geomlib.grading.errors import Mismatch
 
-from .course import failure_of, misspelt, shader_edit, shader_line
+from .course import (
+    assert_compile_error_names_its_line,
+    assert_hang_names_its_task,
+    failure_of,
+    shader_edit,
+    stub_error_lines,
+)
 
-COURSE = Path(__file__).resolve().parents[2]
 SHADER = "denoise.vert"
 
 
 def test_a_compile_error_names_the_shader_its_line_and_task():
     needle = "return p - lam * s * n;"
     case = next(c for c in load_cases("denoise") if c.id == "map-uv-sphere-8bit")
-    msg = failure_of(
-        "denoise",
-        misspelt(SHADER, needle, "lam"),
-        lambda lab: lab.call("glsl_denoise_with_map", **case.inputs(), **case.params),
-        GradingFailure,
-    )
-    first, line = msg.splitlines()[0], shader_line("denoise", SHADER, needle)
-    m = re.match(
-        r"glsl_denoise_with_map: shaders/denoise\.vert \(Task 7: vertex denoising\) \(vertex shader\) "
-        r"did not compile, line (\d+)",
-        first,
-    )
-    assert m and int(m.group(1)) == line and "lam_misspelt" in first, (first, line)
+    run = lambda lab: lab.call("glsl_denoise_with_map", **case.inputs(), **case.params)  # noqa: E731
+    head = r"glsl_denoise_with_map: shaders/denoise\.vert \(Task 7: vertex denoising\) \(vertex shader\)"
+    assert_compile_error_names_its_line("denoise", SHADER, needle, "lam", run, head)
 
 
 @pytest.mark.parametrize(
@@ -56,13 +46,8 @@ def test_nan_and_reads_outside_the_map_fail_the_shader_s_own_check(old, new, nee
 
 
 def test_a_hanging_shader_is_named_with_its_task():
-    msg = shader_watch.timeout_message("glsl_denoise_with_map", 60, f"shaders/{SHADER}", [COURSE / "labs" / "denoise"])
-    assert "shaders/denoise.vert (Task 7 (vertex denoising))" in msg and "a loop that does not end" in msg, msg
+    assert_hang_names_its_task("denoise", SHADER, "Task 7 (vertex denoising))")
 
 
 def test_the_stub_is_the_solution_with_error_directives():
-    solution = (COURSE / "solutions" / "denoise" / "shaders" / SHADER).read_text()
-    stub = (COURSE / "labs" / "denoise" / "shaders" / SHADER).read_text()
-    assert stub == make_stub(solution, f"shaders/{SHADER}")
-    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
-    assert len(errors) == 2 and all(e.startswith("#error Task 7 (vertex denoising)") for e in errors), errors
+    assert len(stub_error_lines("denoise", SHADER, "Task 7 (vertex denoising)")) == 2

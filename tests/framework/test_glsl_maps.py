@@ -6,19 +6,22 @@ their task is written and fail only their own tests."""
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 
-from geomlib.grading import shader_watch
 from geomlib.grading.cases import load_cases
-from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.stubs import make_stub
+from geomlib.grading.errors import Mismatch
 
-from .course import failure_of, misspelt, shader_edit, shader_line
+from .course import (
+    assert_compile_error_names_its_line,
+    assert_hang_names_its_task,
+    failure_of,
+    shader_edit,
+    stub_error_lines,
+)
 
-COURSE = Path(__file__).resolve().parents[2]
 CASE = {c.id: c for c in load_cases("maps")}
+TASK = {"tbn.vert": 7, "normalmap.frag": 8, "displace.vert": 9}
 
 
 def _shade_inputs():
@@ -53,14 +56,8 @@ def _tbn_inputs():
     ],
 )
 def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, task):
-    line = shader_line("maps", shader, needle)
-    msg = failure_of("maps", misspelt(shader, needle, typo), lambda lab: lab.call(function, **inputs()), GradingFailure)
-    first = msg.splitlines()[0]  # an undeclared name: the driver names this very line
-    head = rf"{function}: shaders/{re.escape(shader)} \({task}[^)]*\)( \(vertex shader\))? did not compile, line (\d+)"
-    m = re.match(head, first)
-    assert m, first
-    assert int(m.group(2)) == line, (first, line)
-    assert "_misspelt" in first and "glsl.py" not in first, first
+    head = rf"{function}: shaders/{re.escape(shader)} \({task}[^)]*\)( \(vertex shader\))?"
+    assert_compile_error_names_its_line("maps", shader, needle, typo, lambda lab: lab.call(function, **inputs()), head)
 
 
 def _fail_of(edit, check: str, case_id: str) -> str:
@@ -99,21 +96,13 @@ def test_a_wrong_stage_is_named_by_its_shader():
     assert "shaders/tbn.vert, the vertex stage" in msg and ", N" in msg, msg
 
 
-@pytest.mark.parametrize("shader", ["tbn.vert", "normalmap.frag", "displace.vert"])
+@pytest.mark.parametrize("shader", list(TASK))
 def test_a_hanging_shader_is_named_with_its_task(shader):
-    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / "maps"])
-    n = {"tbn.vert": 7, "normalmap.frag": 8, "displace.vert": 9}[shader]
-    assert f"shaders/{shader} (Task {n} (" in msg and "a loop that does not end" in msg, msg
+    assert_hang_names_its_task("maps", shader, f"Task {TASK[shader]} (")
 
 
-@pytest.mark.parametrize("shader", ["tbn.vert", "normalmap.frag", "displace.vert"])
+@pytest.mark.parametrize("shader", list(TASK))
 def test_the_stubs_are_the_solutions_with_error_directives_and_compile_once_written(shader):
     """The stub differs from the solution only by ``#error`` lines where the solution blocks were; with
     the solution's lines put back it is the solution (which compiles: the graded tests run it)."""
-    solution = (COURSE / "solutions" / "maps" / "shaders" / shader).read_text()
-    stub = (COURSE / "labs" / "maps" / "shaders" / shader).read_text()
-    assert stub == make_stub(solution, f"shaders/{shader}")
-    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
-    assert errors and all(e.startswith("#error Task ") for e in errors), errors
-    n = {"tbn.vert": 7, "normalmap.frag": 8, "displace.vert": 9}[shader]
-    assert all(e.startswith(f"#error Task {n} (") for e in errors), errors
+    stub_error_lines("maps", shader, f"Task {TASK[shader]} (")

@@ -6,20 +6,22 @@ task's tests; a hang is named with its task; the stubs are the solutions with ``
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from geomlib.grading import shader_watch
 from geomlib.grading.errors import GradingFailure, Mismatch
-from geomlib.grading.stubs import make_stub
 from tests.graded.shadows.support import small_scene
 
-from .course import failure_of, misspelt, planted_lab, shader_edit, shader_line
+from .course import (
+    assert_compile_error_names_its_line,
+    assert_hang_names_its_task,
+    failure_of,
+    planted_lab,
+    shader_edit,
+    stub_error_lines,
+)
 
-COURSE = Path(__file__).resolve().parents[2]
-SHADERS = COURSE / "solutions" / "shadows" / "shaders"
 TASK = {"cube_depth.vert": 11, "cube_depth.frag": 11, "cube_shadow.frag": 12}
 LIGHT = {"position": np.array([0.2, -0.3, 2.6]), "near": 0.2, "far": 12.0}
 
@@ -46,17 +48,9 @@ def _shadow_inputs():
     ],
 )  # fmt: skip
 def test_a_compile_error_names_the_shader_its_line_and_task(shader, function, inputs, needle, typo, stage):
-    line = shader_line("shadows", shader, needle)
-    edit = misspelt(shader, needle, typo)
-    msg = failure_of("shadows", edit, lambda lab: lab.call(function, **inputs()), GradingFailure, timeout=180)
-    first = msg.splitlines()[0]
-    m = re.match(
-        rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage} did not compile, line (\d+)",
-        first,
-    )
-    assert m, first
-    assert int(m.group(1)) == line, (first, line)
-    assert "_misspelt" in first and "cube_glsl.py" not in first, first
+    head = rf"{function}: shaders/{re.escape(shader)} \(Task {TASK[shader]}: [^)]*\){stage}"
+    run = lambda lab: lab.call(function, **inputs())  # noqa: E731
+    assert_compile_error_names_its_line("shadows", shader, needle, typo, run, head, timeout=180)
 
 
 def _fail_of(edit, check: str, *args) -> str:
@@ -207,14 +201,9 @@ def test_a_broken_cube_lookup_costs_only_its_own_tests():
 
 @pytest.mark.parametrize("shader", ["cube_depth.frag", "cube_shadow.frag"])
 def test_a_hanging_shader_is_named_with_its_task(shader):
-    msg = shader_watch.timeout_message("glsl_x", 60, f"shaders/{shader}", [COURSE / "labs" / "shadows"])
-    assert f"shaders/{shader} (Task {TASK[shader]} (" in msg and "a loop that does not end" in msg, msg
+    assert_hang_names_its_task("shadows", shader, f"Task {TASK[shader]} (")
 
 
 @pytest.mark.parametrize("shader", list(TASK))
 def test_the_stubs_are_the_solutions_with_error_directives(shader):
-    solution = (SHADERS / shader).read_text()
-    stub = (COURSE / "labs" / "shadows" / "shaders" / shader).read_text()
-    assert stub == make_stub(solution, f"shaders/{shader}")
-    errors = [ln.strip() for ln in stub.splitlines() if ln.strip().startswith("#error")]
-    assert errors and all(e.startswith(f"#error Task {TASK[shader]} (") for e in errors), errors
+    stub_error_lines("shadows", shader, f"Task {TASK[shader]} (")
