@@ -19,22 +19,39 @@ ROOT = Path(__file__).resolve().parents[2]
 TOOLS = ("bash", "grep", "mktemp", "cat", "rm", "uname", "tr", "dirname", "true")
 
 
+def _fake_machine(
+    tmp_path: Path, scripts: dict[str, str], libraries, tools=TOOLS, private: dict[str, str] | None = None
+) -> dict[str, str]:
+    """A machine for ``./run``: ``fake/`` holds the ``scripts`` (bash bodies by name) first on the PATH,
+    ``tools/`` links to the real ``tools``, ``lib/`` empty files named ``libraries`` (the only folder
+    where ``./run`` looks for them) and ``private/`` the ``private`` scripts, off the PATH. Returns the
+    environment (PATH, HOME, GEOMLIB_LIB_DIRS)."""
+    fake, bin_dir, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
+    for d in (fake, bin_dir, libs):
+        d.mkdir()
+    for t in tools:
+        (bin_dir / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
+    for lib in libraries:
+        (libs / lib).write_text("")
+    bash = shutil.which("bash")
+    places = [(fake, scripts)] + ([(tmp_path / "private", private)] if private is not None else [])
+    for folder, bodies in places:
+        folder.mkdir(exist_ok=True)
+        for name, body in bodies.items():
+            (folder / name).write_text(f"#!{bash}\n{body}\n")
+            (folder / name).chmod(0o755)
+    return {"PATH": f"{fake}:{bin_dir}", "HOME": str(tmp_path), "GEOMLIB_LIB_DIRS": str(libs)}
+
+
+#: What ``./run`` needs of OpenGL: OSMesa, and libGL and libXrender for pyrender.
+OPENGL = ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1")
+
+
 def _run(
     tmp_path: Path, *args: str, uid: int, has_osmesa: bool, sudo_ok: bool = False, has_libgl: bool | None = None
 ) -> tuple[str, list[str]]:
-    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
-    for d in (fake, tools, libs):
-        d.mkdir()
-    for t in TOOLS:
-        found = shutil.which(t)
-        if not found:
-            pytest.skip(f"{t} is not installed")
-        (tools / t).symlink_to(found)
-    if has_osmesa:
-        (libs / "libOSMesa.so.8").write_text("")
-    if has_osmesa if has_libgl is None else has_libgl:
-        (libs / "libGL.so.1").write_text("")
-        (libs / "libXrender.so.1").write_text("")
+    gl = has_osmesa if has_libgl is None else has_libgl
+    libraries = (OPENGL[:1] if has_osmesa else ()) + (OPENGL[1:] if gl else ())
     log = tmp_path / "calls.log"
     scripts = {
         "id": f'[ "$1" = -u ] && echo {uid} || echo "uid={uid}"',
@@ -43,10 +60,7 @@ def _run(
         "apt-cache": 'echo "  Candidate: 1.0"',
         "python3": f'echo "python3 $*" >> {log}; exit 1',
     }
-    for name, body in scripts.items():
-        (fake / name).write_text(f"#!{shutil.which('bash')}\n{body}\n")
-        (fake / name).chmod(0o755)
-    env = {"PATH": f"{fake}:{tools}", "HOME": str(tmp_path), "GEOMLIB_LIB_DIRS": str(libs)}
+    env = _fake_machine(tmp_path, scripts, libraries)
     p = subprocess.run([str(ROOT / "run"), *args], env=env, capture_output=True, text=True, timeout=120)
     assert p.returncode == 1, p.stderr  # stopped by the fake python3, after the system step
     calls = log.read_text().splitlines() if log.exists() else []
@@ -148,26 +162,17 @@ exit 0
     return p, (log.read_text().splitlines() if log.exists() else [])
 
 
-def _fake_root_with_osmesa(tmp_path: Path, *, uv: str, apt_get: str) -> dict[str, str]:
-    """The environment of a ``./run`` as root (fake ``id``) with libOSMesa present, the shell tools and
-    the system ``python3`` on the PATH, and the fake ``uv`` and ``apt-get`` given as bash bodies."""
-    fake, tools, libs = tmp_path / "fake", tmp_path / "tools", tmp_path / "lib"
-    for d in (fake, tools, libs):
-        d.mkdir()
-    for t in (*TOOLS, "python3"):
-        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1"):  # OpenGL
-        (libs / lib).write_text("")
-    bash = shutil.which("bash")
-    for name, body in {"id": "echo 0", "uv": uv, "apt-get": apt_get}.items():
-        (fake / name).write_text(f"#!{bash}\n{body}")
-        (fake / name).chmod(0o755)
-    return {
-        "PATH": f"{fake}:{tools}",
-        "HOME": str(tmp_path),
-        "GEOMLIB_LIB_DIRS": str(libs),
-        "GEOMLIB_UV": str(fake / "uv"),
-    }
+def _fake_root_with_osmesa(tmp_path: Path, *, uv: str, apt_get: str | None = None, private_uv: bool = False,
+                           tools: tuple[str, ...] = ()) -> dict[str, str]:  # fmt: skip
+    """The environment of a ``./run`` as root (fake ``id``) with libOSMesa present, the shell tools, the
+    system ``python3`` and ``tools`` on the PATH, and the fake ``uv`` and ``apt-get`` (none when None)
+    given as bash bodies; with ``private_uv`` the uv is a private copy off the PATH (as on a fresh
+    machine)."""
+    scripts = {"id": "echo 0"} | ({"apt-get": apt_get} if apt_get is not None else {})
+    uv_script = {"uv": uv}
+    env = _fake_machine(tmp_path, scripts if private_uv else scripts | uv_script, OPENGL, (*TOOLS, "python3", *tools),
+                        private=uv_script if private_uv else None)  # fmt: skip
+    return {**env, "GEOMLIB_UV": str(tmp_path / ("private" if private_uv else "fake") / "uv")}
 
 
 def test_a_system_without_a_supported_python_gets_one_from_uv_and_is_told(tmp_path):
@@ -196,24 +201,7 @@ def test_a_supported_system_python_is_used_as_it_is(tmp_path):
 def _root_with_a_private_uv(tmp_path: Path, uv_body: str) -> dict[str, str]:
     """The environment of a ``./run`` as root (fake ``id``) with libOSMesa present and ``uv`` only as a
     private copy off the PATH (as on a fresh machine), given as a bash body."""
-    fake, tools, libs, private = (tmp_path / d for d in ("fake", "tools", "lib", "private"))
-    for d in (fake, tools, libs, private):
-        d.mkdir()
-    for t in (*TOOLS, "python3", "mkdir", "ln"):
-        (tools / t).symlink_to(shutil.which(t) or pytest.skip(f"{t} is not installed"))
-    for lib in ("libOSMesa.so.8", "libGL.so.1", "libXrender.so.1"):  # OpenGL
-        (libs / lib).write_text("")
-    bash = shutil.which("bash")
-    (fake / "id").write_text(f"#!{bash}\necho 0")
-    (private / "uv").write_text(f"#!{bash}\n{uv_body}")
-    for f in (fake / "id", private / "uv"):
-        f.chmod(0o755)
-    return {
-        "PATH": f"{fake}:{tools}",
-        "HOME": str(tmp_path),
-        "GEOMLIB_LIB_DIRS": str(libs),
-        "GEOMLIB_UV": str(private / "uv"),
-    }
+    return _fake_root_with_osmesa(tmp_path, uv=uv_body, private_uv=True, tools=("mkdir", "ln"))
 
 
 def test_every_job_puts_the_private_uv_on_the_guides_path(tmp_path):
