@@ -524,30 +524,43 @@ def render_quad(
         No headless OpenGL context can be created (the message names the fix).
     """
     size = _size(size)
-    GL = _gl()
-    _note_shader(name)
-    try:
-        return _render_quad(GL, fragment, size, textures, uniforms, outputs, filter, wrap, version, name)
-    finally:
-        _note_shader(None)
-
-
-def _render_quad(GL, fragment, size, textures, uniforms, outputs, filter, wrap, version, name):
-    prog = _program(GL, QUAD_VERTEX_SHADER, fragment, name, version)
     quad = np.array([[-1, -1], [1, -1], [-1, 1], [1, 1]], dtype=np.float32)
-    vao, buffers = _vertex_array(GL, prog, {"position": quad})
 
-    def draw():
+    def draw(GL, vao):
         GL.glBindVertexArray(vao)
         GL.glDrawArrays(GL.GL_TRIANGLE_STRIP, 0, 4)
 
+    return _run_program(
+        QUAD_VERTEX_SHADER, fragment, {"position": quad}, None, draw,
+        size, textures, uniforms, outputs, filter, wrap, version, name,
+    )  # fmt: skip
+
+
+def _run_program(vertex, fragment, attributes, F, draw, size, textures, uniforms, outputs, filter, wrap, version, name):
+    """What :func:`render_quad`, :func:`render_mesh` and :func:`render_points` share: compile and link
+    ``vertex`` + ``fragment`` (``name`` noted for the shader watchdog), upload the per-vertex
+    ``attributes`` (and the triangles ``F`` as element indices, unless None), call ``draw(GL, vao)``
+    into ``outputs`` float targets of ``size`` (:func:`_draw`), free the buffers; one image, or the list."""
+    GL = _gl()
+    _note_shader(name)
     try:
-        out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
+        prog = _program(GL, vertex, fragment, name, version)
+        vao, buffers = _vertex_array(GL, prog, attributes)
+        try:
+            if F is not None:  # the element buffer is state of the bound vertex array
+                idx = np.ascontiguousarray(F, dtype=np.uint32)
+                buffers.append(GL.glGenBuffers(1))
+                GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, buffers[-1])
+                GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, idx.nbytes, idx, GL.GL_STATIC_DRAW)
+            out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, lambda: draw(GL, vao))
+        finally:
+            GL.glBindVertexArray(0)
+            if buffers:
+                GL.glDeleteBuffers(len(buffers), buffers)
+            GL.glDeleteVertexArrays(1, [vao])
+        return out[0] if outputs == 1 else out
     finally:
-        GL.glBindVertexArray(0)
-        GL.glDeleteBuffers(len(buffers), buffers)
-        GL.glDeleteVertexArrays(1, [vao])
-    return out[0] if outputs == 1 else out
+        _note_shader(None)
 
 
 def _vertex_count(attributes: Mapping[str, np.ndarray], where: str) -> int | None:
@@ -605,37 +618,16 @@ def render_mesh(
     n = _vertex_count(attributes, "render_mesh")
     if n is None or F.size and (F.min() < 0 or F.max() >= n):
         raise MeshError("geomlib.gl.render_mesh: F indexes vertices that have no attributes")
-    GL = _gl()
-    _note_shader(name)
-    try:
-        return _render_mesh(
-            GL, vertex, fragment, attributes, F, size, textures, uniforms, outputs, filter, wrap, version, name
-        )
-    finally:
-        _note_shader(None)
 
-
-def _render_mesh(GL, vertex, fragment, attributes, F, size, textures, uniforms, outputs, filter, wrap, version, name):
-    prog = _program(GL, vertex, fragment, name, version)
-    vao, buffers = _vertex_array(GL, prog, attributes)
-    idx = np.ascontiguousarray(F, dtype=np.uint32)
-    ebo = GL.glGenBuffers(1)
-    GL.glBindBuffer(GL.GL_ELEMENT_ARRAY_BUFFER, ebo)
-    GL.glBufferData(GL.GL_ELEMENT_ARRAY_BUFFER, idx.nbytes, idx, GL.GL_STATIC_DRAW)
-
-    def draw():
+    def draw(GL, vao):
         GL.glEnable(GL.GL_DEPTH_TEST)
         GL.glBindVertexArray(vao)
-        GL.glDrawElements(GL.GL_TRIANGLES, idx.size, GL.GL_UNSIGNED_INT, ctypes.c_void_p(0))
+        GL.glDrawElements(GL.GL_TRIANGLES, F.size, GL.GL_UNSIGNED_INT, ctypes.c_void_p(0))
         GL.glDisable(GL.GL_DEPTH_TEST)
 
-    try:
-        out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
-    finally:
-        GL.glBindVertexArray(0)
-        GL.glDeleteBuffers(len(buffers) + 1, [*buffers, ebo])
-        GL.glDeleteVertexArrays(1, [vao])
-    return out[0] if outputs == 1 else out
+    return _run_program(
+        vertex, fragment, attributes, F, draw, size, textures, uniforms, outputs, filter, wrap, version, name
+    )
 
 
 #: Fragment shader for :func:`render_points` when a vertex shader moves each vertex: it writes the
@@ -674,23 +666,11 @@ def render_points(
     n = _vertex_count(attributes, "render_points")
     if not n:
         raise MeshError("geomlib.gl.render_points: no vertices (give at least one attribute with rows)")
-    GL = _gl()
-    _note_shader(name)
-    try:
-        prog = _program(GL, vertex, fragment, name, version)
-        vao, buffers = _vertex_array(GL, prog, attributes)
 
-        def draw():
-            GL.glBindVertexArray(vao)
-            GL.glDrawArrays(GL.GL_POINTS, 0, n)
+    def draw(GL, vao):
+        GL.glBindVertexArray(vao)
+        GL.glDrawArrays(GL.GL_POINTS, 0, n)
 
-        try:
-            out = _draw(GL, prog, size, textures, uniforms, outputs, filter, wrap, draw)
-        finally:
-            GL.glBindVertexArray(0)
-            if buffers:
-                GL.glDeleteBuffers(len(buffers), buffers)
-            GL.glDeleteVertexArrays(1, [vao])
-        return out[0] if outputs == 1 else out
-    finally:
-        _note_shader(None)
+    return _run_program(
+        vertex, fragment, attributes, None, draw, size, textures, uniforms, outputs, filter, wrap, version, name
+    )
