@@ -58,6 +58,8 @@ __all__ = [
     "render_quad",
     "render_mesh",
     "render_points",
+    "render_per_vertex",
+    "point_grid",
     "renderer_info",
     "close",
     "SHADER_FOLDER",
@@ -674,3 +676,44 @@ def render_points(
     return _run_program(
         vertex, fragment, attributes, None, draw, size, textures, uniforms, outputs, filter, wrap, version, name
     )
+
+
+def point_grid(n: int, width: int = 1024) -> tuple[int, int]:
+    """The ``(width, height)`` of the image that holds ``n`` points one per pixel, row by row
+    (``min(n, width)`` wide): point ``i`` on pixel ``(i % width, i // width)``."""
+    w = int(min(n, width))
+    return w, int(-(-n // w))
+
+
+def render_per_vertex(
+    vertex: str,
+    fragment: str,
+    attributes: Mapping[str, np.ndarray],
+    n: int,
+    *,
+    textures: Mapping[str, np.ndarray] | None = None,
+    uniforms: Mapping[str, object] | None = None,
+    outputs: int = 1,
+    name: str = "vertex shader",
+) -> list[np.ndarray]:
+    """A vertex shader's per-vertex results, in vertex order: :func:`render_points` on the
+    :func:`point_grid` of the ``n`` vertices, whose size the shader gets as the uniform ``ivec2 grid``
+    (it places vertex ``gl_VertexID`` on pixel ``(i % grid.x, i / grid.x)``).
+
+    Returns
+    -------
+    list of ``outputs`` (n, 4) float32 arrays, row ``i`` what vertex ``i`` wrote to that target.
+    """
+    size = point_grid(n)
+    out = render_points(
+        vertex,
+        fragment,
+        attributes,
+        size,
+        textures=textures,
+        uniforms={**(uniforms or {}), "grid": np.array(size, dtype=np.int32)},
+        outputs=outputs,
+        name=name,
+    )
+    # Read-back row 0 is the top of the image: GL row size[1] - 1.
+    return [o[::-1].reshape(-1, 4)[:n] for o in (out if outputs > 1 else [out])]

@@ -31,20 +31,11 @@ shader_path = gl.shader_finder(__file__)
 
 def _run_points(name: str, n: int, attributes: dict, textures: dict, uniforms: dict) -> list[np.ndarray]:
     source = gl.lab_shader_source(shader_path(name))
-    width = int(min(n, 1024))
-    size = (width, int(-(-n // width)))
     with gl.naming_task(f"shaders/{name}", TASKS[name]):  # the message leads with the file and task
-        out = gl.render_points(
-            source,
-            gl.MOVED_OFFSET_FRAGMENT_SHADER,
-            attributes,
-            size,
-            textures=textures,
-            uniforms={**uniforms, "grid": np.array(size, dtype=np.int32)},
-            outputs=2,
+        return gl.render_per_vertex(
+            source, gl.MOVED_OFFSET_FRAGMENT_SHADER, attributes, n, textures=textures, uniforms=uniforms, outputs=2,
             name=f"shaders/{name}",
-        )
-    return [o[::-1].reshape(-1, 4)[:n] for o in out]  # read-back row 0 is the top: GL row size[1] - 1
+        )  # fmt: skip
 
 
 def glsl_denoise_with_map(

@@ -29,7 +29,7 @@ from geomlib.raster import MAX_SIZE
 from geomlib.validate import MeshError, as_array, check_choice, check_float, check_int, check_mesh
 
 from .cubemap import _near_far, cube_depth_maps, cube_face_index, cube_light_matrices
-from .glsl import _grid, _on_grid
+from .glsl import _on_grid
 from .lookup import DEFAULT_BIAS_TEXELS, compare_depth, light_uvz, pcf_visibility
 from .options import CULL_MODES
 
@@ -259,7 +259,7 @@ def glsl_point_shadow_visibility(
     k = _pcf(pcf, where)
     if len(P) == 0:
         return np.ones(0)
-    grid = _grid(len(P))
+    grid = gl.point_grid(len(P))
     uniforms = {"lightPos": pos, "far": far, "bias": b, "pcf": k}
     textures = {"position_in": _on_grid(P, grid), "cube_maps": np.concatenate(list(maps), axis=1)}
     source = gl.lab_shader_source(_shader_path("cube_shadow.frag"))

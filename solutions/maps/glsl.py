@@ -53,28 +53,20 @@ void main() { out_T = vec4(T_world, 1.0); out_B = vec4(B_world, 1.0); out_N = ve
 shader_path = gl.shader_finder(__file__)
 
 
-def _grid(n: int) -> tuple[int, int]:
-    width = int(min(n, 1024))
-    return width, int(-(-n // width))
-
-
 def _run_points(name: str, fragment: str, n: int, attributes: dict, textures: dict, uniforms: dict, outputs: int):
     """Run the vertex shader ``shaders/<name>`` on ``n`` vertices; ``outputs`` arrays ``(n, 4)``."""
     source = gl.lab_shader_source(shader_path(name))
-    size = _grid(n)
     with gl.naming_task(f"shaders/{name}", TASKS[name]):  # the message leads with the file and task
-        out = gl.render_points(
+        return gl.render_per_vertex(
             source,
             fragment,
             attributes,
-            size,
+            n,
             textures=textures,
-            uniforms={**uniforms, "grid": np.array(size, dtype=np.int32)},
+            uniforms=uniforms,
             outputs=outputs,
             name=f"shaders/{name}",
         )
-    # Read-back row 0 is the top of the image: GL row size[1] - 1.
-    return [o[::-1].reshape(-1, 4)[:n] for o in out]
 
 
 def _model(model, where: str) -> np.ndarray:

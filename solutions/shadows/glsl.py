@@ -96,11 +96,6 @@ def glsl_depth_map(V, F, M, size: int, cull: str = "front") -> np.ndarray:
     return np.where(out[..., 1] > 0, out[..., 0].astype(np.float64), 1.0)
 
 
-def _grid(n: int) -> tuple[int, int]:
-    width = int(min(n, 1024))
-    return width, int(-(-n // width))
-
-
 def _on_grid(a: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     w, h = size
     out = np.zeros((w * h, 3))
@@ -158,7 +153,7 @@ def glsl_shadow_visibility(
     opts = ShadowOptions.of(options, where, keywords, _SHADOW_VISIBILITY_DEFAULTS)
     if opts.pcf_sampling == "poisson" and opts.pcf_samples > MAX_DISK_SAMPLES:
         raise MeshError(f"{where}: at most {MAX_DISK_SAMPLES} Poisson samples (shadow.frag's disk array)")
-    grid = _grid(len(P))
+    grid = gl.point_grid(len(P))
     poisson = opts.pcf_sampling == "poisson" and opts.pcf > 1
     uniforms = {
         "lightSpaceMatrix": M,
