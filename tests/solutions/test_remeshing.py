@@ -3,11 +3,6 @@ sharp edges, the half-edge invariants after every kernel edit, and the kernels w
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
-from pathlib import Path
-
 import igl
 import numpy as np
 
@@ -16,8 +11,7 @@ from geomlib.geometry import dihedral_angles
 from solutions import remeshing as R
 from solutions.remeshing import kernels as K
 from solutions.remeshing import state as M
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.solutions.fresh import run_python
 
 
 def test_projection_matches_igl():
@@ -88,14 +82,9 @@ def test_kernels_run_without_numba():
         "import numpy as np; from geomlib import datasets; from solutions.remeshing import isotropic_remesh as r;"
         "V, F = datasets.icosphere(1); W, G = r(V, F, 0.5, iterations=2); print(len(W), len(G), float(np.abs(W).sum()))"
     )
-    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
-    out = subprocess.run(
-        [sys.executable, "-c", code], env=env, cwd=ROOT, capture_output=True, text=True, timeout=1200
-    )  # hangs only
-    assert out.returncode == 0, out.stderr
+    n, m, s = run_python(code, NUMBA_DISABLE_JIT="1").split()
     V, F = datasets.icosphere(1)
     W, G = R.isotropic_remesh(V, F, 0.5, iterations=2)
-    n, m, s = out.stdout.split()
     assert (int(n), int(m)) == (len(W), len(G))
     assert abs(float(s) - np.abs(W).sum()) < 1e-9
 

@@ -15,8 +15,6 @@ Grids are small (<= 32^3) to keep the suite quick; the 128^3 comparisons are in 
 from __future__ import annotations
 
 import json
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -49,6 +47,7 @@ from solutions.sdf import (
 from solutions.sdf.bricks import BRICK
 from solutions.sdf.field import outside_rule
 from solutions.sdf.trace import camera_rays
+from tests.solutions.fresh import run_python
 
 ROOT = Path(__file__).resolve().parents[2]
 FANDISK = Path("/work/shared/data/meshes/fandisk.obj")
@@ -357,12 +356,7 @@ def test_kernels_run_without_jit():
         "P = np.random.default_rng(0).uniform(-1.5, 1.5, size=(6, 3))\n"
         "print(json.dumps({s: signed_distance(V, F, P, sign=s).tolist() for s in ('pseudonormal', 'vote')}))\n"
     )
-    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
-    out = subprocess.run(
-        [sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=1200
-    )  # hangs only
-    assert out.returncode == 0, out.stderr[-2000:]
-    got = json.loads(out.stdout.strip().splitlines()[-1])
+    got = json.loads(run_python(code, NUMBA_DISABLE_JIT="1"))
     V, F = datasets.icosphere(1)
     P = np.random.default_rng(0).uniform(-1.5, 1.5, size=(6, 3))
     for s, d in got.items():

@@ -9,10 +9,6 @@ libraries; the solution itself is never its own reference.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import fast_simplification
 import igl
@@ -37,8 +33,7 @@ from solutions.simplification import (
 )
 from solutions.simplification.contraction import contract_pair, neighbors
 from tests.graded.simplification.support import flipped_faces  # the grader's definition of a flip
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.solutions.fresh import run_python
 
 RNG = np.random.default_rng(7)
 
@@ -380,19 +375,6 @@ def test_compiled_loop_makes_the_same_contractions_as_the_python_loop(name, make
     U2, G2 = qem_simplify(V, F, target, method="fast", refit=False)
     np.testing.assert_array_equal(G2, G1)
     np.testing.assert_allclose(U2, U1, atol=1e-9)
-
-
-def run_python(code: str, **env) -> str:
-    out = subprocess.run(
-        [sys.executable, "-c", code],
-        cwd=ROOT,
-        env={**os.environ, "PYTHONPATH": str(ROOT), **env},
-        capture_output=True,
-        text=True,
-        timeout=1800,  # hangs only: seconds of work, but a loaded machine gives a fraction of a core
-    )
-    assert out.returncode == 0, out.stderr[-3000:]
-    return out.stdout.strip().splitlines()[-1]
 
 
 SMALL_CASE = """
