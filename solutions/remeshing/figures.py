@@ -19,7 +19,15 @@ import numpy as np
 
 from geomlib import datasets, topology
 from geomlib.geometry import bbox_diagonal, closest_points, corner_angles, triangle_quality
-from geomlib.labfigures import Drawn, MeshView, MissingTasks, figure_name, lab_figure_makers, missing_panel
+from geomlib.labfigures import (
+    Drawn,
+    MeshView,
+    MissingTasks,
+    figure_name,
+    lab_figure_makers,
+    missing_panel,
+    partial_figure,
+)
 from geomlib.plot import colorbar, heat_colors, line_plot, panels
 from geomlib.render import render
 
@@ -45,6 +53,8 @@ TARGET_INSIDE, TARGET_BOUNDARY = 6, 4
 #: boundary vertices (black, apart from the valence colours) and feature lines (green)
 BOUNDARY, FEATURE = (0.05, 0.05, 0.05), (0.05, 0.6, 0.2)
 CMAP = "YlOrRd"  # light at zero, so the shape stays readable where the error vanishes
+#: The tasks whose panels the figure being drawn left out (:func:`~geomlib.labfigures.partial_figure`).
+_MISSING = MissingTasks()
 
 
 def _ss(quick: bool) -> int:
@@ -216,7 +226,7 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     its = 5 if quick else 10
     size = (260, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True, zoom=0.95)
-    missing = MissingTasks()  # tasks whose panels are left blank
+    missing = _MISSING  # tasks whose panels are left blank (emptied by partial_figure)
     imgs, caps = [], []
     for name, (V, F) in (("bunny (marching cubes)", bunny), ("bunny decimated by QEM", decimated)):
         imgs.append(render(V, F, **valence_dots(V, F), **kw))
@@ -238,8 +248,7 @@ def fig_before_after(out: Path, R, quick: bool) -> Drawn:
     img = panels(imgs, caps, ncols=3, title=f"Isotropic remeshing, {its} iterations; {DOTS_TITLE}")
     return Drawn(
         img,
-        missing.caption_head()
-        + f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
+        f"Top: a scan-like bunny (metaballs extracted by marching cubes, {len(bunny[1])} faces) before and after "
         f"isotropic_remesh to L = {L} ({its} iterations); bottom: the same bunny decimated by QEM "
         f"(fast-simplification, {len(decimated[1])} faces: long thin triangles) before and after the same call. "
         "A dot marks each vertex whose valence is not 6 (blue below, red above; 4 on the boundary); the captions "
@@ -289,7 +298,7 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
     size = (280, 220) if quick else (380, 300)
     kw = dict(camera="three_quarter", size=size, supersample=_ss(quick), wireframe=True)
     diag = bbox_diagonal(V)
-    missing = MissingTasks()  # tasks whose panels are left blank
+    missing = _MISSING  # tasks whose panels are left blank (emptied by partial_figure)
     sharp = missing.attempt(R.sharp_edges, V, F, angle)
     results = [
         _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its, feature_angle=fa)) for fa in (angle, None)
@@ -321,8 +330,8 @@ def fig_features(out: Path, R, quick: bool) -> Drawn:
     if any(e is not None for e in errs):  # the bar of the heat maps, when there are any
         bar = colorbar(0, vmax, CMAP, label="distance, % of diagonal", height=size[1])
         grid = _bar_beside_row(grid, bar, panels(imgs, caps, ncols=3))
-    if missing.caption_head() or sharp is None:
-        return Drawn(grid, missing.caption_head() + "A block with sharp edges remeshed with and without them kept.")
+    if missing or sharp is None:
+        return Drawn(grid, "A block with sharp edges remeshed with and without them kept.")
     return Drawn.claimed(
         grid,
         "A block with a curved top and waist and sharp edges (a built-in stand-in for the fandisk); its {n_sharp} "
@@ -364,7 +373,7 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
     imgs = [render(V, F, colors=valence_colors(V, F), highlight_points=np.unique(E), **kw)]
     caps = [f"input: {len(F)} faces, {len(np.unique(E))} boundary vertices (black dots), boundary length {length:.2f}"]
     offsets = {}
-    missing = MissingTasks()  # tasks whose panels are left blank
+    missing = _MISSING  # tasks whose panels are left blank (emptied by partial_figure)
     for keep in (True, False):
         r = _mesh(missing.attempt(R.isotropic_remesh, V, F, L, iterations=its, preserve_boundary=keep))
         if r is None:
@@ -381,8 +390,8 @@ def fig_boundary(out: Path, R, quick: bool) -> Drawn:
         )
     title = f"An open surface remeshed to L = {L}; valence: blue below the target (6, on the boundary 4), grey at it, red above"
     img = panels(imgs, caps, ncols=3, title=title)
-    if missing.caption_head():
-        return Drawn(img, missing.caption_head() + "An open surface remeshed with its boundary preserved or not.")
+    if missing:
+        return Drawn(img, "An open surface remeshed with its boundary preserved or not.")
     return Drawn.claimed(
         img,
         "The bunny's head cut off at the neck (a built-in stand-in for the camel head: an open surface with one "
@@ -454,7 +463,7 @@ def fig_operations(out: Path, R, quick: bool) -> Drawn:
     pa, pb, pc, pd = V[a], V[b], V[c], V[d]
     mid = 0.5 * (pa + pb)
     size = (240, 240) if quick else (300, 300)
-    missing = MissingTasks()  # tasks whose panels are left blank
+    missing = _MISSING  # tasks whose panels are left blank (emptied by partial_figure)
     names = [("a", pa), ("b", pb), ("c", pc), ("d", pd)]
     imgs = [_patch_drawing(V, F, size, thick=[(pa, pb)], labels=names)]
     caps = [f"{len(F)} faces; the edge a-b in red, c and d opposite it"]
@@ -485,8 +494,8 @@ def fig_operations(out: Path, R, quick: bool) -> Drawn:
     imgs.append(_blank(size) if W is None else _patch_drawing(np.asarray(W, dtype=np.float64), F, size))
     caps.append("tangential_relaxation: not implemented yet" if W is None else "after tangential_relaxation")
     img = panels(imgs, caps, title="The local operations on a 4 x 4 patch", ncols=3)
-    if missing.caption_head():
-        return Drawn(img, missing.caption_head() + "The local operations on the diagonal a-b of a grid patch.")
+    if missing:
+        return Drawn(img, "The local operations on the diagonal a-b of a grid patch.")
     return Drawn.claimed(
         img,
         "The diagonal a-b of the middle cell of a grid patch ({faces} faces; c and d are the vertices opposite "
@@ -516,7 +525,13 @@ def fig_view(R, quick: bool) -> MeshView:
     )  # fmt: skip
 
 
+#: The figures in order; one drawn without some of its panels names the first missing task in its caption.
+FIGURES = [
+    partial_figure(build, _MISSING)
+    for build in (fig_before_after, fig_operations, fig_iterations, fig_features, fig_boundary)
+]
+
 make_figures, make_view = lab_figure_makers(
-    LAB, __name__, (fig_before_after, fig_operations, fig_iterations, fig_features, fig_boundary), fig_view,
+    LAB, __name__, FIGURES, fig_view,
     quick="Smaller meshes, fewer iterations and smaller images (for notebooks and smoke tests).",
 )  # fmt: skip
