@@ -18,6 +18,7 @@ from geomlib.grading import tolerances as tol
 from geomlib.grading.checks import Context, compare_arrays, nonfinite_problem
 from geomlib.grading.errors import BadReturn, Mismatch, StudentError
 from geomlib.grading.registry import (  # re-exported: graded tests and the tooling import them from here
+    hidden_cases,
     load_cases,
     load_reference,
     load_stored,
@@ -34,6 +35,7 @@ __all__ = [
     "expect_close",
     "expect_raises",
     "load_cases",
+    "hidden_cases",
     "reference_path",
     "load_reference",
     "inputs_digest",

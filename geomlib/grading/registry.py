@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "graded_module",
+    "hidden_cases",
     "load_cases",
     "reference_path",
     "load_reference",
@@ -40,13 +41,24 @@ def graded_package_modules() -> list[str]:
     return [m for m in sys.modules if m == package or m.startswith(package + ".")]
 
 
-def graded_module(lab: str, name: str):
+def graded_module(lab: str, name: str, *, package: str | None = None):
     """The module ``tests/graded/<lab>/<name>.py`` of the course under grading, or None without that file.
 
     The course's ``tests`` folder goes first on ``sys.path`` (ahead of another course's tests folder
     imported in this process), and a ``graded`` package imported from another course (a fixture
     course in the same process) is forgotten first.
+
+    ``package``: the lab's graded package as it is already imported (a graded test module's
+    ``__package__``): the module is looked for in that package's folder and imported under its
+    name, whichever course copy and package name pytest imported it from. Either way a missing
+    file is None (a student's bundle has no ``cases_hidden.py``) and any error raised while
+    importing an existing file is raised.
     """
+    if package is not None:
+        if package.rpartition(".")[2] != lab:
+            raise ValueError(f"graded package {package!r} is not lab {lab!r}'s")
+        folder = Path(next(iter(sys.modules[package].__path__)))
+        return importlib.import_module(f"{package}.{name}") if (folder / f"{name}.py").is_file() else None
     c = course()
     folder = c.lab(lab).graded
     if not (folder / f"{name}.py").is_file():
@@ -61,6 +73,14 @@ def graded_module(lab: str, name: str):
         for mod in graded_package_modules():
             del sys.modules[mod]
     return importlib.import_module(f"{c.graded_dir.name}.{lab}.{name}")
+
+
+def hidden_cases(lab: str, *, package: str | None = None) -> tuple[Case, ...]:
+    """The hidden cases of ``lab`` (``cases_hidden.CASES``; ``package`` as for :func:`graded_module`),
+    or none where the course copy has none: a student's bundle holds no hidden files, and a public
+    test that looks its case up by id among public and hidden cases must still run there."""
+    mod = graded_module(lab, "cases_hidden", package=package)
+    return tuple(getattr(mod, "CASES", ())) if mod is not None else ()
 
 
 def load_cases(lab: str, *, hidden: bool = True, probes: bool = True) -> list[Case]:

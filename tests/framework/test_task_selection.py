@@ -191,7 +191,7 @@ def _env() -> dict:
 
 def test_public_graded_tests_do_not_import_the_hidden_cases():
     """A student's bundle has no ``cases_hidden.py``: a public test that looks a case up by id among
-    public and hidden cases goes through ``common.hidden_cases`` (shadows' and maps' GLSL tests and
+    public and hidden cases goes through ``registry.hidden_cases`` (shadows' and maps' GLSL tests and
     denoise's imported ``.cases_hidden`` and failed there with ModuleNotFoundError)."""
     graded = ROOT / "tests" / "graded"
     offenders = [

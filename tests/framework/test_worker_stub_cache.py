@@ -324,3 +324,84 @@ def test_a_worker_cannot_change_what_the_zygote_merged_for_the_next_calls(tmp_pa
     lab = LabProxy("toy", student)
     assert lab.task(2) == 6 + 1  # the course's helper, and its file was merged ahead by the zygote
     assert lab.task(2) == 6 + 1, "a worker's forged entry ran in the next call"
+
+
+OWN_USER = """
+from .mine import offset
+
+
+def given_helper(x):
+    return -1
+
+
+def task(x):
+    return given_helper(x) + offset()
+"""
+OWN = '''"""The student's own module: no stub of that name."""
+
+
+def offset():
+    return {n}
+'''
+
+
+def _own_submission(tmp_path, n: int = 1):
+    stubs, student = tmp_path / "stubs" / "toy", tmp_path / "sub" / "toy"
+    _write(stubs, STUB.format(scale=3))
+    _write(student, OWN_USER)
+    (student / "mine.py").write_text(OWN.format(n=n))
+    return stubs, student
+
+
+def test_the_zygote_compiles_a_submissions_own_module_once_for_all_its_workers(tmp_path, fresh_cache, monkeypatch):
+    """A module of the submission's own (no stub: imported whole) is compiled by the zygote
+    (prepare_merged), not by each worker, which could not keep its bytecode (the snapshot is
+    read-only to it) and compiled it at every call. Planted fault: prepare_merged skipping files
+    without a stub (the old code) makes the worker compile mine.py and fails here."""
+    import builtins
+
+    stubs, student = _own_submission(tmp_path)
+    worker.prepare_stubs(str(stubs))
+    worker.prepare_merged(str(stubs), str(student))
+    real_compile = builtins.compile
+
+    def compile_here(source, filename, *args, **kwargs):
+        if str(filename).endswith("mine.py"):
+            raise AssertionError("the worker compiled the submission's own module again")
+        return real_compile(source, filename, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "compile", compile_here)
+    for _ in range(2):  # two workers of the same snapshot
+        try:
+            fn = worker.find_function(student, "toy", "task", stubs)
+            assert fn(2) == 6 + 1
+            assert not list(student.glob("__pycache__/*")), "a worker wrote bytecode into the snapshot"
+        finally:
+            _unload("toy")
+        _next_worker()
+
+
+def test_an_own_module_changed_since_the_zygote_compiled_it_runs_as_it_is_now(tmp_path, fresh_cache):
+    """The worker compares the bytes it reads with those the zygote compiled: a module of the
+    submission's own changed since (size and modification time put back) runs as it is now.
+    Planted fault: the loader taking the zygote's code without comparing the bytes returns 7."""
+    stubs, student = _own_submission(tmp_path, n=1)
+    worker.prepare_stubs(str(stubs))
+    worker.prepare_merged(str(stubs), str(student))
+    st = (student / "mine.py").stat()
+    (student / "mine.py").write_text(OWN.format(n=5))
+    os.utime(student / "mine.py", ns=(st.st_atime_ns, st.st_mtime_ns))
+    try:
+        assert worker.find_function(student, "toy", "task", stubs)(2) == 6 + 5, "the zygote's code of the old bytes ran"
+    finally:
+        _unload("toy")
+
+
+def test_a_submissions_own_module_runs_in_the_sandbox(tmp_path, monkeypatch):
+    """Through the zygote and its workers: the own module imported by the submission's task runs."""
+    stubs_root = tmp_path / "stubs"
+    _, student = _own_submission(tmp_path, n=4)
+    monkeypatch.setenv("GEOMLIB_STUBS", str(stubs_root))
+    lab = LabProxy("toy", student)
+    assert lab.task(2) == 6 + 4
+    assert lab.task(3) == 9 + 4

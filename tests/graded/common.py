@@ -11,20 +11,6 @@ from geomlib.grading.checks import Context, as_output_array, format_vec
 from geomlib.grading.errors import Mismatch
 
 
-def hidden_cases(package: str) -> tuple:
-    """The hidden cases of a lab's graded package (a test module's ``__package__``), or none where
-    the course has none: a student's bundle holds no hidden files, and a public test that looks its
-    case up by id among public and hidden cases must still run there."""
-    import importlib
-
-    try:
-        return tuple(importlib.import_module(f"{package}.cases_hidden").CASES)
-    except ModuleNotFoundError as e:
-        if e.name != f"{package}.cases_hidden":
-            raise
-        return ()
-
-
 def expect_rejected(lab, function: str, *args, match: str | None = None, label: str | None = None, **kwargs) -> None:
     """``lab.<function>(*args, **kwargs)`` must raise a ``MeshError`` whose message matches ``match``.
 

@@ -14,13 +14,13 @@ import numpy as np
 from geomlib import datasets, topology
 from geomlib.geometry import mean_edge_length, vertex_normals
 from geomlib.grading import expect_close, graded, reference_tests
-from geomlib.grading.cases import stored_input
+from geomlib.grading.cases import hidden_cases, stored_input
 from geomlib.grading.checks import Context
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 from geomlib.textures import rasterize_uv
 
-from ..common import expect_rejected, expect_true, hidden_cases
+from ..common import expect_rejected, expect_true
 from .cases import CASES
 from .support import (
     PYRAMID_F,
@@ -603,7 +603,7 @@ def check_glsl_denoise(lab, case_id: str) -> None:
     """``glsl_denoise_with_map`` (shaders/denoise.vert, the vertex stage) on a map case: its stored reference."""
     from geomlib.grading.cases import load_reference
 
-    case = {c.id: c for c in (*CASES, *hidden_cases(__package__))}[case_id]
+    case = {c.id: c for c in (*CASES, *hidden_cases("denoise", package=__package__))}[case_id]
     inp = case.inputs()
     got = np.asarray(lab.glsl_denoise_with_map(**inp, **case.params), float)
     expected = load_reference("denoise", case)["V"]

@@ -10,11 +10,12 @@ import numpy as np
 
 from geomlib import datasets
 from geomlib.grading import expect_close, graded, reference_tests
+from geomlib.grading.cases import hidden_cases
 from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture, marked_picture
 
-from ..common import expect_rejected, hidden_cases
+from ..common import expect_rejected
 from .cases import CASES, LIGHT, quad_gbuffer, texel_uv, unit_vectors, wave
 
 test_references = reference_tests(CASES)
@@ -438,7 +439,7 @@ STAGE = {
 
 
 def _case(case_id: str):
-    return {c.id: c for c in (*CASES, *hidden_cases(__package__))}[case_id]
+    return {c.id: c for c in (*CASES, *hidden_cases("maps", package=__package__))}[case_id]
 
 
 def expect_glsl_rows(label: str, got, expected, atol: float, mesh=None, name: str = "output") -> None:

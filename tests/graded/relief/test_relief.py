@@ -9,11 +9,11 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.grading import expect_close, expect_raises, graded, reference_tests
-from geomlib.grading.cases import load_reference
+from geomlib.grading.cases import hidden_cases, load_reference
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
-from ..common import expect_rejected, hidden_cases
+from ..common import expect_rejected
 from .cases import CASES, SCALE, direction, pixel_uv, texel_uv
 
 test_references = reference_tests(CASES)
@@ -47,7 +47,7 @@ def expect_glsl_matches(label: str, got, expected, *, atol: float, unit: str = "
 
 def check_glsl_case(lab, case_id: str, function: str) -> None:
     """Run the student's shader on a NumPy case's inputs and compare with that case's stored reference."""
-    case = BY_ID.get(case_id) or {c.id: c for c in hidden_cases(__package__)}[case_id]
+    case = BY_ID.get(case_id) or {c.id: c for c in hidden_cases("relief", package=__package__)}[case_id]
     got = getattr(lab, function)(**case.inputs(), **case.params)
     expected = load_reference("relief", case)
     label = f'{function} (shaders/{SHADER_OF[function]}.frag) on "{case_id}"'

@@ -21,12 +21,11 @@ from __future__ import annotations
 import numpy as np
 
 from geomlib.grading import graded
-from geomlib.grading.cases import load_reference, stored_input
+from geomlib.grading.cases import hidden_cases, load_reference, stored_input
 from geomlib.grading.checks import format_vec
 from geomlib.grading.errors import Mismatch
 from geomlib.grading.feedback import failure_picture
 
-from ..common import hidden_cases
 from .cases import CASES
 from .cases_glsl import STORED, STORED_HIDDEN, eye_points
 from .support import VISIBILITY_SHAPES, gpu_array, small_scene, visibility_picture
@@ -39,7 +38,7 @@ SHADOW_LABEL = "glsl_shadow_visibility (shaders/shadow.frag, the shadow pass's f
 
 
 def _case(case_id: str):
-    return {c.id: c for c in (*CASES, *hidden_cases(__package__), *STORED, *STORED_HIDDEN)}[case_id]
+    return {c.id: c for c in (*CASES, *hidden_cases("shadows", package=__package__), *STORED, *STORED_HIDDEN)}[case_id]
 
 
 def expect_depth_map(label: str, got, expected) -> None:
