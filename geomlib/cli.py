@@ -301,7 +301,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--impl",
         default=None,
-        help="'solutions', 'labs' (your work) or a submission folder (default: solutions if present, else labs)",
+        help="'solutions', 'labs' (your work) or a submission folder: the lab's own folder or the one holding it "
+        "(default: solutions if present, else labs)",
     )
     g.add_argument("--lab", help="only this lab")
     g.add_argument("--task", type=int, help="only the tests of this task (the 'Task N' of the stubs)")

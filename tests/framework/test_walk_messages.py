@@ -50,3 +50,18 @@ def test_what_the_code_printed_follows_the_exception_as_its_own_sentence():
     else:
         raise AssertionError("no StudentError")
     assert "is not defined. Your code printed: 'debug: n = [3. 4. 6.]'" in msg, msg
+
+
+def test_a_lab_folder_given_as_the_implementation_is_graded(tmp_path):
+    """`geomlib grade --impl path/to/subdivision --lab subdivision` (the folder a student uploads) was
+    graded as the folder *holding* the lab: every test read "lab folder .../subdivision/subdivision is
+    missing from the submission" (fresh-clone walk, issue 26)."""
+    import shutil
+
+    from geomlib.grading.course import course
+    from geomlib.grading.grade import grade
+
+    lab = tmp_path / "subdivision"
+    shutil.copytree(course().lab("subdivision").solution, lab)
+    data = grade(str(lab), ["subdivision"], task=1, pictures="none", feedback_dir=tmp_path / "feedback")
+    assert data["tests"] and all(t["status"] == "passed" for t in data["tests"]), data["report"]
