@@ -362,6 +362,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from geomlib.validate import MeshError
 
+    # Progress lines ("[1/3] bob: 0/151", "[1/9] subdivision ...") as they happen, also into a log file
+    # or `| tee`: block-buffered, `grade-all ... > log` showed nothing until every submission was graded.
+    if hasattr(sys.stdout, "reconfigure"):
+        sys.stdout.reconfigure(line_buffering=True)
     try:
         return a.func(a)
     except (MeshError, FileNotFoundError) as e:
