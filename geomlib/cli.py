@@ -301,7 +301,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument(
         "--impl",
         default=None,
-        help="'solutions', 'labs' (your work) or a submission folder (default: solutions if present, else labs)",
+        help="'solutions', 'labs' (your work) or a submission folder: the lab's own folder or the one holding it "
+        "(default: solutions if present, else labs)",
     )
     g.add_argument("--lab", help="only this lab")
     g.add_argument("--task", type=int, help="only the tests of this task (the 'Task N' of the stubs)")
@@ -361,6 +362,10 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     from geomlib.validate import MeshError
 
+    # Progress lines ("[1/3] bob: 0/151", "[1/9] subdivision ...") as they happen, also into a log file
+    # or `| tee`: block-buffered, `grade-all ... > log` showed nothing until every submission was graded.
+    if hasattr(sys.stdout, "reconfigure"):
+        sys.stdout.reconfigure(line_buffering=True)
     try:
         return a.func(a)
     except (MeshError, FileNotFoundError) as e:

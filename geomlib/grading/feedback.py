@@ -485,7 +485,7 @@ def rows_on_mesh(ctx: Context, inputs: dict, expected: dict, got: dict, *, atol:
             # points (odd vertices, edge points, moved vertices): where they should be and where they are
             what = f"expected: where the {count(int(bad.sum()), 'wrong row', 'wrong rows')} of {name} should be"
             return rows_picture(
-                ctx, V, F, e[bad], g[bad], what, err=err[bad], yours=f"yours: where your {name} puts them"
+                ctx, V, F, e[bad], g[bad], what, err=err[bad], yours=f"yours: where your code puts them ({name})"
             )
         what = f"expected: {count(int(bad.sum()), 'vertex', 'vertices')} where {name} is wrong (colour: value)"
         size = (

@@ -143,9 +143,13 @@ def grade(
     import pytest
 
     impl = impl or _impl.default_impl()
-    _impl.resolve_impl(impl)  # fail early, with the path, if it does not exist
+    root = _impl.resolve_impl(impl)  # fail early, with the path, if it does not exist
     c = course()
     names = labs or c.labs
+    if names == [root.name] and not (root / root.name).is_dir() and c.impl_dir(str(impl)) is None:
+        # `--impl path/to/subdivision --lab subdivision`: the lab folder itself, as a student uploads it
+        # (it read "lab folder .../subdivision/subdivision is missing from the submission")
+        impl = str(root.parent)
     unknown = [n for n in names if not c.lab(n).graded.is_dir()]
     if unknown:
         raise SystemExit(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(c.labs)}")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import os
 import sys
 from collections import OrderedDict
 
@@ -51,6 +52,10 @@ def graded_items(labs: list[str] | None = None) -> list[tuple[str, str, str, flo
     args += ["--collect-only", "-qq", "-p", "no:cacheprovider", f"--rootdir={_impl.course_root()}"]
     # Another course's `graded` package (a test session may hold one) would shadow this one's.
     saved = {k: sys.modules.pop(k) for k in graded_package_modules()}
+    # Collecting loads the course's conftest.py, whose pytest_configure sets the test suite's limits
+    # (GEOMLIB_TIME_LIMIT=300 for hangs) in os.environ and adds an import guard: left behind, every
+    # submission `grade-all` started after counting the points got 300 s per call instead of 30 s.
+    environ, meta_path = dict(os.environ), list(sys.meta_path)
     try:
         with contextlib.redirect_stdout(io.StringIO()) as out:
             code = pytest.main(args, plugins=[c])
@@ -58,6 +63,10 @@ def graded_items(labs: list[str] | None = None) -> list[tuple[str, str, str, flo
         for k in graded_package_modules():
             del sys.modules[k]
         sys.modules.update(saved)
+        for k in set(os.environ) - set(environ):
+            del os.environ[k]
+        os.environ.update({k: v for k, v in environ.items() if os.environ.get(k) != v})
+        sys.meta_path[:] = meta_path
     if code not in (0, 5):
         raise RuntimeError(f"collecting the graded tests of {', '.join(names)} failed:\n{out.getvalue()[-2000:]}")
     return c.items

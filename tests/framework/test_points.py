@@ -69,3 +69,18 @@ def test_a_stale_readme_table_is_reported_with_its_diff(tmp_path, monkeypatch):
     assert (tmp_path / "README.md").read_text() == text
     (tmp_path / "README.md").write_text(text.replace(readme.BEGIN, ""))
     assert "needs the lines" in readme.check()[0]
+
+
+def test_counting_the_points_leaves_the_process_as_it_found_it(monkeypatch):
+    """`grade-all` counts the points (collecting loads the course's conftest.py) before it starts a
+    grading process per submission with its own environment: the suite's limits (GEOMLIB_TIME_LIMIT=300)
+    left behind gave a hanging submission 300 s per call instead of 30 (fresh-clone walk, issue 26)."""
+    import os
+    import sys
+
+    for name in ("GEOMLIB_TIME_LIMIT", "GEOMLIB_PICTURE_TIME_LIMIT"):
+        monkeypatch.delenv(name, raising=False)
+    before, finders = dict(os.environ), list(sys.meta_path)
+    points_by_part(["subdivision"])
+    assert dict(os.environ) == before
+    assert sys.meta_path == finders

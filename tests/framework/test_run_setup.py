@@ -278,3 +278,21 @@ def test_the_suite_finds_the_uv_that_run_found_on_its_path(tmp_path):
     runs = log.read_text().splitlines()
     assert len(runs) == 2 and all(r.startswith("run --frozen pytest") for r in runs), runs
     assert all(r.endswith(f"found={private / 'uv'}") for r in runs), runs
+
+
+def test_the_path_hint_says_whether_the_next_login_adds_it(tmp_path):
+    """`./run setup` told root "your next login adds it: ~/.profile does on Debian and Ubuntu", but
+    root's /root/.profile does not (only /etc/skel's does): the next `bash -l` said "uv: command not
+    found" (fresh-clone walk, issue 26). It now names the login file and says which of the two holds."""
+    env = _root_with_a_private_uv(tmp_path, "exit 0")
+    (tmp_path / ".profile").write_text("mesg n 2> /dev/null || true\n")  # Debian's /root/.profile
+    p = subprocess.run([str(ROOT / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert "to keep it, add that line to ~/.profile" in p.stderr and "next login" not in p.stderr, p.stderr
+    skel = 'if [ -d "$HOME/.local/bin" ] ; then\n    PATH="$HOME/.local/bin:$PATH"\nfi\n'  # /etc/skel/.profile
+    (tmp_path / ".profile").write_text(skel)
+    p = subprocess.run([str(ROOT / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+    assert "your next login adds it: ~/.profile does" in p.stderr, p.stderr
+    (tmp_path / ".bash_profile").write_text("# bash reads this one instead of ~/.profile\n")
+    p = subprocess.run([str(ROOT / "run"), "setup"], env=env, capture_output=True, text=True, timeout=120)
+    assert "to keep it, add that line to ~/.bash_profile" in p.stderr, p.stderr

@@ -50,3 +50,34 @@ def test_what_the_code_printed_follows_the_exception_as_its_own_sentence():
     else:
         raise AssertionError("no StudentError")
     assert "is not defined. Your code printed: 'debug: n = [3. 4. 6.]'" in msg, msg
+
+
+def test_a_lab_folder_given_as_the_implementation_is_graded(tmp_path):
+    """`geomlib grade --impl path/to/subdivision --lab subdivision` (the folder a student uploads) was
+    graded as the folder *holding* the lab: every test read "lab folder .../subdivision/subdivision is
+    missing from the submission" (fresh-clone walk, issue 26)."""
+    import shutil
+
+    from geomlib.grading.course import course
+    from geomlib.grading.grade import grade
+
+    lab = tmp_path / "subdivision"
+    shutil.copytree(course().lab("subdivision").solution, lab)
+    data = grade(str(lab), ["subdivision"], task=1, pictures="none", feedback_dir=tmp_path / "feedback")
+    assert data["tests"] and all(t["status"] == "passed" for t in data["tests"]), data["report"]
+
+
+def test_progress_lines_reach_a_log_file_as_they_happen(tmp_path):
+    """`geomlib grade-all ... > log` (or `| tee`) showed no progress line ("[1/3] bob: 0/151") until
+    the last submission was graded: Python block-buffers stdout that is not a terminal (fresh-clone
+    walk, issue 26). Every command's stdout is line-buffered, also into a pipe."""
+    import subprocess
+    import sys
+
+    from geomlib import datasets, mesh_io
+
+    mesh = tmp_path / "mesh.obj"
+    mesh_io.write_mesh(str(mesh), *datasets.icosphere(0))
+    code = "import sys, geomlib.cli as c; c.main(['info', sys.argv[1]]); print('line-buffered:', sys.stdout.line_buffering)"
+    p = subprocess.run([sys.executable, "-c", code, str(mesh)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0 and "line-buffered: True" in p.stdout, p.stdout + p.stderr
