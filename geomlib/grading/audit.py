@@ -880,6 +880,19 @@ def select_mutants(muts: list, *, kind: str | None = None, tasks=None, files=Non
     return muts
 
 
+def _labs_and_work(labs: list[str] | None, prefix: str) -> tuple[list[str], Path]:
+    """The labs asked for (all by default; an unknown one is an :class:`AuditError`) and a new work
+    folder the sandbox user can read (the copies are graded from there)."""
+    names = labs or _impl.lab_names()
+    known = _impl.lab_names()
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
+    work = Path(tempfile.mkdtemp(prefix=prefix))
+    os.chmod(work, 0o755)
+    return names, work
+
+
 def audit(
     labs: list[str] | None = None,
     *,
@@ -900,13 +913,7 @@ def audit(
     the strings (``shaders/``: the GLSL part)."""
     from geomlib.grading import tasks as _tasks
 
-    names = labs or _impl.lab_names()
-    known = _impl.lab_names()
-    unknown = [n for n in names if n not in known]
-    if unknown:
-        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
-    work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
-    os.chmod(work, 0o755)
+    names, work = _labs_and_work(labs, "geomlib-audit-")
     t_start = time.time()
     report: dict = {"labs": {}, "quick": quick, "jobs": jobs, "kind": kind, "sample": sample}
     if tasks or files:
@@ -1360,13 +1367,7 @@ def in_order(
     ``seconds`` and ``note`` (the grader's note, e.g. a task graded through a composite)."""
     from geomlib.grading import tasks as _tasks
 
-    names = labs or _impl.lab_names()
-    known = _impl.lab_names()
-    unknown = [x for x in names if x not in known]
-    if unknown:
-        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
-    work = Path(tempfile.mkdtemp(prefix="geomlib-in-order-"))
-    os.chmod(work, 0o755)
+    names, work = _labs_and_work(labs, "geomlib-in-order-")
     t_start = time.time()
     report: dict = {"in_order": True, "jobs": jobs, "labs": {x: [] for x in names}}
     reqs = []
