@@ -191,20 +191,23 @@ def _cmd_audit(a) -> int:
     from geomlib.grading import audit
 
     try:
-        report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs, kind=a.kind, sample=a.sample, tasks=a.task,
-                             files=a.file)  # fmt: skip
+        if a.in_order:
+            report = audit.in_order(a.lab, jobs=a.jobs, tasks=a.task)
+        else:
+            report = audit.audit(a.lab, quick=a.quick, jobs=a.jobs, kind=a.kind, sample=a.sample, tasks=a.task,
+                                 files=a.file)  # fmt: skip
     except audit.AuditError as e:
         print(f"geomlib audit: error: {e}", file=sys.stderr)
         return 1
-    text = audit.markdown(report)
+    text = audit.in_order_markdown(report) if a.in_order else audit.markdown(report)
     print(text, end="")
     if a.out:
-        out = Path(a.out)
+        out, name = Path(a.out), "in-order" if a.in_order else "audit"
         out.mkdir(parents=True, exist_ok=True)
-        (out / "audit.md").write_text(text)
-        (out / "audit.json").write_text(json.dumps(report, indent=1, ensure_ascii=False) + "\n")
-        print(f"wrote {out / 'audit.md'} and {out / 'audit.json'}")
-    return 1 if audit.failed(report) else 0
+        (out / f"{name}.md").write_text(text)
+        (out / f"{name}.json").write_text(json.dumps(report, indent=1, ensure_ascii=False) + "\n")
+        print(f"wrote {out / f'{name}.md'} and {out / f'{name}.json'}")
+    return 1 if (audit.in_order_failed(report) if a.in_order else audit.failed(report)) else 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -349,7 +352,13 @@ def build_parser() -> argparse.ArgumentParser:
     au.add_argument("--sample", type=int, help="a fixed, seeded sample of N mutants per lab (of --kind)")
     au.add_argument("--task", type=int, action="append", help="only the mutants of this task number (repeatable)")
     au.add_argument("--file", action="append", help="only mutants of files whose path has this (repeatable)")
-    au.add_argument("--out", help="also write audit.md and audit.json into this folder")
+    au.add_argument(
+        "--in-order",
+        action="store_true",
+        help="instead of mutants: for every task N, grade --task N on the solution with Tasks 1..N done and the "
+        "later ones stubbed (full marks, no later task's 'not implemented'); --lab, --task, --jobs, --out apply",
+    )
+    au.add_argument("--out", help="also write audit.md and audit.json (in-order.md/.json) into this folder")
     au.set_defaults(func=_cmd_audit)
     return p
 

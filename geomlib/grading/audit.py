@@ -42,6 +42,10 @@ interpreter (the sandbox's zygote and pytest's imports are reused: about 1.5 s p
 8 s for a fresh ``geomlib grade``). A mutant's run gets a time budget of five times the solution's
 (at least 60 s): a mutant that loops forever is killed by the budget, and the report says so.
 
+``--in-order`` (:func:`in_order`) uses the same copies and workers for another question: a copy with
+Tasks 1..N done and the later tasks stubbed (as ``geomlib stubs build`` stubs them) must get full
+marks from ``--task N``, for every N: a student doing the tasks in order meets no later task.
+
 Longer than most modules (about 860 lines) on purpose: generating mutants, grading them and
 reporting are one pipeline over one data type (``Mutant``); split, each part would import the
 others' internals.
@@ -70,7 +74,7 @@ from geomlib.grading import impl as _impl
 from geomlib.grading.course import course
 from geomlib.taskref import find_task
 
-__all__ = ["Mutant", "generate", "audit", "markdown", "AuditError"]
+__all__ = ["Mutant", "generate", "audit", "markdown", "AuditError", "in_order", "in_order_copy", "in_order_markdown"]
 
 _HELPER = "_geomlib_audit_nothing"
 NOTHING_MODES = ("zeros", "input", "constant")
@@ -728,7 +732,7 @@ def _worker_main() -> int:
             records: list = []
             data = grade(
                 req["impl"], [req["lab"]], task=req["task"], feedback_dir="", extra_args=["-p", "geomlib.grading.audit"],
-                records_out=records, every_test=True,
+                records_out=records, every_test=req.get("every_test", True),
             )  # fmt: skip
             ids = [r.nodeid for r in records]
             ids = ids if len(ids) == len(data["tests"]) else [""] * len(data["tests"])
@@ -737,7 +741,7 @@ def _worker_main() -> int:
                  "output": x.get("output", "")[:300], "calls": registered._CALLS.get(nid, [])}
                 for x, nid in zip(data["tests"], ids, strict=True)
             ]  # fmt: skip
-            out = {"ok": True, "tests": tests}
+            out = {"ok": True, "tests": tests, "note": data.get("output", "")[:1000]}
         except BaseException as e:  # noqa: BLE001  (the audit keeps going; the mutant's row says what happened)
             out = {"ok": False, "error": f"{type(e).__name__}: {e}"}
         out["seconds"] = time.time() - t
@@ -805,8 +809,9 @@ class _Pool:
 
 
 class _Progress:
-    def __init__(self, total: int, stream=sys.stderr):
+    def __init__(self, total: int, stream=sys.stderr, *, what: str = "mutants", bad: str = "survived"):
         self.total, self.done, self.survived, self.t0, self.stream = total, 0, 0, time.time(), stream
+        self.what, self.bad = what, bad
 
     def step(self, survived: bool, what: str = "") -> None:
         self.done += 1
@@ -816,8 +821,8 @@ class _Progress:
         el = time.time() - self.t0
         eta = el / self.done * (self.total - self.done)
         line = (
-            f"\r[{'#' * fill}{'.' * (width - fill)}] {self.done}/{self.total} mutants, "
-            f"{self.survived} survived, {el:.0f} s (about {eta:.0f} s left) {what[:40]:<40}"
+            f"\r[{'#' * fill}{'.' * (width - fill)}] {self.done}/{self.total} {self.what}, "
+            f"{self.survived} {self.bad}, {el:.0f} s (about {eta:.0f} s left) {what[:40]:<40}"
         )
         self.stream.write(line)
         self.stream.flush()
@@ -875,6 +880,19 @@ def select_mutants(muts: list, *, kind: str | None = None, tasks=None, files=Non
     return muts
 
 
+def _labs_and_work(labs: list[str] | None, prefix: str) -> tuple[list[str], Path]:
+    """The labs asked for (all by default; an unknown one is an :class:`AuditError`) and a new work
+    folder the sandbox user can read (the copies are graded from there)."""
+    names = labs or _impl.lab_names()
+    known = _impl.lab_names()
+    unknown = [n for n in names if n not in known]
+    if unknown:
+        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
+    work = Path(tempfile.mkdtemp(prefix=prefix))
+    os.chmod(work, 0o755)
+    return names, work
+
+
 def audit(
     labs: list[str] | None = None,
     *,
@@ -895,13 +913,7 @@ def audit(
     the strings (``shaders/``: the GLSL part)."""
     from geomlib.grading import tasks as _tasks
 
-    names = labs or _impl.lab_names()
-    known = _impl.lab_names()
-    unknown = [n for n in names if n not in known]
-    if unknown:
-        raise AuditError(f"unknown lab(s): {', '.join(unknown)}; known: {', '.join(known)}")
-    work = Path(tempfile.mkdtemp(prefix="geomlib-audit-"))
-    os.chmod(work, 0o755)
+    names, work = _labs_and_work(labs, "geomlib-audit-")
     t_start = time.time()
     report: dict = {"labs": {}, "quick": quick, "jobs": jobs, "kind": kind, "sample": sample}
     if tasks or files:
@@ -1300,6 +1312,148 @@ def markdown(report: dict) -> str:
             out += ["", f"## {lab}: not mutated", ""]
             out += [f"- {n}" for n in lr["notes"]]
     return "\n".join(out) + "\n"
+
+
+# ---------------------------------------------------------------------------------- tasks done in order
+
+
+def in_order_copy(lab: str, n: int, dest: Path) -> None:
+    """``dest`` becomes the lab of a student who has done Tasks 1..``n`` and nothing else: a copy of
+    ``solutions/<lab>/`` whose blocks of later tasks are stubbed exactly as ``geomlib stubs build``
+    stubs them (:func:`geomlib.grading.stubs.make_stub` with ``keep``), prompts included."""
+    from geomlib.grading import stubs
+
+    src = course().lab(lab).solution
+    _copy_lab(src, dest)
+
+    def keep(task: str) -> bool:
+        m = find_task(task, titled=True)
+        return m is not None and m.number <= n
+
+    for f in sorted(dest.rglob("*")):
+        if f.suffix in stubs.STUB_SUFFIXES and "__pycache__" not in f.parts:
+            text = f.read_text()
+            new = stubs.make_stub(text, str(f.relative_to(dest)), keep=keep)
+            if new != text:
+                f.write_text(new)
+
+
+#: "not implemented yet (Task 6 ...", "NotImplementedError: Task 6 (...", "#error Task 6 (...": a stub's words.
+_NOT_DONE = re.compile(r"(?:not implemented(?: yet)?|NotImplementedError|#error)\W{0,20}(Task\s+\d+)", re.I)
+
+
+def later_tasks_named(text: str, n: int) -> list[int]:
+    """The task numbers above ``n`` that ``text`` (a failed test's message) names as not implemented."""
+    out = []
+    for m in _NOT_DONE.finditer(text):
+        ref = find_task(m.group(1))
+        if ref and ref.number > n and ref.number not in out:
+            out.append(ref.number)
+    return out
+
+
+def in_order(
+    labs: list[str] | None = None, *, jobs: int = 1, progress: bool = True, tasks: list[int] | None = None
+) -> dict:
+    """``geomlib audit --in-order``: for every lab and task N, grade (``--task N``, as a student runs
+    it: public and hidden tests, sandboxed, the tests whose latest task is N) a copy of the solution
+    with Tasks 1..N done and the later ones stubbed (:func:`in_order_copy`). A student who did the
+    tasks in order must get full marks there, and no test may stop at a later task's stub.
+
+    Returns ``{"labs": {lab: [row per task]}, "seconds": ...}``; a row has ``task``, ``status``
+    (``ok``; ``later``: a test stopped at a later task's stub; ``lost``: points lost otherwise;
+    ``no tests``: nothing graded; ``error``: the grading failed), ``score``, ``max``, ``later``
+    (the later task numbers named), ``failures`` (``name: message`` of each failed test),
+    ``seconds`` and ``note`` (the grader's note, e.g. a task graded through a composite)."""
+    from geomlib.grading import tasks as _tasks
+
+    names, work = _labs_and_work(labs, "geomlib-in-order-")
+    t_start = time.time()
+    report: dict = {"in_order": True, "jobs": jobs, "labs": {x: [] for x in names}}
+    reqs = []
+    for lab in names:
+        numbers = sorted(_tasks.derive(course().lab(lab).solution).titles)
+        jit = _jit_request(course().lab(lab).solution)
+        for n in numbers if not tasks else [t for t in numbers if t in tasks]:
+            d = work / f"{lab}-{n}"
+
+            def prepare(lab=lab, n=n, d=d, jit=jit):
+                in_order_copy(lab, n, d / lab)
+                return {"impl": str(d), "lab": lab, "task": n, "budget": None, "every_test": False, **jit}
+
+            reqs.append({"prepare": prepare, "lab": lab, "task": n})
+    prog = _Progress(len(reqs), what="tasks", bad="not at full marks") if progress else None
+    pool = _Pool(max(1, jobs), work)
+    rows: dict[int, dict] = {}
+
+    def done(i, r, res):
+        shutil.rmtree(r["impl"], ignore_errors=True) if "impl" in r else None
+        lab, n = reqs[i]["lab"], reqs[i]["task"]
+        got, top = _score(res)
+        failures = [f"{t['name']}: {' '.join(t['output'].split())}" for t in res.get("tests", []) if not t["passed"]]
+        later = sorted({k for f in failures for k in later_tasks_named(f, n)})
+        if not res.get("ok"):
+            status, failures = "error", [res.get("error", "")]
+        elif not res["tests"]:
+            status = "no tests"
+        elif later:
+            status = "later"
+        elif got < top or failures:
+            status = "lost"
+        else:
+            status = "ok"
+        rows[i] = {"lab": lab, "task": n, "status": status, "score": got, "max": top, "later": later,
+                   "failures": failures, "seconds": round(res.get("seconds", 0.0), 2),
+                   "note": _through(res.get("note", ""))}  # fmt: skip
+        if prog:
+            prog.step(status != "ok", f"{lab} Task {n}")
+
+    try:
+        pool.run(reqs, done)
+    finally:
+        pool.close()
+        shutil.rmtree(work, ignore_errors=True)
+    if prog:
+        prog.end()
+    for i in sorted(rows):
+        report["labs"][rows[i]["lab"]].append({k: v for k, v in rows[i].items() if k != "lab"})
+    report["seconds"] = round(time.time() - t_start, 1)
+    return report
+
+
+def _through(output: str) -> str:
+    """The grader's note that a task without a test of its own was graded through later tasks' tests."""
+    return next((line.strip() for line in str(output).splitlines() if "no test of its own" in line), "")
+
+
+def in_order_markdown(report: dict) -> str:
+    """The ``--in-order`` report: a row per lab and task, then each failure's tests and messages."""
+    out = ["# Tasks done in order", ""]
+    out.append(
+        f"{report.get('seconds', 0):.0f} s with {report.get('jobs', 1)} job(s). Each row grades `--task N` on a copy "
+        "of the solution with Tasks 1..N done and the later tasks stubbed as `geomlib stubs build` stubs them."
+    )
+    out += ["", "| lab | task | status | score | later task named | seconds |", "|---|---:|---|---:|---|---:|"]
+    for lab, rows in report["labs"].items():
+        for r in rows:
+            later = ", ".join(f"Task {k}" for k in r["later"]) or ""
+            out.append(
+                f"| {lab} | {r['task']} | {r['status']} | {r['score']:g}/{r['max']:g} | {later} | {r['seconds']:.1f} |"
+            )
+    for lab, rows in report["labs"].items():
+        for r in rows:
+            if r["status"] == "ok":
+                continue
+            out += ["", f"## {lab}, Task {r['task']}: {r['status']}", ""]
+            if r.get("note"):
+                out.append(f"- grader's note: {r['note']}")
+            out += [f"- {f[:400]}" for f in r["failures"]]
+    return "\n".join(out) + "\n"
+
+
+def in_order_failed(report: dict) -> bool:
+    """True when some lab's task, done in order, does not get full marks (or names a later task)."""
+    return any(r["status"] not in ("ok",) for rows in report["labs"].values() for r in rows)
 
 
 def failed(report: dict) -> bool:

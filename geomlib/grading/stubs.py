@@ -96,10 +96,19 @@ def _scan(text: str, name: str) -> tuple[list[_Block], list[tuple[int, int]]]:
     return blocks, prompts
 
 
-def make_stub(text: str, name: str = "<solution>") -> str:
-    """The stub version of one solution file's text."""
+def make_stub(text: str, name: str = "<solution>", keep=None) -> str:
+    """The stub version of one solution file's text.
+
+    ``keep``: a function of a block's task text (``"Task 2 (even vertices): ..."``) that says which
+    blocks stay as the solution wrote them, with the prompt just before each (``geomlib audit
+    --in-order``: the lab of a student who has done Tasks 1..N); the others are stubbed as always."""
     blocks, prompts = _scan(text, name)
-    lines = _comments(text, name).splitlines()
+    if keep is not None:
+        kept = {b.start for b in blocks if keep(b.task)}
+        # A prompt belongs to the block after it: it stays commented out when that block stays.
+        prompts = [(s, e) for s, e in prompts if next((b.start for b in blocks if b.start > e), None) not in kept]
+        blocks = [b for b in blocks if b.start not in kept]
+    lines = text.splitlines()  # marker lines (the only ones _comments changes) are all dropped below
     out: list[str] = []
     starts = {b.start: b for b in blocks}
     in_prompt = {i for s, e in prompts for i in range(s, e + 1)}
@@ -116,7 +125,7 @@ def make_stub(text: str, name: str = "<solution>") -> str:
             continue
         line = lines[i - 1]
         if i in in_prompt:
-            if _PBEGIN.match(line) or _PEND.match(line):
+            if i in (s for s, _ in prompts) or i in (e for _, e in prompts):
                 i += 1
                 continue
             out.append(re.sub(r"^(\s*)// ?" if _glsl(name) else r"^(\s*)# ?", r"\1", line, count=1))

@@ -131,6 +131,7 @@ CASES = [
         inputs=mesh(box, target_length=0.12, feature_angle=45.0),
         outputs=("V", "F"),
         check=remesh_check(mesh(box), 0.12, hausdorff=1e-3, **QUALITY),  # solution: 0 (edges kept exactly)
+        tasks=(7, 10),  # isotropic_remesh is the loop, Task 10
         part="features",
         points=1,
         hint="vertices on sharp edges slide along them, corners stay",

@@ -147,6 +147,7 @@ CASES = [
         inputs=mesh(box8, target_length=0.07, feature_angle=45.0),
         outputs=("V", "F"),
         check=remesh_check(mesh(box8), 0.07, hausdorff=1e-3, **QUALITY),  # solution: 0
+        tasks=(7, 10),  # isotropic_remesh is the loop, Task 10
         part="features",
         points=2,
         visibility="hidden",
