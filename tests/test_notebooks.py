@@ -4,7 +4,8 @@ and on the stubs; on the stubs its ``check()`` cells show that every lab's stubs
 Each thing is graded once in the suite: ``tests/graded/<lab>`` grades every graded test against the
 solutions, and the stubs run here grades every graded test against the stubs (the notebook's
 ``check(lab, task=N)`` cells, one per task; ``tests/framework/test_task_selection.py`` checks that
-together they select every graded test). So the run on the solutions executes every cell but the
+together they select every graded test, and the stubs run here checks that no task's tests name a
+later task). So the run on the solutions executes every cell but the
 ``check()`` cells, which would grade the solutions a second time (and start a grading sandbox in the
 kernel for it: seconds of CPU per lab); only in one notebook (:data:`PASSING_REPORT_IN`) it keeps
 the first one (task 1, it also imports ``check``), which shows a passing report in a kernel: the
@@ -228,7 +229,8 @@ def test_notebook_runs_on_the_stubs(path):
     """As in the student bundle before any work: every cell runs, the missing tasks are named (in
     the figures too: :func:`tests.test_lab_contracts.untouched_stub_figure_problems`), and
     every task's check() scores 0 with no failure other than "not implemented yet" (a stub that
-    fails for another reason, an error in the grader or in a given helper, shows here)."""
+    fails for another reason, an error in the grader or in a given helper, shows here), and names
+    no later task than its own (:func:`_later_tasks_named`)."""
     from geomlib.grading import tasks
     from geomlib.grading.results import validate_results
 
@@ -250,6 +252,31 @@ def test_notebook_runs_on_the_stubs(path):
     assert not bad, "stub tests that fail for another reason than 'not implemented yet':\n" + "\n".join(
         f"{t['name']}: {t['output'][:300]}" for t in bad
     )
+    later = _later_tasks_named(lab, reports)
+    assert not later, "\n".join(later)
+
+
+def _later_tasks_named(lab: str, reports: dict[int, dict]) -> list[str]:
+    """The tests of ``check(lab, task=N)`` on the untouched stubs whose message names a later task
+    than N (a student working in order has not reached it): ``--task N`` runs the tests whose latest
+    task is N (:func:`geomlib.grading.tasks.selects`). Remeshing's split-bumpy-sphere runs Task 1's
+    split through Task 4's split_long_edges and said "Task 4" under ``--task 1``. A task with no
+    test of its own runs the tests of the functions that run it, and says so: those are later
+    tasks' tests, and are left out. This is the suite's one grading of every lab's stubs task by
+    task (``tests/framework/test_task_selection.py`` checks which tests each task selects)."""
+    from geomlib.grading.results import plain_text
+    from geomlib.taskref import find_task
+
+    problems = []
+    for task, r in sorted(reports.items()):
+        if "has no test of its own" in plain_text(r["output"]):
+            continue
+        for t in r["tests"]:
+            msg = plain_text(t["output"])
+            m = find_task(msg)
+            if m is not None and m.number > task:
+                problems.append(f"{lab}: check(task={task}) runs {t['name']}, which says: {msg[:150]}")
+    return problems
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
