@@ -220,6 +220,22 @@ def stub_panel_problems(lab: str, stub: dict, solution) -> list[str]:
     return problems
 
 
+def notebook_draws_the_quick_figures(lab: str) -> bool:
+    """Whether the lab's notebook has one cell that draws the figures as
+    :func:`test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing` does:
+    ``make_figures(out, quick=True)`` of ``<the lab's module>.figures``."""
+    notebook = course(ROOT).lab(lab).notebook
+    if not notebook.is_file():
+        return False
+    cells = ["".join(c["source"]) for c in json.loads(notebook.read_text())["cells"] if c["cell_type"] == "code"]
+    drawing = [c for c in cells if "make_figures(" in c]
+    return (
+        len(drawing) == 1
+        and re.search(r"^\s*for fig in figures\.make_figures\(out, quick=True\):", drawing[0], re.M) is not None
+        and re.search(r'figures = importlib\.import_module\(f"\{\w+\.__name__\}\.figures"\)', drawing[0]) is not None
+    )
+
+
 @pytest.mark.parametrize("lab", LABS)
 def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing(lab, tmp_path):
     """A panel of a figure drawn from the untouched stubs either shows what the solution's shows, or
@@ -227,17 +243,11 @@ def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missi
     or wrong panel passes for a result (relief's x3 close-up cropped two stand-ins into a blank
     panel; its silhouette outlines compared the cylinder with itself).
 
-    A lab notebook's figures cell draws the same figures (``make_figures(out, quick=True)`` of the
-    stubs, then of the solutions) and its runs check their panels (``tests/test_notebooks.py``), so
-    the suite draws them once: here, that the notebook has that cell; a lab without a notebook
-    draws them here."""
-    notebook = course(ROOT).lab(lab).notebook
-    if notebook.is_file():
-        cells = ["".join(c["source"]) for c in json.loads(notebook.read_text())["cells"] if c["cell_type"] == "code"]
-        drawing = [c for c in cells if re.search(r"^\s*for fig in figures\.make_figures\(out, quick=True\):", c, re.M)]
-        assert len(drawing) == 1 and re.search(r'import_module\(f"\{\w+\.__name__\}\.figures"\)', drawing[0]), (
-            f"{notebook.name}: no one cell that draws the lab's figures with make_figures(out, quick=True)"
-        )
+    A lab notebook's figures cell that draws ``make_figures(out, quick=True)`` of the lab's figures
+    module draws exactly these figures (on the stubs, then on the solutions), and the notebook's
+    runs check their panels (``tests/test_notebooks.py``): the suite draws them once, there. Any
+    other lab is drawn here."""
+    if notebook_draws_the_quick_figures(lab):
         return
     stub = _panels_drawn(importlib.import_module(f"labs.{lab}.figures"), tmp_path / "labs")
     problems = stub_panel_problems(
