@@ -10,13 +10,17 @@
 - ``make_figures`` and ``make_view`` on the untouched stubs finish, and draw one "Task N not implemented yet"
   picture (naming a task the stubs really leave open) for each figure it cannot draw, under the
   figure's own file name (``make_figures`` of a lab with a notebook: on the stubs notebook's run,
-  ``tests/test_notebooks.py``).
+  ``tests/test_notebooks.py``);
+- every panel of those figures shows what the solution's shows or says what is missing (for a lab
+  with a notebook: on its runs, which draw the same figures).
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import inspect
+import json
 import re
 import types
 from pathlib import Path
@@ -146,10 +150,12 @@ def test_make_figures_draws_the_lab_it_is_given(tmp_path):
     assert isinstance(stubs, types.ModuleType)
 
 
-def _panels_drawn(figures_module, out_dir) -> dict:
-    """``{(figure title, panel index): [(RGB panel, label), ...]}`` of every ``panels`` call that
-    ``figures_module.make_figures(out_dir, quick=True)`` makes (the lab's figures and the given
-    placeholders both lay their pictures out with ``geomlib.plot.panels``)."""
+@contextlib.contextmanager
+def panels_spy():
+    """``{(figure title, panel index): [(RGB panel, label), ...]}`` of every ``panels`` call made
+    inside the block (the lab's figures and the given placeholders both lay their pictures out with
+    ``geomlib.plot.panels``): the modules that hold ``panels`` when the block starts call a spy.
+    Used here and in the notebooks' runs around their figures cell (``tests/test_notebooks.py``)."""
     import sys
 
     from geomlib import plot
@@ -166,10 +172,16 @@ def _panels_drawn(figures_module, out_dir) -> dict:
     for m in users:
         m.panels = spy
     try:
-        figures_module.make_figures(out_dir, quick=True)
+        yield drawn
     finally:
         for m in users:
             m.panels = real
+
+
+def _panels_drawn(figures_module, out_dir) -> dict:
+    """:func:`panels_spy` of ``figures_module.make_figures(out_dir, quick=True)``."""
+    with panels_spy() as drawn:
+        figures_module.make_figures(out_dir, quick=True)
     return drawn
 
 
@@ -187,13 +199,10 @@ def _says_missing(label: str) -> bool:
     return "not implemented" in label or task_at_start(label) is not None
 
 
-@pytest.mark.parametrize("lab", LABS)
-def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing(lab, tmp_path):
-    """A panel of a figure drawn from the untouched stubs either shows what the solution's shows, or
-    says that a task is missing (a grey stand-in, or "not implemented yet" in its label): no blank
-    or wrong panel passes for a result (relief's x3 close-up cropped two stand-ins into a blank
-    panel; its silhouette outlines compared the cylinder with itself)."""
-    stub = _panels_drawn(importlib.import_module(f"labs.{lab}.figures"), tmp_path / "labs")
+def stub_panel_problems(lab: str, stub: dict, solution) -> list[str]:
+    """The panels of figures drawn from the untouched stubs (``stub``, :func:`panels_spy`) that
+    neither say that a task is missing (a grey stand-in, or "not implemented yet" in the label) nor
+    show what the solution's show (``solution()``: the solution's panels, drawn only when needed)."""
     unsaid = [
         (key, i, img, label)
         for key, items in stub.items()
@@ -201,11 +210,47 @@ def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missi
         if not _says_missing(label) and not _stand_in(img)
     ]
     if not unsaid:  # every panel is a stand-in or says what it lacks: no need to draw the solution's
-        return
-    solution = _panels_drawn(importlib.import_module(f"solutions.{lab}.figures"), tmp_path / "solutions")
+        return []
+    drawn = solution()
     problems = []
     for key, i, img, label in unsaid:
-        ref = solution.get(key, [])
+        ref = drawn.get(key, [])
         if not (i < len(ref) and ref[i][0].shape == img.shape and np.array_equal(ref[i][0], img)):
             problems.append(f"{lab}: panel {key[1]} of {key[0]!r} ({label!r}) differs from the solution's")
+    return problems
+
+
+def notebook_draws_the_quick_figures(lab: str) -> bool:
+    """Whether the lab's notebook has one cell that draws the figures as
+    :func:`test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing` does:
+    ``make_figures(out, quick=True)`` of ``<the lab's module>.figures``."""
+    notebook = course(ROOT).lab(lab).notebook
+    if not notebook.is_file():
+        return False
+    cells = ["".join(c["source"]) for c in json.loads(notebook.read_text())["cells"] if c["cell_type"] == "code"]
+    drawing = [c for c in cells if "make_figures(" in c]
+    return (
+        len(drawing) == 1
+        and re.search(r"^\s*for fig in figures\.make_figures\(out, quick=True\):", drawing[0], re.M) is not None
+        and re.search(r'figures = importlib\.import_module\(f"\{\w+\.__name__\}\.figures"\)', drawing[0]) is not None
+    )
+
+
+@pytest.mark.parametrize("lab", LABS)
+def test_every_panel_drawn_from_the_stubs_is_the_solutions_or_says_what_is_missing(lab, tmp_path):
+    """A panel of a figure drawn from the untouched stubs either shows what the solution's shows, or
+    says that a task is missing (a grey stand-in, or "not implemented yet" in its label): no blank
+    or wrong panel passes for a result (relief's x3 close-up cropped two stand-ins into a blank
+    panel; its silhouette outlines compared the cylinder with itself).
+
+    A lab notebook's figures cell that draws ``make_figures(out, quick=True)`` of the lab's figures
+    module draws exactly these figures (on the stubs, then on the solutions), and the notebook's
+    runs check their panels (``tests/test_notebooks.py``): the suite draws them once, there. Any
+    other lab is drawn here."""
+    if notebook_draws_the_quick_figures(lab):
+        return
+    stub = _panels_drawn(importlib.import_module(f"labs.{lab}.figures"), tmp_path / "labs")
+    problems = stub_panel_problems(
+        lab, stub, lambda: _panels_drawn(importlib.import_module(f"solutions.{lab}.figures"), tmp_path / "solutions")
+    )
     assert not problems, "\n".join(problems)

@@ -4,7 +4,8 @@ and on the stubs; on the stubs its ``check()`` cells show that every lab's stubs
 Each thing is graded once in the suite: ``tests/graded/<lab>`` grades every graded test against the
 solutions, and the stubs run here grades every graded test against the stubs (the notebook's
 ``check(lab, task=N)`` cells, one per task; ``tests/framework/test_task_selection.py`` checks that
-together they select every graded test). So the run on the solutions executes every cell but the
+together they select every graded test, and the stubs run here checks that no task's tests name a
+later task). So the run on the solutions executes every cell but the
 ``check()`` cells, which would grade the solutions a second time (and start a grading sandbox in the
 kernel for it: seconds of CPU per lab); only in one notebook (:data:`PASSING_REPORT_IN`) it keeps
 the first one (task 1, it also imports ``check``), which shows a passing report in a kernel: the
@@ -12,7 +13,8 @@ path from ``check()`` to the report is the same for every lab, and the stubs run
 notebook.
 
 On the stubs, the figures cell's pictures are checked as ``tests/test_lab_contracts.py`` checks the
-stubs' figures (each names a task not implemented yet): the suite draws them once, here.
+stubs' figures (each names a task not implemented yet), and every panel it lays out is the solutions
+run's panel or says what is missing: the suite draws them once, here.
 
 One kernel runs a notebook twice: on the stubs first, as in a student's fresh kernel, then, after a
 ``%reset`` that drops every name the first run defined (:data:`_SWITCH`), on the solutions. The two
@@ -28,6 +30,7 @@ from __future__ import annotations
 import base64
 import io
 import json
+import pickle
 import re
 import tempfile
 import time
@@ -111,6 +114,22 @@ __import__("os").environ["GEOMLIB_IMPL"] = {impl!r}
 #: kernel), then the solutions.
 RUNS = ("labs", "solutions")
 
+#: Cells around the figures cell of a run: every ``panels`` call it makes, as
+#: ``tests/test_lab_contracts.py`` records them (:func:`tests.test_lab_contracts.panels_spy`), into
+#: a pickle for the test. The figures module the cell imports is imported first, so that its
+#: ``panels`` is spied on too.
+_SPY_ON = """\
+__import__("importlib").import_module("{impl}.{lab}.figures")
+from tests.test_lab_contracts import panels_spy as _panels_spy
+_spy = _panels_spy()
+_panels = _spy.__enter__()
+"""
+_SPY_OFF = """\
+_spy.__exit__(None, None, None)
+with open({path!r}, "wb") as _f:
+    __import__("pickle").dump(_panels, _f)
+"""
+
 
 def _cells(cells: list, lab: str, impl: str) -> list:
     """The notebook's cells for a run on ``impl``: on the solutions, the check() cells are left out
@@ -155,9 +174,17 @@ def _execute_both(path: Path) -> dict[str, tuple[str, dict[int, dict], list]]:
     assert not any(c.get("outputs") for c in nb.cells if c.cell_type == "code"), f"{path.name} is stored with outputs"
     parts = {}
     cells = []
+    spied = tempfile.TemporaryDirectory(prefix="panels-")
     for impl in RUNS:
         switch = [nbformat.v4.new_code_cell(_SWITCH.format(impl=impl))] if cells else []
         run = [copy.deepcopy(c) for c in _cells(nb.cells, lab, impl)]
+        at = [i for i, c in enumerate(run) if c.cell_type == "code" and "make_figures(" in c.source]
+        assert len(at) == 1, f"{path.name}: {len(at)} cells call make_figures"
+        run[at[0] : at[0] + 1] = [
+            nbformat.v4.new_code_cell(_SPY_ON.format(impl=impl, lab=lab)),
+            run[at[0]],
+            nbformat.v4.new_code_cell(_SPY_OFF.format(path=str(Path(spied.name, impl)))),
+        ]
         reports = nbformat.v4.new_code_cell(_REPORTS)
         parts[impl] = (run, reports)
         cells += [*switch, *run, reports]
@@ -200,6 +227,10 @@ def _execute_both(path: Path) -> dict[str, tuple[str, dict[int, dict], list]]:
                 reports[task] = by_count[str(c.execution_count)]
         text = "".join(o.get("text", "") for c in run if c.cell_type == "code" for o in c.get("outputs", []))
         out[impl] = (text, reports, _figures(run))
+    with spied:
+        panels = {impl: pickle.loads(Path(spied.name, impl).read_bytes()) for impl in RUNS}
+    # the stubs' panels with the solutions' (tests.test_lab_contracts.stub_panel_problems)
+    out["labs"] = (*out["labs"], panels)
     return out
 
 
@@ -226,18 +257,26 @@ def test_notebook_executes(path):
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs_on_the_stubs(path):
     """As in the student bundle before any work: every cell runs, the missing tasks are named (in
-    the figures too: :func:`tests.test_lab_contracts.untouched_stub_figure_problems`), and
+    the figures too: :func:`tests.test_lab_contracts.untouched_stub_figure_problems`; every panel
+    the solution's or saying what is missing: :func:`tests.test_lab_contracts.stub_panel_problems`), and
     every task's check() scores 0 with no failure other than "not implemented yet" (a stub that
-    fails for another reason, an error in the grader or in a given helper, shows here)."""
+    fails for another reason, an error in the grader or in a given helper, shows here), and names
+    no later task than its own (:func:`_later_tasks_named`)."""
     from geomlib.grading import tasks
     from geomlib.grading.results import validate_results
 
     lab = path.stem
-    from tests.test_lab_contracts import untouched_stub_figure_problems
+    from tests.test_lab_contracts import (
+        notebook_draws_the_quick_figures,
+        stub_panel_problems,
+        untouched_stub_figure_problems,
+    )
 
-    text, reports, figures = _execute(path, "labs")
+    text, reports, figures, panels = _execute(path, "labs")
     assert "not implemented yet" in text
     problems = untouched_stub_figure_problems(lab, figures)
+    if notebook_draws_the_quick_figures(lab):  # else test_lab_contracts draws them itself
+        problems += stub_panel_problems(lab, panels["labs"], lambda: panels["solutions"])
     assert not problems, f"{path.name}, figures cell:\n" + "\n".join(problems)
     assert set(reports) == set(tasks.table(lab).titles), f"{path.name}: check() reports for tasks {sorted(reports)}"
     pointed = {}
@@ -250,6 +289,31 @@ def test_notebook_runs_on_the_stubs(path):
     assert not bad, "stub tests that fail for another reason than 'not implemented yet':\n" + "\n".join(
         f"{t['name']}: {t['output'][:300]}" for t in bad
     )
+    later = _later_tasks_named(lab, reports)
+    assert not later, "\n".join(later)
+
+
+def _later_tasks_named(lab: str, reports: dict[int, dict]) -> list[str]:
+    """The tests of ``check(lab, task=N)`` on the untouched stubs whose message names a later task
+    than N (a student working in order has not reached it): ``--task N`` runs the tests whose latest
+    task is N (:func:`geomlib.grading.tasks.selects`). Remeshing's split-bumpy-sphere runs Task 1's
+    split through Task 4's split_long_edges and said "Task 4" under ``--task 1``. A task with no
+    test of its own runs the tests of the functions that run it, and says so: those are later
+    tasks' tests, and are left out. This is the suite's one grading of every lab's stubs task by
+    task (``tests/framework/test_task_selection.py`` checks which tests each task selects)."""
+    from geomlib.grading.results import plain_text
+    from geomlib.taskref import find_task
+
+    problems = []
+    for task, r in sorted(reports.items()):
+        if "has no test of its own" in plain_text(r["output"]):
+            continue
+        for t in r["tests"]:
+            msg = plain_text(t["output"])
+            m = find_task(msg)
+            if m is not None and m.number > task:
+                problems.append(f"{lab}: check(task={task}) runs {t['name']}, which says: {msg[:150]}")
+    return problems
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])

@@ -3,6 +3,10 @@
 The task numbers come from each handout's task table (``labs/<lab>/README.md``); which graded
 tests a task selects is what the grader's own selection plugin keeps, collected in a subprocess
 (the same code path as ``geomlib grade --task N`` and ``check``).
+
+That a task's tests on the untouched stubs name no later task (``--task 1`` listed Task 4's
+"not implemented" in remeshing) is checked on the one grading of every lab's stubs task by task:
+the notebooks' ``check(lab, task=N)`` cells (``tests/test_notebooks.py``, ``_later_tasks_named``).
 """
 
 from __future__ import annotations
@@ -134,38 +138,6 @@ def test_remeshing_task_1_from_the_cli_and_from_check(tmp_path):
     )
     assert p.returncode == 0, p.stderr[-3000:]
     assert p.stdout.strip().splitlines() == cli.strip().splitlines()
-
-
-_STUBS = r"""
-import json, os, sys
-os.environ["GEOMLIB_NO_FEEDBACK_PICTURES"] = "1"
-from geomlib.grading import grade as G
-records = []
-G.grade("labs", sys.argv[1:], feedback_dir="", records_out=records)
-print(json.dumps({r.nodeid: r.message for r in records if r.not_implemented}))
-"""
-
-
-def test_a_task_on_the_untouched_stubs_names_no_later_task(selected):
-    """``--task N`` on the stubs of every lab: no selected test says that a later task is not
-    implemented yet (a student working in order has not reached it). Remeshing's split-bumpy-sphere
-    runs Task 1's split through Task 4's split_long_edges and said "Task 4" under ``--task 1``."""
-    from geomlib.grading.tasks import selects
-    from geomlib.taskref import find_task
-
-    labs = _impl.lab_names()
-    p = subprocess.run([sys.executable, "-c", _STUBS, *labs], capture_output=True, text=True, timeout=900, cwd=ROOT)
-    assert p.returncode == 0, p.stderr[-3000:]
-    messages = json.loads(p.stdout.strip().splitlines()[-1])
-    assert messages, "no test of the stubs said 'not implemented yet'"
-    problems = []
-    for nodeid, msg in messages.items():
-        lab, name = nodeid.split("/")[2], nodeid.split("::", 1)[1]
-        tasks = selected[lab][name][0]
-        m = find_task(msg)
-        for n in (n for n in tasks if selects(tasks, n) and m is not None and m.number > n):
-            problems.append(f"{lab}: --task {n} runs {name}, which says: {msg[:150]}")
-    assert not problems, "\n".join(problems)
 
 
 def test_a_task_graded_through_the_loop_runs_the_loop_tests_and_says_so(tmp_path):
