@@ -15,7 +15,6 @@ from scipy.spatial import cKDTree
 from geomlib import topology
 from geomlib.errors import MeshError
 from geomlib.geometry import closest_points
-from geomlib.portable import dot
 from geomlib.validate import check_float, check_mesh
 
 from . import kernels as K
@@ -221,30 +220,38 @@ def _cover(S: RemeshState, project, passes: int) -> int:
     total = 0
     for _ in range(passes):
         V = S.V[:n]
-        sub = np.arange(len(Fl))
+        G = Fl
         if np.isfinite(reach):  # only the faces that can hold the closest point of an uncovered vertex
-            near = np.isfinite(cKDTree(X[U]).query(V, distance_upper_bound=reach)[0])
-            sub = np.flatnonzero(near[Fl].any(axis=1))
+            G = Fl[_within(V, X[U], reach)[Fl].any(axis=1)]
         tree = igl.AABB()
-        tree.init(V, Fl[sub])
-        d2, face, _ = tree.squared_distance(V, Fl[sub], X[U])
-        d, corners = np.sqrt(np.asarray(d2).ravel()), Fl[sub[np.asarray(face, np.int64).ravel()]]
-        far = np.flatnonzero(d > COVER_DISTANCE * S.high[corners[:, 0]])
-        if not len(far):
+        tree.init(V, G)
+        d2, face, _ = tree.squared_distance(V, G, X[U])
+        face = np.asarray(face, np.int64).ravel()
+        corners = G[face]
+        U, d, cand, Q = K.cover_targets(V, X, U, np.asarray(d2).ravel(), corners, S.high, COVER_DISTANCE, steps)
+        if not len(U):
             break
-        far = far[np.argsort(-d[far], kind="stable")]  # the farthest first
-        U, d, corners = U[far], d[far], corners[far]
-        g = V[corners] - X[U][:, None, :]
-        w = corners[np.arange(len(U)), dot(g, g).argmin(axis=1)]
-        Q = V[w][:, None, :] + steps[None, :, None] * (X[U] - V[w])[:, None, :]
-        done = K.cover_pass(*S.args(), np.repeat(w, len(steps)), project(Q.reshape(-1, 3)), floor)
+        done = K.cover_pass(*S.args(), cand, project(Q), floor)
         total += done
         if not done:
             break
         # the next pass: the input vertices near these (a move may uncover the place it left)
         reach = d[0] + 2.0 * S.high[:n].max()  # a face's corners are within this of its points' vertices
-        U = np.flatnonzero(np.isfinite(cKDTree(X[U]).query(X, distance_upper_bound=reach)[0]))
+        U = np.flatnonzero(_within(X, X[U], reach))
     return total
+
+
+#: Below this many pairs, :func:`_within` compares every pair instead of building a k-d tree.
+WITHIN_PAIRS = 200_000
+
+
+def _within(P, Y, reach) -> np.ndarray:
+    """``(len(P),)`` bool: the rows of ``P`` closer than ``reach`` to a row of ``Y`` (a k-d tree of
+    ``Y``, or :func:`.kernels.within` for few pairs: on a 100-face mesh, building the trees was a
+    fifth of the remeshing's time)."""
+    if len(P) * len(Y) <= WITHIN_PAIRS:
+        return K.within(P, Y, reach)
+    return np.isfinite(cKDTree(Y).query(P, distance_upper_bound=reach)[0])
 
 
 def split_long_edges(V, F, high, *, feature_edges=None, preserve_boundary=True):
