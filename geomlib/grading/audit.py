@@ -72,7 +72,7 @@ from pathlib import Path
 from geomlib.grading import glsl_mutants
 from geomlib.grading import impl as _impl
 from geomlib.grading.course import course
-from geomlib.taskref import find_task
+from geomlib.taskref import find_task, task_at_start
 
 __all__ = ["Mutant", "generate", "audit", "markdown", "AuditError", "in_order", "in_order_copy", "in_order_markdown"]
 
@@ -1338,15 +1338,16 @@ def in_order_copy(lab: str, n: int, dest: Path) -> None:
                 f.write_text(new)
 
 
-#: "not implemented yet (Task 6 ...", "NotImplementedError: Task 6 (...", "#error Task 6 (...": a stub's words.
-_NOT_DONE = re.compile(r"(?:not implemented(?: yet)?|NotImplementedError|#error)\W{0,20}(Task\s+\d+)", re.I)
+#: "not implemented yet (Task 6 ...", "NotImplementedError: Task 6 (...", "#error Task 6 (...": a stub's words,
+#: up to the task reference they lead to (read by :func:`geomlib.taskref.task_at_start`).
+_NOT_DONE = re.compile(r"(?:not implemented(?: yet)?|NotImplementedError|#error)[^\w]{0,20}", re.I)
 
 
 def later_tasks_named(text: str, n: int) -> list[int]:
     """The task numbers above ``n`` that ``text`` (a failed test's message) names as not implemented."""
     out = []
     for m in _NOT_DONE.finditer(text):
-        ref = find_task(m.group(1))
+        ref = task_at_start(text[m.end() :])
         if ref and ref.number > n and ref.number not in out:
             out.append(ref.number)
     return out
