@@ -224,6 +224,11 @@ def _cover(S: RemeshState, project, passes: int) -> int:
     floor = K.faces_min_angle(S.V[:n], Fl).min() if len(Fl) else 0.0
     U, reach = np.arange(len(X)), np.inf
     steps = np.asarray(COVER_STEPS)
+    # An input vertex's points depend on it and its candidate's position only: where that did not
+    # change since its last pass, their projections are the ones it got then (from, at, P_at)
+    from_ = np.full(len(X), -1, np.int64)
+    at = np.empty((len(X), 3))
+    P_at = np.empty((len(X), len(steps), 3))
     total = 0
     for _ in range(passes):
         V = S.V[:n]
@@ -238,7 +243,14 @@ def _cover(S: RemeshState, project, passes: int) -> int:
         U, d, cand, Q = K.cover_targets(V, X, U, np.asarray(d2).ravel(), corners, S.high, COVER_DISTANCE, steps)
         if not len(U):
             break
-        done = K.cover_pass(*S.args(), cand, project(Q), floor)
+        w = cand[:: len(steps)]
+        known = (from_[U] == w) & (at[U].view(np.int64) == V[w].view(np.int64)).all(axis=1)  # the same bits
+        P = np.empty_like(Q).reshape(len(U), len(steps), 3)
+        P[known] = P_at[U[known]]
+        fresh = ~known
+        P[fresh] = project(Q.reshape(P.shape)[fresh].reshape(-1, 3)).reshape(-1, len(steps), 3)
+        from_[U], at[U], P_at[U] = w, V[w], P
+        done = K.cover_pass(*S.args(), cand, P.reshape(-1, 3), floor)
         total += done
         if not done:
             break

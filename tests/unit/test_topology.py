@@ -228,6 +228,24 @@ def test_corner_fans_split_a_bowtie_vertex_into_two_fans(one_per_row):
     assert labels[0] == labels[3] and labels[6] == labels[9] and labels[0] != labels[6]
 
 
+def test_vertex_fans_count_cycles_paths_and_pinches_as_the_connected_components_do():
+    # vertex_fans counts the fans of a paired mesh by pointer doubling, fans() by scipy's connected
+    # components: they agree on closed fans of 3, 4 (a power of two: a doubling lands on the corner
+    # itself) and 5 corners, open fans, and pinches of two closed or open fans at one vertex.
+    octa = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    pyramid5 = np.array([[0, 1, 5], [1, 2, 5], [2, 3, 5], [3, 4, 5], [4, 0, 5], [1, 0, 6], [2, 1, 6], [3, 2, 6],
+                         [4, 3, 6], [0, 4, 6]])  # fmt: skip
+    pinch = np.r_[octa, octa + 5]  # vertex 5 is the apex of both: two closed fans of 4 corners
+    open_pinch = np.r_[octa[:3], octa[:3] + 4]  # vertex 4 is in both: two open fans
+    for F in (TETRA, octa, pyramid5, pinch, open_pinch, octa[:5], SQUARE):
+        F = np.asarray(F, np.int64)
+        H = tp.halfedge_mesh(F)
+        expected = np.bincount(H.fans()[1], minlength=H.n_vertices)
+        np.testing.assert_array_equal(H.vertex_fans, expected)
+    assert tp.halfedge_mesh(pinch).vertex_fans[5] == 2
+    assert tp.halfedge_mesh(open_pinch).vertex_fans[4] == 2
+
+
 # --------------------------------------------------------------------------------------------
 # the half-edge structure
 
