@@ -342,7 +342,8 @@ def sandbox_interpreter(user: str, log=print) -> str:
     python = venv / "bin" / "python"
     if not ((root / "pyproject.toml").is_file() and (root / "uv.lock").is_file()):
         return sys.executable  # not a checkout: check_sandbox_user says what is wrong
-    log(f"the sandbox user cannot run {sys.executable}; making {venv} as the autograder's setup.sh does")
+    doing = f"checking {venv} against uv.lock" if python.is_file() else f"making {venv}"
+    log(f"the sandbox user cannot run {sys.executable}; {doing} as the autograder's setup.sh does")
     env = {**os.environ, "UV_PROJECT_ENVIRONMENT": str(venv)}
     env.pop("VIRTUAL_ENV", None)
     # Bytecode compiled now (the sandbox user cannot write it), unless uv's own UV_COMPILE_BYTECODE=0 says not to.
