@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-__all__ = ["TASK", "TASK_RUN", "TaskRef", "find_task", "find_tasks", "task_at_start"]
+__all__ = ["TASK", "TASK_RUN", "TaskRef", "find_task", "find_tasks", "task_at_start", "tasks_label"]
 
 #: ``Task 3``, ``Task 3b``, ``Task 3 (title)``: groups number, part letter, title (or None).
 TASK = re.compile(r"Task\s+(\d+)([a-z]?)(?![A-Za-z0-9])(?:\s*\(([^()\n]{0,80})\))?")
@@ -66,3 +66,13 @@ def task_at_start(text: str) -> TaskRef | None:
 def find_task(text: str, *, titled: bool = False) -> TaskRef | None:
     """The first task reference in ``text`` (with ``titled``: the first one that has a title), or None."""
     return next((r for r in find_tasks(text) if r.title is not None or not titled), None)
+
+
+def tasks_label(numbers) -> str:
+    """``Task 2``, ``Tasks 3, 5``, ``Tasks 1-8``: how a report names the tasks a test checks."""
+    t = sorted(numbers)
+    if len(t) == 1:
+        return f"Task {t[0]}"
+    if len(t) > 2 and t == list(range(t[0], t[-1] + 1)):
+        return f"Tasks {t[0]}-{t[-1]}"
+    return "Tasks " + ", ".join(map(str, t))

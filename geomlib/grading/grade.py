@@ -24,7 +24,7 @@ from geomlib.grading.course import course
 from geomlib.grading.errors import SEE_PICTURE
 from geomlib.grading.results import build_results, write_results
 from geomlib.grading.settings import GradingSettings, env
-from geomlib.taskref import find_task, task_at_start
+from geomlib.taskref import find_task, task_at_start, tasks_label
 
 __all__ = ["grade", "check", "Report", "report_lines"]
 
@@ -211,7 +211,7 @@ def grade(
             note += ":\n" + "\n".join(tail)
     if selection.through and records:
         note = f"{selection.through}\n{note}" if note else selection.through
-    data = build_results(records, elapsed, note)
+    data = build_results(records, elapsed, note, tasks=selection.tasks)
     if results:
         write_results(data, results)
     data["report"] = report_lines(
@@ -382,7 +382,7 @@ def report_lines(
         owner = task_at_start(msg[rows.end() :]) if rows else None
         if owner and owner.title is not None:
             t, part = (owner.number,), owner.title
-        line = f"✗ {where}{_tasks_text(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
+        line = f"✗ {where}{tasks_label(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
         if line in seen:
             continue
         seen.add(line)
@@ -463,16 +463,6 @@ def _hidden_totals(records) -> list[str]:
                 f"out of {m.group(3)} ({m.group(1)} public + {m.group(2)} hidden)."
             )
     return out
-
-
-def _tasks_text(t) -> str:
-    """``Task 2``, ``Tasks 3, 5``, ``Tasks 1-8``."""
-    t = sorted(t)
-    if len(t) == 1:
-        return f"Task {t[0]}"
-    if len(t) > 2 and t == list(range(t[0], t[-1] + 1)):
-        return f"Tasks {t[0]}-{t[-1]}"
-    return "Tasks " + ", ".join(map(str, t))
 
 
 class Report(list):

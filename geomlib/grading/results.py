@@ -20,6 +20,7 @@ from pathlib import Path
 
 from geomlib.grading.errors import SEE_PICTURE
 from geomlib.grading.sandbox import clean_text
+from geomlib.taskref import tasks_label
 
 __all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results", "markdown_text", "plain_text"]
 
@@ -171,18 +172,25 @@ def _without_paths(message: str, embedded: str | None) -> str:
     return SEE_PICTURE.sub(lambda m: " (picture below)" if embedded and m.group(1) == embedded else "", message)
 
 
-def _test_output(r: Record) -> dict:
-    """A test's ``output`` and ``output_format``: Markdown, or HTML with its feedback picture inlined."""
+def _test_output(r: Record, tasks=()) -> dict:
+    """A test's ``output`` and ``output_format``: Markdown, or HTML with its feedback picture inlined.
+    A failed test's message starts with the tasks it checks (``Task 4: ...``), as the local report's
+    "What to fix" lines do: on Gradescope the test's name gives only the lab and the part. (Not on a
+    stub's "not implemented yet", which names its task, a skip, or a grader problem.)"""
     img = embedded_picture(r.picture) if (r.picture and not r.passed) else None
     message = _without_paths(r.message, r.picture if img is not None else None)
+    if tasks and not (r.passed or r.not_implemented or r.error or r.message.startswith("skipped")):
+        message = f"{tasks_label(tasks)}: {message}"
     if img is None:
         return {"output": markdown_text(message), "output_format": "md"}
     text = html.escape(clean_text(message, TEST_OUTPUT_CHARS)).replace("\n", "<br>")
     return {"output": f"<p>{text}</p>\n{img}", "output_format": "html"}
 
 
-def build_results(records: list[Record], execution_time: float, output: str = "") -> dict:
+def build_results(records: list[Record], execution_time: float, output: str = "", tasks=None) -> dict:
     """The ``results.json`` dict for graded records (test numbers are ``<lab>.<part>.<k>``).
+
+    ``tasks``: ``{nodeid: task numbers}`` of the run's tests (the handout's tasks each checks).
 
     Everything that may come from student code is sanitised (lone surrogates, control characters),
     escaped for Markdown (``output_format: md``) and cut to a bounded length.
@@ -202,7 +210,7 @@ def build_results(records: list[Record], execution_time: float, output: str = ""
                 "score": round(r.score, 6),
                 "max_score": round(r.points, 6),
                 "status": "passed" if r.passed else "failed",
-                **_test_output(r),
+                **_test_output(r, (tasks or {}).get(r.nodeid, ())),
                 "visibility": r.visibility,
                 "tags": [clean_text(r.lab, 100), clean_text(r.part, 100)],
             }

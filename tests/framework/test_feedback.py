@@ -115,6 +115,38 @@ def test_results_json_inlines_a_failed_tests_feedback_picture(tmp_path):
     assert passed["output_format"] == "md" and "data:image" not in passed["output"]
 
 
+def test_results_json_names_the_tasks_of_a_failed_test():
+    """On Gradescope a test's name gives the lab and the part only; a failed test's output starts with
+    the handout's tasks it checks, as the local "What to fix" lines do (a wrong Task 4 split point read
+    "remeshing › stages › split_long_edges on ...: V has shape ..." with no task)."""
+    from geomlib.grading.results import Record, build_results, validate_results
+
+    def record(nodeid, passed, message="V has shape (1226, 3), expected (1225, 3)", not_implemented=False):
+        return Record(
+            nodeid=nodeid, lab="remeshing", part="stages", name="split", points=1.0, visibility="visible",
+            passed=passed, message=message, duration=0.1, not_implemented=not_implemented,
+        )  # fmt: skip
+
+    records = [
+        record("a", False),
+        record("b", False),
+        record("c", True, ""),
+        record("d", False, "split_long_edges: not implemented yet (Task 4 (split long edges))", True),
+        record("e", False),
+        record("f", False, "grader problem (not your code): the sandbox user cannot run python"),
+    ]
+    records[-1].error = True
+    data = build_results(records, 1.0, tasks={"a": (4,), "b": (1, 4), "c": (4,), "d": (4,), "f": (4,)})
+    validate_results(data)
+    out = [t["output"] for t in data["tests"]]
+    assert out[0].startswith("Task 4: V has shape") and out[1].startswith("Tasks 1, 4: V has shape")
+    assert "Task" not in out[2]  # passed: nothing to say
+    assert out[3].count("Task 4") == 1  # a stub's message names its task already
+    assert out[4].startswith("V has shape")  # a test without tasks (bad input): as before
+    assert out[5].startswith("grader problem (not your code)")  # not the student's task
+    assert build_results(records, 1.0)["tests"][0]["output"].startswith("V has shape")  # no task map given
+
+
 def test_a_missing_or_huge_picture_is_not_embedded(tmp_path):
     from PIL import Image
 

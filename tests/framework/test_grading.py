@@ -133,7 +133,7 @@ def test_wrong_values_get_a_message_naming_the_row_values_and_count(sample_cours
     r = grade(sample_course, str(_submission(tmp_path, wrong)))
     t = _by_name(r)['sample › scaling › scale_about_centroid on "tet-scale"']
     assert t["status"] == "failed" and t["score"] == 0
-    assert t["output"].startswith('scale_about_centroid on "tet-scale": V[0] expected (')
+    assert t["output"].startswith('Task 1: scale_about_centroid on "tet-scale": V[0] expected (')
     assert "got (0, 0, 0)" in t["output"] and "of 4 rows off by more than" in t["output"]
     assert "scale about the centroid, not the origin" in t["output"]  # the case's hint
     # Partial credit: the midpoints part is untouched.
