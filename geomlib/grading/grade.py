@@ -22,9 +22,9 @@ from geomlib.grading import impl as _impl
 from geomlib.grading import plugin
 from geomlib.grading.course import course
 from geomlib.grading.errors import SEE_PICTURE
-from geomlib.grading.results import build_results, write_results
+from geomlib.grading.results import build_results, failure_tasks, write_results
 from geomlib.grading.settings import GradingSettings, env
-from geomlib.taskref import find_task, task_at_start, tasks_label
+from geomlib.taskref import find_task, tasks_label
 
 __all__ = ["grade", "check", "Report", "report_lines"]
 
@@ -324,9 +324,6 @@ def _problem_lines(text: str, limit: int = 12) -> list[str]:
 
 
 #: geomlib.grading.diagnose.rows_task_note: the rows that differ are another task's than the case's
-_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to ")
-
-
 def report_lines(
     records: list,
     *,
@@ -375,13 +372,8 @@ def report_lines(
         if r.not_implemented:
             todo.setdefault((r.lab, msg), []).append(r)
             continue
-        t = tasks.get(r.nodeid, ())
         where = f"{r.lab} · " if several else ""
-        part = r.part
-        rows = _ROWS.search(msg)  # the differing rows are another task's (geomlib.grading.diagnose)
-        owner = task_at_start(msg[rows.end() :]) if rows else None
-        if owner and owner.title is not None:
-            t, part = (owner.number,), owner.title
+        t, part = failure_tasks(msg, tasks.get(r.nodeid, ()), r.part)
         line = f"✗ {where}{tasks_label(t)} · {part}: {msg}" if t else f"✗ {where}{part}: {msg}"
         if line in seen:
             continue

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from geomlib.grading.errors import SEE_PICTURE
 from geomlib.grading.sandbox import clean_text
-from geomlib.taskref import tasks_label
+from geomlib.taskref import task_at_start, tasks_label
 
 __all__ = ["RESULTS_SCHEMA", "build_results", "write_results", "validate_results", "markdown_text", "plain_text"]
 
@@ -172,6 +172,21 @@ def _without_paths(message: str, embedded: str | None) -> str:
     return SEE_PICTURE.sub(lambda m: " (picture below)" if embedded and m.group(1) == embedded else "", message)
 
 
+#: A diagnosis saying which task's rows differ (geomlib.grading.diagnose): "... belong to Task 1 (odd vertices)".
+_ROWS = re.compile(r"the rows that differ(?: at [^—]*?)? belong to ")
+
+
+def failure_tasks(message: str, tasks, part: str) -> tuple[tuple, str]:
+    """``(task numbers, part)`` a failed test's message is about: the test's own ``tasks`` and
+    ``part``, unless the diagnosis says the differing rows belong to another task (then that task
+    and its title). Used by the local report and by results.json alike."""
+    rows = _ROWS.search(message)
+    owner = task_at_start(message[rows.end() :]) if rows else None
+    if owner and owner.title is not None:
+        return (owner.number,), owner.title
+    return tuple(tasks), part
+
+
 def _test_output(r: Record, tasks=()) -> dict:
     """A test's ``output`` and ``output_format``: Markdown, or HTML with its feedback picture inlined.
     A failed test's message starts with the tasks it checks (``Task 4: ...``), as the local report's
@@ -180,7 +195,7 @@ def _test_output(r: Record, tasks=()) -> dict:
     img = embedded_picture(r.picture) if (r.picture and not r.passed) else None
     message = _without_paths(r.message, r.picture if img is not None else None)
     if tasks and not (r.passed or r.not_implemented or r.error or r.message.startswith("skipped")):
-        message = f"{tasks_label(tasks)}: {message}"
+        message = f"{tasks_label(failure_tasks(' '.join(r.message.split()), tasks, r.part)[0])}: {message}"
     if img is None:
         return {"output": markdown_text(message), "output_format": "md"}
     text = html.escape(clean_text(message, TEST_OUTPUT_CHARS)).replace("\n", "<br>")
