@@ -71,14 +71,55 @@ def attack(cache):
 '''
 
 
-@pytest.fixture
-def course(tmp_path) -> Path:
-    root = tmp_path / "course"
+def _new_course(base: Path) -> Path:
+    root = base / "course"
     (root / "labs" / "jitlab").mkdir(parents=True)
     (root / "solutions" / "jitlab").mkdir(parents=True)
     (root / "labs" / "jitlab" / "kernels.py").write_text(STUB)
     (root / "solutions" / "jitlab" / "kernels.py").write_text(SOLUTION)
+    # A module of the submission's in test_a_submission_is_neither_served_from_nor_written_into...:
+    # in the course's solution from the start, so that submission is the solution byte for byte.
+    (root / "solutions" / "jitlab" / "attack.py").write_text(ATTACK)
     return root
+
+
+@pytest.fixture(scope="module")
+def filled(tmp_path_factory) -> dict:
+    """The course, its shared cache filled by two grading processes of the solution started at once.
+
+    Each of the three scenarios below starts from a cache the solution has filled: one filling (two
+    processes, two compiles) serves them all, and each checks what it is about from there (a grading
+    process with a numba compile costs about 2.5 s of CPU; each scenario filled its own before).
+    ``course``; ``first``: the two processes' answers; ``entries``, ``tmp`` and ``files``: the cache
+    right after (its entry folders, its half-written files, :func:`cache_files`)."""
+    course = _new_course(tmp_path_factory.mktemp("kcache"))
+    env = {
+        **os.environ,
+        "GEOMLIB_ROOT": str(course),
+        "GEOMLIB_KERNEL_CACHE": str(course.parent / "cache"),
+        "GEOMLIB_SANDBOX_USER": "",
+    }
+    env.pop("NUMBA_CACHE_DIR", None)
+    solution = course / "solutions" / "jitlab"
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", GRADE, str(solution)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
+        )
+        for _ in range(2)
+    ]
+    first = []
+    for p in procs:
+        out, err = p.communicate(timeout=600)
+        assert p.returncode == 0, err.decode()[-3000:]
+        first.append(json.loads(out.decode().strip().splitlines()[-1]))
+    cache = course.parent / "cache"
+    return {
+        "course": course,
+        "first": first,
+        "entries": [p for p in cache.iterdir() if p.is_dir()],
+        "tmp": list(cache.rglob("*.tmp")),
+        "files": cache_files(course),
+    }
 
 
 def grade(course: Path, lab_dir: Path, *extra: str) -> dict:
@@ -106,28 +147,32 @@ def cache_files(course: Path) -> dict[str, tuple]:
     return out
 
 
-def test_a_changed_constant_gets_its_own_compile_and_result_and_the_old_code_its_own_kernels(course):
+def test_a_changed_constant_gets_its_own_compile_and_result_and_the_old_code_its_own_kernels(filled):
+    course = filled["course"]
     solution = course / "solutions" / "jitlab" / "kernels.py"
-    assert grade(course, solution.parent)["value"] == 4.0
+    assert [f["value"] for f in filled["first"]] == [4.0, 4.0]  # the first version, compiled and kept
     text = solution.read_text()
     st = solution.stat()
     solution.write_text(text.replace("2.0 * x", "3.0 * x"))  # same size, same bytecode (co_code)
     os.utime(solution, ns=(st.st_atime_ns, st.st_mtime_ns))
-    changed = grade(course, solution.parent)
+    try:
+        changed = grade(course, solution.parent)
+    finally:  # the other scenarios grade this solution
+        solution.write_text(text)
+        os.utime(solution, ns=(st.st_atime_ns, st.st_mtime_ns))
     assert changed["value"] == 5.5, f"the kernel compiled for 2.0 * x ran: {changed}"
     assert changed["misses"] == 1, changed
-    solution.write_text(text)
     back = grade(course, solution.parent)
     assert (back["value"], back["misses"], back["hits"]) == (4.0, 0, 1), f"the first version was not kept: {back}"
 
 
-def test_a_submission_is_neither_served_from_nor_written_into_the_shared_cache(course):
-    solution = course / "solutions" / "jitlab"
-    (solution / "attack.py").write_text(ATTACK)  # the submission below is this folder byte for byte
-    grade(course, solution)
+def test_a_submission_is_neither_served_from_nor_written_into_the_shared_cache(filled):
+    course = filled["course"]
+    solution = course / "solutions" / "jitlab"  # its kernels are in the shared cache (the fixture)
     kept = cache_files(course)
-    # The course's solution byte for byte, but not the course's folder: untrusted.
+    # The course's solution byte for byte (attack.py included), but not the course's folder: untrusted.
     sub = course.parent / "submission" / "jitlab"
+    shutil.rmtree(sub.parent, ignore_errors=True)
     shutil.copytree(solution, sub)
     cache = course.parent / "cache"
     out = grade(course, sub, str(cache))
@@ -140,35 +185,18 @@ def test_a_submission_is_neither_served_from_nor_written_into_the_shared_cache(c
     assert (again["value"], again["misses"], again["hits"]) == (4.0, 0, 1), again
 
 
-def test_two_processes_fill_the_cache_at_once_and_a_third_compiles_nothing(course):
+def test_two_processes_fill_the_cache_at_once_and_a_third_compiles_nothing(filled):
     """numba writes each file by ``os.replace`` but extends an index by load-modify-save, unlocked:
     the grader publishes under a lock, first index wins. A later process loads, compiles nothing and
-    writes nothing."""
-    solution = course / "solutions" / "jitlab"
-    env = {
-        **os.environ,
-        "GEOMLIB_ROOT": str(course),
-        "GEOMLIB_KERNEL_CACHE": str(course.parent / "cache"),
-        "GEOMLIB_SANDBOX_USER": "",
-    }
-    env.pop("NUMBA_CACHE_DIR", None)
-    procs = [
-        subprocess.Popen(
-            [sys.executable, "-c", GRADE, str(solution)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
-        )
-        for _ in range(2)
-    ]
-    for p in procs:
-        out, err = p.communicate(timeout=600)
-        assert p.returncode == 0, err.decode()[-3000:]
-        first = json.loads(out.decode().strip().splitlines()[-1])
+    writes nothing. The two processes at once are the fixture's."""
+    course = filled["course"]
+    for first in filled["first"]:
         assert (first["value"], first["misses"]) == (4.0, 1), first
-    entries = [p for p in (course.parent / "cache").iterdir() if p.is_dir()]
-    assert len(entries) == 1, f"one content, one entry: {entries}"
-    assert not list((course.parent / "cache").rglob("*.tmp")), "a half-written file was left"
+    assert len(filled["entries"]) == 1, f"one content, one entry: {filled['entries']}"
+    assert not filled["tmp"], "a half-written file was left"
+    assert any(p.endswith(".nbc") for p in filled["files"]), f"nothing compiled was kept: {sorted(filled['files'])}"
     kept = cache_files(course)
-    assert any(p.endswith(".nbc") for p in kept), f"nothing compiled was kept: {sorted(kept)}"
-    third = grade(course, solution)
+    third = grade(course, course / "solutions" / "jitlab")
     assert (third["value"], third["misses"], third["hits"]) == (4.0, 0, 1), f"a later process compiled again: {third}"
     assert cache_files(course) == kept, "a process that compiled nothing wrote into the cache"
 
