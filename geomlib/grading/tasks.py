@@ -219,6 +219,9 @@ def lab_calls(fn) -> list[str]:
     list of str
         The function names, in order of first use.
     """
+    key = _key(fn)
+    if key in _CALLS:  # every check() cell of a notebook collects the same tests again
+        return list(_CALLS[key])
     tree = _tree(fn)
     if tree is None:
         return []
@@ -231,7 +234,18 @@ def lab_calls(fn) -> list[str]:
                 for name in _direct_lab_calls(g):
                     if name not in out:
                         out.append(name)
+    _CALLS[key] = tuple(out)
     return out
+
+
+#: :func:`lab_calls` by function (the same key as :data:`_TREES`).
+_CALLS: dict = {}
+
+
+def _key(fn) -> tuple:
+    """A function's key in the caches below: module, name and code object (a reloaded test module
+    parses again)."""
+    return (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None), getattr(fn, "__code__", None))
 
 
 def _dedent(fn) -> str:
@@ -243,7 +257,7 @@ def _dedent(fn) -> str:
 def _tree(fn):
     """The syntax tree of ``fn``'s source, or None where it has no readable source (parsed once
     per function: a ``--task N`` run asks for every collected test's tasks)."""
-    key = (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None), getattr(fn, "__code__", None))
+    key = _key(fn)
     if key not in _TREES:
         try:
             _TREES[key] = ast.parse(_dedent(fn))
@@ -257,7 +271,7 @@ _TREES: dict = {}
 
 
 def _direct_lab_calls(fn, tree=None) -> list[str]:
-    key = (getattr(fn, "__module__", None), getattr(fn, "__qualname__", None), getattr(fn, "__code__", None))
+    key = _key(fn)
     if tree is None and key in _DIRECT:  # a helper asked for by every test that calls it
         return list(_DIRECT[key])
     tree = _tree(fn) if tree is None else tree
@@ -291,15 +305,20 @@ _DIRECT: dict = {}
 def named_functions(fn, tab: TaskTable) -> list[str]:
     """Lab functions a test names in a string (``check_glsl_case(lab, case, "glsl_parallax_uv")``):
     the string constants of ``fn``'s source that are functions of the task table ``tab``, in order."""
-    tree = _tree(fn)
-    if tree is None:
-        return []
-    out = []
-    for n in ast.walk(tree):
-        if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value not in out:
-            if n.value in tab.tasks or n.value in tab.composites:
-                out.append(n.value)
-    return out
+    key = _key(fn)
+    if key not in _STRINGS:
+        tree = _tree(fn)
+        found = (
+            []
+            if tree is None
+            else [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)]
+        )
+        _STRINGS[key] = tuple(dict.fromkeys(found))
+    return [s for s in _STRINGS[key] if s in tab.tasks or s in tab.composites]
+
+
+#: The string constants of a function's source, in order, once each (the same key as :data:`_TREES`).
+_STRINGS: dict = {}
 
 
 def test_functions(item, tab: TaskTable) -> list[str]:
