@@ -20,16 +20,19 @@ from .analytic import as_points
 __all__ = ["cone_directions", "sphere_occluder_visibility", "mesh_visibility"]
 
 
-def cone_directions(axis, alpha, n: int, seed: int = 0) -> np.ndarray:
+def cone_directions(axis, alpha, n: int, seed: int = 0, rows=None) -> np.ndarray:
     """``n`` unit directions per row, stratified uniformly in solid angle in the cone (``axis (k, 3)``, ``alpha (k,)``).
 
-    Returns ``(k, n, 3)``.
+    Returns ``(k, n, 3)``, or only the given ``rows`` (indices into the k rows) of it: the random
+    numbers are drawn for all k rows either way, so a row is the same as in the full result.
     """
     rng = np.random.default_rng(seed)
     s = int(np.ceil(np.sqrt(n)))
     i, j = np.divmod(np.arange(n), s)
     u1 = (i + rng.random((len(axis), n))) / s  # stratified in cos(theta) x phi
     u2 = (j + rng.random((len(axis), n))) / s
+    if rows is not None:
+        axis, alpha, u1, u2 = axis[rows], alpha[rows], u1[rows], u2[rows]
     ca = np.cos(alpha)[:, None]
     cos_t = 1 - u1 * (1 - ca)
     sin_t = np.sqrt(np.maximum(1 - cos_t**2, 0))
@@ -87,7 +90,6 @@ def mesh_visibility(V, F, P, light_center, light_radius, *, n: int = 256, seed: 
     V, F = check_mesh(V, F, where=where, allow_duplicate=True)
     P, L, D, alpha = _light_cone(P, light_center, light_radius, where)
     n = check_int(n, "n", minimum=1, where=where)
-    Dir = cone_directions(L, alpha, n, seed)  # every point's directions, so the random stream is the same
     # A point whose whole cone misses the mesh's bounding sphere (with a margin far above rounding) sees
     # the whole light: its rays would all miss, so they are not cast (most points, under a small occluder).
     c = 0.5 * (V.max(axis=0) + V.min(axis=0))
@@ -98,7 +100,7 @@ def mesh_visibility(V, F, P, light_center, light_radius, *, n: int = 256, seed: 
     misses = dc > r
     misses[misses] = np.arccos(cos_ac[misses]) > alpha[misses] + np.arcsin(r / dc[misses]) + 1e-6
     cast = np.flatnonzero(~misses)
-    Dir = Dir[cast].reshape(-1, 3)
+    Dir = cone_directions(L, alpha, n, seed, rows=cast).reshape(-1, 3)  # drawn for every point: the same stream
     O = np.repeat(P[cast], n, axis=0)
     tmax = np.repeat(D[cast] - float(light_radius), n)  # stop at the light's near side (no self-hits there)
     eps = 1e-6 * float(np.linalg.norm(V.max(0) - V.min(0))) if t_min is None else t_min
