@@ -528,6 +528,81 @@ def within(P, Y, reach):
 
 
 @njit(cache=True)
+def near_faces(X, U, V, G, r2):
+    """``(len(U),)`` bool: the input vertices ``X[U]`` that have a point of a face of ``G`` closer
+    than ``sqrt(r2)``, by Ericson's closest point on a triangle (*Real-Time Collision Detection*,
+    5.1.5). For :func:`..stages._cover`: such a vertex is covered whatever libigl's tree answers,
+    and is not measured (the caller leaves a margin for the rounding of both computations)."""
+    out = np.zeros(len(U), np.bool_)
+    m = len(G)
+    C = np.empty((m, 3))
+    R = np.empty(m)
+    for f in range(m):  # a bounding sphere per face: centroid and farthest corner
+        for c in range(3):
+            C[f, c] = (V[G[f, 0], c] + V[G[f, 1], c] + V[G[f, 2], c]) / 3.0
+        r = 0.0
+        for k in range(3):
+            e0, e1, e2 = V[G[f, k], 0] - C[f, 0], V[G[f, k], 1] - C[f, 1], V[G[f, k], 2] - C[f, 2]
+            r = max(r, np.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
+        R[f] = r
+    reach = np.sqrt(r2)
+    for i in range(len(U)):
+        p = X[U[i]]
+        for f in range(m):
+            g0, g1, g2 = p[0] - C[f, 0], p[1] - C[f, 1], p[2] - C[f, 2]
+            s = reach + R[f]
+            if g0 * g0 + g1 * g1 + g2 * g2 > s * s:
+                continue
+            a, b, c = V[G[f, 0]], V[G[f, 1]], V[G[f, 2]]
+            ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+            ac0, ac1, ac2 = c[0] - a[0], c[1] - a[1], c[2] - a[2]
+            ap0, ap1, ap2 = p[0] - a[0], p[1] - a[1], p[2] - a[2]
+            d1 = ab0 * ap0 + ab1 * ap1 + ab2 * ap2
+            d2 = ac0 * ap0 + ac1 * ap1 + ac2 * ap2
+            bp0, bp1, bp2 = p[0] - b[0], p[1] - b[1], p[2] - b[2]
+            d3 = ab0 * bp0 + ab1 * bp1 + ab2 * bp2
+            d4 = ac0 * bp0 + ac1 * bp1 + ac2 * bp2
+            cp0, cp1, cp2 = p[0] - c[0], p[1] - c[1], p[2] - c[2]
+            d5 = ab0 * cp0 + ab1 * cp1 + ab2 * cp2
+            d6 = ac0 * cp0 + ac1 * cp1 + ac2 * cp2
+            vc, vb, va = d1 * d4 - d3 * d2, d5 * d2 - d1 * d6, d3 * d6 - d5 * d4
+            if d1 <= 0.0 and d2 <= 0.0:
+                q0, q1, q2 = a[0], a[1], a[2]
+            elif d3 >= 0.0 and d4 <= d3:
+                q0, q1, q2 = b[0], b[1], b[2]
+            elif d6 >= 0.0 and d5 <= d6:
+                q0, q1, q2 = c[0], c[1], c[2]
+            elif vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+                if not d1 - d3 > 0.0:  # a degenerate face: no answer (not covered)
+                    continue
+                t = d1 / (d1 - d3)
+                q0, q1, q2 = a[0] + t * ab0, a[1] + t * ab1, a[2] + t * ab2
+            elif vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+                if not d2 - d6 > 0.0:  # a degenerate face: no answer (not covered)
+                    continue
+                t = d2 / (d2 - d6)
+                q0, q1, q2 = a[0] + t * ac0, a[1] + t * ac1, a[2] + t * ac2
+            elif va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+                if not (d4 - d3) + (d5 - d6) > 0.0:  # a degenerate face: no answer (not covered)
+                    continue
+                t = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+                q0, q1, q2 = b[0] + t * (c[0] - b[0]), b[1] + t * (c[1] - b[1]), b[2] + t * (c[2] - b[2])
+            else:
+                den = va + vb + vc
+                if not den > 0.0:
+                    continue
+                v, w = vb / den, vc / den
+                q0 = a[0] + ab0 * v + ac0 * w
+                q1 = a[1] + ab1 * v + ac1 * w
+                q2 = a[2] + ab2 * v + ac2 * w
+            z0, z1, z2 = p[0] - q0, p[1] - q1, p[2] - q2
+            if z0 * z0 + z1 * z1 + z2 * z2 < r2:
+                out[i] = True
+                break
+    return out
+
+
+@njit(cache=True)
 def cover_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, P, floor):
     """Move vertex ``cand[i]`` to ``P[i]`` (a point on the surface) when the smallest angle of the
     faces around it stays at least ``floor`` (radians) and none turns over; the rows of a vertex in

@@ -243,3 +243,20 @@ def test_a_wrong_valence_count_is_named_when_the_mesh_is_returned():
     S.val[9] -= 1
     with pytest.raises(MeshError, match=r"val\[7\] .*; 1 more vertex disagrees"):
         M.state_mesh(S)
+
+
+def test_near_faces_agrees_with_igl_distances():
+    """The clean-up's tips' pass skips libigl for the input vertices ``kernels.near_faces`` calls
+    covered: that must never claim a point nearer than libigl's distance, and must find every one
+    that libigl puts clearly within the bound (points on, near and off a mesh with sharp edges)."""
+    V, F = datasets.rock_on_plinth(16)
+    rng = np.random.default_rng(5)
+    scale = np.ptp(V, axis=0).max()
+    X = np.r_[V, V[rng.integers(0, len(V), 400)] + rng.normal(0.0, 0.05 * scale, (400, 3))]
+    X = np.r_[X, rng.uniform(V.min(axis=0) - 0.1 * scale, V.max(axis=0) + 0.1 * scale, (400, 3))]
+    d2 = np.asarray(igl.point_mesh_squared_distance(X, V, F)[0]).ravel()
+    U = np.arange(len(X))
+    for t in np.quantile(np.sqrt(d2), [0.1, 0.3, 0.5, 0.7, 0.9]):
+        near = K.near_faces(X, U, V, F.astype(np.int64), t * t)
+        assert not (near & (d2 >= t * t * (1 + 1e-9))).any()
+        assert near[d2 < t * t * (1 - 1e-9)].all()
