@@ -11,7 +11,9 @@ output (every returned array's dtype, shape and bytes), so two runs agree only w
 bit for bit; ``inputs`` holds the same for the run's inputs; ``kernels`` maps each lab to the functions of its numba module that ran (recorded
 only with ``NUMBA_DISABLE_JIT=1``, when the kernels are plain Python functions). With
 ``--case-inputs``, ``case_inputs`` holds :func:`case_inputs`: the inputs digest of every case of
-every lab, as ``geomlib refs check`` computes it.
+every lab, as ``geomlib refs check`` computes it. With the JIT on, ``jit`` holds the CPU name
+numba compiled for (the one its cache key names) and, per lab, how many of the kernel module's
+compiled versions numba's cache served (``hits``) and how many it compiled (``misses``).
 
 Run ids are the graded case ids of ``tests/graded/<lab>/cases*.py``; for simplification, whose
 graded cases only run the lab's Python loop, ``<case id>[greedy]`` and ``<case id>[fast]`` run a
@@ -158,6 +160,26 @@ def compute(wanted: list[str], record: bool = False) -> dict:
     }
 
 
+def jit_state(labs) -> dict:
+    """``{"cpu": name, "cache": {lab: {"hits": n, "misses": n}}}``: the CPU numba's code generator
+    compiles for in this process, as its cache key names it, and what numba's cache did for each
+    lab's kernels in this process (summed over the kernel module's functions)."""
+    from numba.core.dispatcher import Dispatcher
+    from numba.core.registry import cpu_target
+
+    cache = {}
+    for lab in labs:
+        if lab in KERNEL_MODULES:
+            kernels = [
+                d for d in vars(importlib.import_module(KERNEL_MODULES[lab])).values() if isinstance(d, Dispatcher)
+            ]
+            cache[lab] = {
+                "hits": sum(sum(d.stats.cache_hits.values()) for d in kernels),
+                "misses": sum(sum(d.stats.cache_misses.values()) for d in kernels),
+            }
+    return {"cpu": cpu_target.target_context.codegen().magic_tuple()[1], "cache": cache}
+
+
 def case_inputs() -> dict[str, str]:
     """``{lab/id: inputs digest}`` of every stored input and case of every lab: the digest
     ``geomlib refs check`` compares with the manifests (``inputs_digest`` of ``case.inputs()`` and
@@ -179,7 +201,10 @@ def main(argv: list[str]) -> None:
         sys.path.insert(0, str(ROOT))
     with_inputs = "--case-inputs" in argv
     argv = [a for a in argv if a != "--case-inputs"]
-    out = compute(argv, record=os.environ.get("NUMBA_DISABLE_JIT") == "1")
+    no_jit = os.environ.get("NUMBA_DISABLE_JIT") == "1"
+    out = compute(argv, record=no_jit)
+    if not no_jit:
+        out["jit"] = jit_state(sorted({a.split("/", 1)[0] for a in argv}))
     if with_inputs:
         out["case_inputs"] = case_inputs()
     print(json.dumps(out))
