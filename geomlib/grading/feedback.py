@@ -298,7 +298,8 @@ def heat_on_mesh_picture(ctx: Context, V, F, expected, got, err, caption: str, l
         b = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(vg, nan=hi), vmin=lo, vmax=hi, cmap="viridis"),
                   size=size, camera=cam)  # fmt: skip
         c = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(e, nan=vmax), vmin=0.0, vmax=vmax), size=size, camera=cam)
-        vbar = plot.colorbar(lo, hi, cmap="viridis", label="value", height=size[1])
+        rows = np.asarray(expected).size > len(V)  # rows of several numbers are coloured by their length
+        vbar = plot.colorbar(lo, hi, cmap="viridis", label="|row| (length)" if rows else "value", height=size[1])
         ebar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
         captions = ["expected", "yours", f"difference: {caption}"]
         img = plot.panels([a, _beside(b, vbar), _beside(c, ebar)], captions, title=ctx.label)

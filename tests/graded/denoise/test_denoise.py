@@ -398,7 +398,8 @@ def test_map_route_matches_direct_route(lab):
     if not gap <= 0.7 * 0.05 * float(scale):
         raise Mismatch(
             f"{label}: the map route differs from denoise_vertices by up to {gap:.3g} (scale {float(scale):.3g}); check "
-            "that the bake and the lookup use the same texel convention (row 0 = v near 1, texel centres at (col + 1/2) / size)",
+            "that the lookup undoes the bake (s = bias + scale h, with the bias and scale bake_offset_map returned) and that "
+            "both use the same texel convention (row 0 = v near 1, texel centres at (col + 1/2) / size)",
             failure_picture(
                 label, Xm, Xd, name="map route - direct route", mesh=(Vn, F), atol=0.7 * 0.05 * float(scale)
             ),
