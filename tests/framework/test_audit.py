@@ -8,6 +8,7 @@ is killed: the audit measures the tests' power, not the solution's.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -35,6 +36,14 @@ def _changed_span(original: str, mutant: str) -> tuple[int, int]:
     return head + 1, tail
 
 
+@functools.cache
+def _generated(lab: str) -> tuple:
+    """``audit.generate(lab)`` of the course's solution (GLSL compiling: test_audit_glsl.py), made once
+    for the tests below that read it (shadows': 1 s of CPU)."""
+    mutants, notes = audit.generate(lab, check_glsl=False)
+    return tuple(mutants), notes
+
+
 @pytest.mark.parametrize("lab", LABS)
 def test_every_mutant_changes_one_block_only_and_compiles(lab):
     """Mutants differ from the solution only inside their own solution block (between its BEGIN and
@@ -46,7 +55,7 @@ def test_every_mutant_changes_one_block_only_and_compiles(lab):
     whole file per mutant, 1.9 s of CPU for remeshing's 1,226 mutants, and let a mutant edit
     another block too."""
     root = _impl.course_root() / "solutions" / lab
-    mutants, notes = audit.generate(lab, check_glsl=False)  # GLSL compiling: test_audit_glsl.py
+    mutants, notes = _generated(lab)
     assert mutants, f"{lab}: no mutants"
     assert len({m.id for m in mutants}) == len(mutants), f"{lab}: duplicate mutant ids"
     blocks, _ = audit._blocks(root)
@@ -351,8 +360,7 @@ def test_does_nothing_restores_the_objects_the_block_changes(tmp_path):
 
 def test_task_and_file_filters_keep_exactly_their_mutants():
     """``geomlib audit --task 11 --file shaders/`` grades the cube light pass's shader mutants only."""
-    root = _impl.course_root() / "solutions"
-    muts, _ = audit.generate("shadows", root / "shadows", check_glsl=False)
+    muts, _ = _generated("shadows")
     kept = audit.select_mutants(muts, tasks=[11], files=["shaders/"])
     assert kept and {m.task for m in kept} == {11}, {m.task for m in kept}
     assert {m.file for m in kept} == {"shaders/cube_depth.vert", "shaders/cube_depth.frag"}, {m.file for m in kept}

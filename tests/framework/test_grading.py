@@ -305,16 +305,23 @@ def test_a_broken_sandbox_is_reported_as_the_graders_problem(sample_course, tmp_
     assert all("'no-such-user-here'" in t["output"] and "JSONDecodeError" not in t["output"] for t in pointed)
 
 
-def test_student_code_cannot_open_hidden_cases_or_the_courses_tests(sample_course, tmp_path):
-    """Under Landlock (or as the sandbox user) the worker gets nothing from tests/; leaks would show in messages."""
+def test_student_code_cannot_open_hidden_cases_and_deleting_the_given_validation_gains_nothing(sample_course):
+    """One submission, two attacks on scale_about_centroid that leave the grade whole (one grade: its
+    start costs 2 s of CPU): it deletes the stub's given validation at the top of the task, and the
+    course's still runs (NaN input is rejected with the course's message); and, under Landlock or as
+    the sandbox user, it reads nothing of tests/ (hidden cases, references): a leak would raise, and
+    show in the messages and the score."""
     from geomlib.grading import landlock
 
-    if not landlock.abi_version() and sandbox_user_problem("nobody"):
-        pytest.skip("neither Landlock nor a usable sandbox user here")
-    hidden = sample_course / "tests" / "graded" / "sample" / "cases_hidden.py"
     src = GOOD_OPS.replace(
-        "    c = V.mean(axis=0)\n",
-        f"""    leaked = []
+        '    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n"
+    )
+    sandboxed = bool(landlock.abi_version()) or not sandbox_user_problem("nobody")
+    if sandboxed:  # else nothing keeps tests/ from the worker: the leak check cannot run here
+        hidden = sample_course / "tests" / "graded" / "sample" / "cases_hidden.py"
+        src = src.replace(
+            "    c = V.mean(axis=0)\n",
+            f"""    leaked = []
     for p in ({str(hidden)!r}, {str(sample_course / "tests" / "reference")!r}):
         try:
             leaked.append(open(p).read()[:50] if p.endswith(".py") else str(__import__("os").listdir(p)))
@@ -324,18 +331,11 @@ def test_student_code_cannot_open_hidden_cases_or_the_courses_tests(sample_cours
         raise RuntimeError("LEAK " + repr(leaked))
     c = V.mean(axis=0)
 """,
-    )
-    r = grade(sample_course, str(_submission(tmp_path, src)))
+        )
+        assert "LEAK" in src
+    assert "check_mesh" not in src.split("def scale_about_centroid")[1].split("def ")[0]
+    r = grade(sample_course, str(_submission(None, src)))
     assert "LEAK" not in json.dumps(r)
-    assert r["score"] == 7
-
-
-def test_deleting_the_given_validation_gains_nothing(sample_course, tmp_path):
-    """The stub's validation at the top of a task still runs: NaN input is rejected with the course's message."""
-    src = GOOD_OPS.replace(
-        '    V, F = check_mesh(V, F, where="scale_about_centroid")\n', "    V = __import__('numpy').asarray(V, float)\n"
-    )
-    r = grade(sample_course, str(_submission(tmp_path, src)))
     assert (
         _by_name(r)["sample › bad input › NaN coordinates are rejected with a message naming the row"]["status"]
         == "passed"

@@ -71,10 +71,27 @@ def gl(root, first):
     return [getattr(proxy, first)()[0], proxy.loaded()[0]]
 
 
+def per_call(root):
+    # scipy.ndimage imported by the stubs' truth.py only: preloaded for the calls into truth.py only.
+    stubs, lab = root / "stubs" / "calllab", root / "calllab"
+    stubs.mkdir(parents=True)
+    lab.mkdir()
+    (stubs / "truth.py").write_text(
+        "from scipy import ndimage\\n\\n\\ndef checked():\\n    raise NotImplementedError('Task 2')\\n"
+    )
+    (stubs / "ops.py").write_text("def plain():\\n    raise NotImplementedError('Task 1')\\n")
+    body = "import sys\\n\\n\\ndef {}():\\n    return ['scipy.ndimage' in sys.modules]\\n"  # before the stub's own imports
+    (lab / "truth.py").write_text(body.format("checked"))
+    (lab / "ops.py").write_text(body.format("plain"))
+    os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
+    proxy = LabProxy("calllab", lab, timeout=120)
+    return [proxy.plain()[0], proxy.checked()[0]]
+
+
 out, zygotes = {}, set()
 for name, (kind, *args) in json.loads(sys.argv[2]).items():
     os.environ.pop("GEOMLIB_STUBS", None)
-    play = {"preload": preload, "in-place": graded_in_place, "gl": gl}[kind]
+    play = {"preload": preload, "in-place": graded_in_place, "gl": gl, "per-call": per_call}[kind]
     out[name] = play(Path(sys.argv[1]) / name, *args)
     zygotes.add(sandbox._STATE["zygote"].proc.pid)
     sandbox.shutdown()  # the next scenario starts a zygote of its own
@@ -83,7 +100,8 @@ print(json.dumps(out))
 """
 
 #: Scenario name -> ("preload", the stub's import ("" none, "none": no known stubs), modules checked),
-#: ("in-place", the same, the stubs graded themselves) or ("gl", the function called first). A lab
+#: ("in-place", the same, the stubs graded themselves), ("gl", the function called first) or
+#: ("per-call",): a plain call, then a call into the stub module that imports scipy.ndimage. A lab
 #: whose stubs import none of them checks them all at once.
 SCENARIOS = {
     "plain": ("preload", "", ["numba", "scipy.spatial", "scipy.ndimage"]),
@@ -97,6 +115,7 @@ SCENARIOS = {
     "gl-loaded": ("gl", "loaded"),
     "gl-gl_loaded": ("gl", "gl_loaded"),
     "gl-via": ("gl", "via"),
+    "per-call": ("per-call",),
 }
 
 
@@ -177,31 +196,7 @@ def test_whether_a_call_may_use_opengl_is_worked_out_once(tmp_path, monkeypatch)
     assert not walked, "the stubs were walked again"
 
 
-PER_CALL_SCRIPT = """
-import os, sys
-from pathlib import Path
-from geomlib.grading.sandbox import LabProxy
-
-root = Path(sys.argv[1])
-stubs, lab = root / "stubs" / "calllab", root / "calllab"
-stubs.mkdir(parents=True)
-lab.mkdir()
-(stubs / "truth.py").write_text("from scipy import ndimage\\n\\n\\ndef checked():\\n    raise NotImplementedError('Task 2')\\n")
-(stubs / "ops.py").write_text("def plain():\\n    raise NotImplementedError('Task 1')\\n")
-body = "import sys\\n\\n\\ndef {}():\\n    return ['scipy.ndimage' in sys.modules]\\n"  # before the stub's own imports
-(lab / "truth.py").write_text(body.format("checked"))
-(lab / "ops.py").write_text(body.format("plain"))
-os.environ["GEOMLIB_STUBS"] = str(root / "stubs")
-proxy = LabProxy("calllab", lab, timeout=120)
-print(proxy.plain()[0], proxy.checked()[0])
-"""
-
-
-def test_a_module_is_preloaded_for_the_calls_whose_stub_module_imports_it(tmp_path):
+def test_a_module_is_preloaded_for_the_calls_whose_stub_module_imports_it(scenarios):
     """Shadows' stubs import scipy.ndimage (0.25 s of CPU) in truth.py only, whose helper no graded call
     runs: a call into another module starts without it, a call into truth.py still inherits it."""
-    p = subprocess.run(
-        [sys.executable, "-c", PER_CALL_SCRIPT, str(tmp_path)], capture_output=True, text=True, timeout=300
-    )
-    assert p.returncode == 0, p.stderr[-2000:]
-    assert p.stdout.split()[-2:] == ["False", "True"]
+    assert scenarios["per-call"] == [False, True]

@@ -135,7 +135,9 @@ def loop_weight(n, weights="warren"):
     raise type("E" * 5_000_000, (Exception,), {})("x" * 5_000_000)
 """
 
-#: loop_odd_matrix returns an empty sparse matrix of shape (3e8, n) to the grader; called by the
+#: loop_odd_matrix returns an empty sparse matrix of shape (4e7, n) to the grader (rows x cols 3.6 to
+#: 1,600 times tolerances.SPARSE_MAX_DENSE for this lab's cases, n from 3 to 1340; 3e8 rows cost the
+#: worker 2.4 GB and about 1 s of CPU a call to build and send, for the same refusal); called by the
 #: lab's own loop_subdivide it answers correctly (building on the forged matrix there only costs
 #: the worker seconds of work, which is not what this attack is about).
 SPARSE_BOMB = """
@@ -149,7 +151,7 @@ def loop_odd_matrix(V, F, *, topo=None):
 
     if sys._getframe(1).f_globals.get("__name__") == __name__:
         return _loop_odd_matrix_real(V, F, topo=topo)
-    return sp.csr_matrix((300_000_000, len(V)))
+    return sp.csr_matrix((40_000_000, len(V)))
 """
 
 #: Every task sleeps for an hour.
