@@ -304,11 +304,17 @@ PYTHON_CANDIDATES = tuple(
 
 
 def _uv() -> list[str]:
-    """How to run uv: ``$UV`` (set by ``uv run``), ``uv`` on the PATH, else ``python3 -m uv``."""
+    """How to run uv: ``$UV`` (set by ``uv run``), ``uv`` on the PATH, the private copy ``./run``
+    installed (:func:`.bootstrap.private_uv`: ``.venv/bin/geomlib`` typed in a shell whose PATH lacks
+    ``~/.local/bin``), else ``python3 -m uv``."""
+    from geomlib.grading import bootstrap
+
     if os.environ.get("UV") and os.access(os.environ["UV"], os.X_OK):
         return [os.environ["UV"]]
     if shutil.which("uv"):
         return [shutil.which("uv")]
+    if os.access(bootstrap.private_uv(), os.X_OK):
+        return [bootstrap.private_uv()]
     return [shutil.which("python3") or "python3", "-m", "uv"]
 
 
