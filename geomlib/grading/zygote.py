@@ -57,7 +57,6 @@ _PR_SET_CHILD_SUBREAPER = 36
 PRELOAD = (
     "numpy",
     "scipy.sparse",
-    "scipy.sparse.linalg",
     "igl",
     "geomlib.validate",
     "geomlib.topology",
@@ -80,6 +79,10 @@ PRELOAD_IF_USED = {
     # 0.08 and 0.05 s of CPU; geomlib.textures looks points up in a k-d tree (maps).
     "scipy.spatial": ("scipy.spatial", "geomlib.textures"),
     "scipy.ndimage": ("scipy.ndimage",),
+    # vdm's parameterisation and transport (splu; simplification's optional refit imports it inside
+    # its function, so at its call): 0.1 s of CPU at every start of a zygote for the other labs, and
+    # for the ~90 zygotes of one run of the test suite (mostly the sample course's).
+    "scipy.sparse.linalg": ("scipy.sparse.linalg",),
 }
 
 #: Processes (threads) a worker may add to what its user already runs.

@@ -104,14 +104,15 @@ print(json.dumps(out))
 #: ("per-call",): a plain call, then a call into the stub module that imports scipy.ndimage. A lab
 #: whose stubs import none of them checks them all at once.
 SCENARIOS = {
-    "plain": ("preload", "", ["numba", "scipy.spatial", "scipy.ndimage"]),
+    "plain": ("preload", "", ["numba", "scipy.spatial", "scipy.ndimage", "scipy.sparse.linalg"]),
     "njit": ("preload", "from numba import njit", ["numba"]),
     "jit": ("preload", "from geomlib.jit import use_cache_folder", ["numba"]),
     "no-stubs": ("preload", "none", ["numba"]),
-    "in-place": ("in-place", "", ["numba", "scipy.spatial", "scipy.ndimage"]),
+    "in-place": ("in-place", "", ["numba", "scipy.spatial", "scipy.ndimage", "scipy.sparse.linalg"]),
     "in-place-njit": ("in-place", "from numba import njit", ["numba"]),
     "scipy.spatial": ("preload", "import scipy.spatial", ["scipy.spatial"]),
     "scipy.ndimage": ("preload", "import scipy.ndimage", ["scipy.ndimage"]),
+    "scipy.sparse.linalg": ("preload", "import scipy.sparse.linalg as spla", ["scipy.sparse.linalg"]),
     "gl-loaded": ("gl", "loaded"),
     "gl-gl_loaded": ("gl", "gl_loaded"),
     "gl-via": ("gl", "via"),
@@ -151,14 +152,14 @@ def test_stubs_graded_in_place_preload_what_their_own_files_import(scenarios):
     """``geomlib grade --impl labs`` and a student's grade of their labs/<lab>: the graded folder is
     the course's stubs, so no other stubs say what the lab uses; its own imports do (numba's import
     and warm-up cost 1.5 s of CPU at every start of the grader, for a lab without it too)."""
-    assert scenarios["in-place"] == [False, False, False], "the zygote preloaded for a lab that imports none"
+    assert scenarios["in-place"] == [False, False, False, False], "the zygote preloaded for a lab that imports none"
     assert scenarios["in-place-njit"] == [True], "a numba lab graded in place: its worker imported numba itself"
 
 
-@pytest.mark.parametrize("module", ["scipy.spatial", "scipy.ndimage"])
-def test_scipy_spatial_and_ndimage_are_preloaded_for_the_labs_that_use_them(scenarios, module):
-    """Like numba: 0.08 and 0.05 s of CPU at every start of the zygote, for subdivision too, whose
-    stubs use neither; a lab whose stubs import them (vdm, sdf, shadows' truth) still has them in
+@pytest.mark.parametrize("module", ["scipy.spatial", "scipy.ndimage", "scipy.sparse.linalg"])
+def test_scipy_modules_are_preloaded_for_the_labs_that_use_them(scenarios, module):
+    """Like numba: 0.08, 0.05 and 0.1 s of CPU at every start of the zygote, for subdivision too, whose
+    stubs use none; a lab whose stubs import them (vdm, sdf, shadows' truth) still has them in
     every worker."""
     plain = dict(zip(SCENARIOS["plain"][2], scenarios["plain"], strict=True))
     assert not plain[module], f"the zygote imported {module} for a lab without it"
