@@ -313,8 +313,9 @@ def _uv() -> list[str]:
         return [os.environ["UV"]]
     if shutil.which("uv"):
         return [shutil.which("uv")]
-    if os.access(bootstrap.private_uv(), os.X_OK):
-        return [bootstrap.private_uv()]
+    private = bootstrap.private_uv()
+    if os.access(private, os.X_OK):
+        return [private]
     return [shutil.which("python3") or "python3", "-m", "uv"]
 
 

@@ -280,11 +280,11 @@ def heat_on_mesh_picture(ctx: Context, V, F, expected, got, err, caption: str, l
     def draw():
         from geomlib import plot
 
-        def size_of(x):
-            x = np.asarray(x, float).reshape(len(V), -1)
+        def size_of(x):  # rows of several numbers are coloured by their length
             return np.linalg.norm(x, axis=1) if x.shape[1] > 1 else x[:, 0]
 
-        ve, vg = size_of(expected), size_of(got)
+        E, G = (np.asarray(x, float).reshape(len(V), -1) for x in (expected, got))
+        ve, vg = size_of(E), size_of(G)
         fin = np.concatenate([ve[np.isfinite(ve)], vg[np.isfinite(vg)]])
         lo, hi = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
         hi = hi if hi > lo else lo + 1e-12
@@ -298,8 +298,9 @@ def heat_on_mesh_picture(ctx: Context, V, F, expected, got, err, caption: str, l
         b = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(vg, nan=hi), vmin=lo, vmax=hi, cmap="viridis"),
                   size=size, camera=cam)  # fmt: skip
         c = _draw(V, F, colors=plot.heat_colors(np.nan_to_num(e, nan=vmax), vmin=0.0, vmax=vmax), size=size, camera=cam)
-        rows = np.asarray(expected).size > len(V)  # rows of several numbers are coloured by their length
-        vbar = plot.colorbar(lo, hi, cmap="viridis", label="|row| (length)" if rows else "value", height=size[1])
+        vbar = plot.colorbar(
+            lo, hi, cmap="viridis", label="|row| (length)" if E.shape[1] > 1 else "value", height=size[1]
+        )
         ebar = plot.colorbar(0.0, vmax, cmap="inferno", label=label, height=size[1])
         captions = ["expected", "yours", f"difference: {caption}"]
         img = plot.panels([a, _beside(b, vbar), _beside(c, ebar)], captions, title=ctx.label)
