@@ -528,95 +528,286 @@ def within(P, Y, reach):
 
 
 @njit(cache=True)
-def near_faces(X, U, V, G, r2):
-    """``(len(U),)`` bool: the input vertices ``X[U]`` that have a point of a face of ``G`` closer
-    than ``sqrt(r2)``, by Ericson's closest point on a triangle (*Real-Time Collision Detection*,
-    5.1.5). For :func:`..stages._cover`: such a vertex is covered whatever libigl's tree answers,
-    and is not measured (the caller leaves a margin for the rounding of both computations)."""
-    out = np.zeros(len(U), np.bool_)
-    m = len(G)
-    C = np.empty((m, 3))
-    R = np.empty(m)
-    for f in range(m):  # a bounding sphere per face: centroid and farthest corner
-        for c in range(3):
-            C[f, c] = (V[G[f, 0], c] + V[G[f, 1], c] + V[G[f, 2], c]) / 3.0
-        r = 0.0
-        for k in range(3):
-            e0, e1, e2 = V[G[f, k], 0] - C[f, 0], V[G[f, k], 1] - C[f, 1], V[G[f, k], 2] - C[f, 2]
-            r = max(r, np.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
-        R[f] = r
-    reach = np.sqrt(r2)
-    for i in range(len(U)):
-        p = X[U[i]]
-        for f in range(m):
-            g0, g1, g2 = p[0] - C[f, 0], p[1] - C[f, 1], p[2] - C[f, 2]
-            s = reach + R[f]
-            if g0 * g0 + g1 * g1 + g2 * g2 > s * s:
-                continue
-            a, b, c = V[G[f, 0]], V[G[f, 1]], V[G[f, 2]]
-            ab0, ab1, ab2 = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-            ac0, ac1, ac2 = c[0] - a[0], c[1] - a[1], c[2] - a[2]
-            ap0, ap1, ap2 = p[0] - a[0], p[1] - a[1], p[2] - a[2]
-            d1 = ab0 * ap0 + ab1 * ap1 + ab2 * ap2
-            d2 = ac0 * ap0 + ac1 * ap1 + ac2 * ap2
-            bp0, bp1, bp2 = p[0] - b[0], p[1] - b[1], p[2] - b[2]
-            d3 = ab0 * bp0 + ab1 * bp1 + ab2 * bp2
-            d4 = ac0 * bp0 + ac1 * bp1 + ac2 * bp2
-            cp0, cp1, cp2 = p[0] - c[0], p[1] - c[1], p[2] - c[2]
-            d5 = ab0 * cp0 + ab1 * cp1 + ab2 * cp2
-            d6 = ac0 * cp0 + ac1 * cp1 + ac2 * cp2
-            vc, vb, va = d1 * d4 - d3 * d2, d5 * d2 - d1 * d6, d3 * d6 - d5 * d4
-            if d1 <= 0.0 and d2 <= 0.0:
-                q0, q1, q2 = a[0], a[1], a[2]
-            elif d3 >= 0.0 and d4 <= d3:
-                q0, q1, q2 = b[0], b[1], b[2]
-            elif d6 >= 0.0 and d5 <= d6:
-                q0, q1, q2 = c[0], c[1], c[2]
-            elif vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-                if not d1 - d3 > 0.0:  # a degenerate face: no answer (not covered)
-                    continue
-                t = d1 / (d1 - d3)
-                q0, q1, q2 = a[0] + t * ab0, a[1] + t * ab1, a[2] + t * ab2
-            elif vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-                if not d2 - d6 > 0.0:  # a degenerate face: no answer (not covered)
-                    continue
-                t = d2 / (d2 - d6)
-                q0, q1, q2 = a[0] + t * ac0, a[1] + t * ac1, a[2] + t * ac2
-            elif va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-                if not (d4 - d3) + (d5 - d6) > 0.0:  # a degenerate face: no answer (not covered)
-                    continue
-                t = (d4 - d3) / ((d4 - d3) + (d5 - d6))
-                q0, q1, q2 = b[0] + t * (c[0] - b[0]), b[1] + t * (c[1] - b[1]), b[2] + t * (c[2] - b[2])
-            else:
-                den = va + vb + vc
-                if not den > 0.0:
-                    continue
-                v, w = vb / den, vc / den
-                q0 = a[0] + ab0 * v + ac0 * w
-                q1 = a[1] + ab1 * v + ac1 * w
-                q2 = a[2] + ab2 * v + ac2 * w
-            z0, z1, z2 = p[0] - q0, p[1] - q1, p[2] - q2
-            if z0 * z0 + z1 * z1 + z2 * z2 < r2:
-                out[i] = True
-                break
-    return out
+def closest_on_triangle(V, i, j, k, p0, p1, p2):
+    """``(q0, q1, q2, ok)``: the closest point to ``p`` on the triangle ``V[i] V[j] V[k]``, by
+    Ericson's Voronoi regions (*Real-Time Collision Detection*, 5.1.5); ``ok`` is False for a
+    degenerate triangle where a region's denominator vanishes (no answer)."""
+    a0, a1, a2 = V[i, 0], V[i, 1], V[i, 2]  # scalars, not row views: no reference counting per call
+    b0, b1, b2 = V[j, 0], V[j, 1], V[j, 2]
+    c0, c1, c2 = V[k, 0], V[k, 1], V[k, 2]
+    ab0, ab1, ab2 = b0 - a0, b1 - a1, b2 - a2
+    ac0, ac1, ac2 = c0 - a0, c1 - a1, c2 - a2
+    ap0, ap1, ap2 = p0 - a0, p1 - a1, p2 - a2
+    d1 = ab0 * ap0 + ab1 * ap1 + ab2 * ap2
+    d2 = ac0 * ap0 + ac1 * ap1 + ac2 * ap2
+    bp0, bp1, bp2 = p0 - b0, p1 - b1, p2 - b2
+    d3 = ab0 * bp0 + ab1 * bp1 + ab2 * bp2
+    d4 = ac0 * bp0 + ac1 * bp1 + ac2 * bp2
+    cp0, cp1, cp2 = p0 - c0, p1 - c1, p2 - c2
+    d5 = ab0 * cp0 + ab1 * cp1 + ab2 * cp2
+    d6 = ac0 * cp0 + ac1 * cp1 + ac2 * cp2
+    vc, vb, va = d1 * d4 - d3 * d2, d5 * d2 - d1 * d6, d3 * d6 - d5 * d4
+    if d1 <= 0.0 and d2 <= 0.0:
+        return a0, a1, a2, True
+    if d3 >= 0.0 and d4 <= d3:
+        return b0, b1, b2, True
+    if d6 >= 0.0 and d5 <= d6:
+        return c0, c1, c2, True
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        if not d1 - d3 > 0.0:
+            return 0.0, 0.0, 0.0, False
+        t = d1 / (d1 - d3)
+        return a0 + t * ab0, a1 + t * ab1, a2 + t * ab2, True
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        if not d2 - d6 > 0.0:
+            return 0.0, 0.0, 0.0, False
+        t = d2 / (d2 - d6)
+        return a0 + t * ac0, a1 + t * ac1, a2 + t * ac2, True
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        if not (d4 - d3) + (d5 - d6) > 0.0:
+            return 0.0, 0.0, 0.0, False
+        t = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+        return b0 + t * (c0 - b0), b1 + t * (c1 - b1), b2 + t * (c2 - b2), True
+    den = va + vb + vc
+    if not den > 0.0:
+        return 0.0, 0.0, 0.0, False
+    v, w = vb / den, vc / den
+    return a0 + ab0 * v + ac0 * w, a1 + ab1 * v + ac1 * w, a2 + ab2 * v + ac2 * w, True
 
 
 @njit(cache=True)
-def cover_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, P, floor):
-    """Move vertex ``cand[i]`` to ``P[i]`` (a point on the surface) when the smallest angle of the
-    faces around it stays at least ``floor`` (radians) and none turns over; the rows of a vertex in
-    order of preference, the first allowed one wins, each test on the positions so far. Returns the
-    number of moves (:func:`.stages._cover`)."""
+def closest_on_face(V, i, j, k, p0, p1, p2):
+    """``(q0, q1, q2, d2)``: the closest point to ``p`` on the face ``V[i] V[j] V[k]`` and its squared
+    distance; a degenerate face (no answer from :func:`closest_on_triangle`) is its three sides."""
+    q0, q1, q2, ok = closest_on_triangle(V, i, j, k, p0, p1, p2)
+    if ok:
+        z0, z1, z2 = p0 - q0, p1 - q1, p2 - q2
+        return q0, q1, q2, z0 * z0 + z1 * z1 + z2 * z2
+    best = np.inf
+    for s in range(3):  # each side a -> a + t (b - a), t in [0, 1] (the first corner if it has no length)
+        a, b = (i, j) if s == 0 else ((j, k) if s == 1 else (k, i))
+        a0, a1, a2 = V[a, 0], V[a, 1], V[a, 2]
+        ab0, ab1, ab2 = V[b, 0] - a0, V[b, 1] - a1, V[b, 2] - a2
+        L2 = ab0 * ab0 + ab1 * ab1 + ab2 * ab2
+        t = 0.0
+        if L2 > 0.0:
+            t = min(max(((p0 - a0) * ab0 + (p1 - a1) * ab1 + (p2 - a2) * ab2) / L2, 0.0), 1.0)
+        x0, x1, x2 = a0 + t * ab0, a1 + t * ab1, a2 + t * ab2
+        z0, z1, z2 = p0 - x0, p1 - x1, p2 - x2
+        d = z0 * z0 + z1 * z1 + z2 * z2
+        if d < best:
+            q0, q1, q2, best = x0, x1, x2, d
+    return q0, q1, q2, best
+
+
+#: The most cells of a :func:`face_grid`, per face (a coarser grid above it).
+GRID_CELLS_PER_FACE = 4
+
+
+@njit(cache=True)
+def face_grid(V, F, cell):
+    """A uniform grid of the faces ``F`` of ``V`` for :func:`grid_closest` (given).
+
+    Cubic cells of side ``cell`` (``cell <= 0``: the faces' mean side; made larger until there are
+    at most :data:`GRID_CELLS_PER_FACE` cells per face, plus 64) from the lowest corner ``lo`` of
+    the faces' bounding box, ``dims`` of them along each axis; every face is listed in each cell its
+    bounding box overlaps, in index order: cell ``c = (ix * dims[1] + iy) * dims[2] + iz`` lists
+    ``items[start[c]:start[c + 1]]``. ``box (m, 6)`` holds the faces' bounding boxes (low corner,
+    high corner). Returns ``(lo, cell, dims, start, items, box)``.
+    """
+    m = len(F)
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    box = np.empty((m, 6))
+    sides = 0.0
+    for f in range(m):
+        for c in range(3):
+            x0, x1, x2 = V[F[f, 0], c], V[F[f, 1], c], V[F[f, 2], c]
+            box[f, c] = min(x0, min(x1, x2))
+            box[f, 3 + c] = max(x0, max(x1, x2))
+            lo[c] = min(lo[c], box[f, c])
+            hi[c] = max(hi[c], box[f, 3 + c])
+        for k in range(3):
+            sides += distance(V, F[f, k], F[f, (k + 1) % 3])
+    if not cell > 0.0:
+        cell = sides / (3 * m) if m else 1.0
+    if not cell > 0.0:  # every face a point
+        cell = 1.0
+    dims = np.ones(3, np.int64)
+    if m == 0:
+        return lo, cell, dims, np.zeros(2, np.int64), np.zeros(0, np.int64), box
+    cap = GRID_CELLS_PER_FACE * m + 64
+    while True:
+        total = 1
+        for c in range(3):
+            dims[c] = int((hi[c] - lo[c]) / cell) + 1
+            total *= dims[c]
+        if total <= cap:
+            break
+        cell *= 1.25
+    count = np.zeros(total + 1, np.int64)
+    rng = np.empty((m, 6), np.int64)
+    for f in range(m):
+        for c in range(3):
+            rng[f, c] = min(int((box[f, c] - lo[c]) / cell), dims[c] - 1)
+            rng[f, 3 + c] = min(int((box[f, 3 + c] - lo[c]) / cell), dims[c] - 1)
+        for ix in range(rng[f, 0], rng[f, 3] + 1):
+            for iy in range(rng[f, 1], rng[f, 4] + 1):
+                for iz in range(rng[f, 2], rng[f, 5] + 1):
+                    count[(ix * dims[1] + iy) * dims[2] + iz + 1] += 1
+    start = np.cumsum(count)
+    fill = start[:-1].copy()
+    items = np.empty(start[-1], np.int64)
+    for f in range(m):
+        for ix in range(rng[f, 0], rng[f, 3] + 1):
+            for iy in range(rng[f, 1], rng[f, 4] + 1):
+                for iz in range(rng[f, 2], rng[f, 5] + 1):
+                    c = (ix * dims[1] + iy) * dims[2] + iz
+                    items[fill[c]] = f
+                    fill[c] += 1
+    return lo, cell, dims, start, items, box
+
+
+@njit(cache=True)
+def _gap(x, a, b):
+    """Distance from ``x`` to the interval ``[a, b]``."""
+    return a - x if x < a else (x - b if x > b else 0.0)
+
+
+@njit(cache=True)
+def _grid_point(V, F, lo, cell, dims, start, items, box, seen, q, p0, p1, p2, e, enough, hint):
+    """One point of :func:`grid_closest`: ``(d2, face, q0, q1, q2)``; ``seen[f] == q`` marks the faces
+    already measured for it. The face ``hint`` (-1: none) is measured first: when it is close, its
+    distance skips most boxes at once."""
+    nx, ny, nz = dims[0], dims[1], dims[2]
+    cx = int(min(max(np.floor((p0 - lo[0]) / cell), 0.0), nx - 1.0))  # clamped before int(): no overflow
+    cy = int(min(max(np.floor((p1 - lo[1]) / cell), 0.0), ny - 1.0))
+    cz = int(min(max(np.floor((p2 - lo[2]) / cell), 0.0), nz - 1.0))
+    best, bound, bf = np.inf, np.inf, -1
+    b0 = b1 = b2 = 0.0
+    if hint >= 0:
+        seen[hint] = q
+        b0, b1, b2, best = closest_on_face(V, F[hint, 0], F[hint, 1], F[hint, 2], p0, p1, p2)
+        bf = hint
+        if best < enough:
+            return best, bf, b0, b1, b2
+        s = np.sqrt(best) + e
+        bound = s * s
+    r = 0
+    while True:
+        for ix in range(max(cx - r, 0), min(cx + r, nx - 1) + 1):
+            gx = _gap(p0, lo[0] + ix * cell, lo[0] + (ix + 1) * cell)
+            ox = ix == cx - r or ix == cx + r
+            for iy in range(max(cy - r, 0), min(cy + r, ny - 1) + 1):
+                gy = _gap(p1, lo[1] + iy * cell, lo[1] + (iy + 1) * cell)
+                shell = ox or iy == cy - r or iy == cy + r
+                # on the shell: the whole row along z; inside it: the row's two ends
+                z0, z1, dz = (max(cz - r, 0), min(cz + r, nz - 1), 1) if shell else (cz - r, cz + r, 2 * r)
+                for iz in range(z0, z1 + 1, dz):
+                    if iz < 0 or iz >= nz:
+                        continue
+                    gz = _gap(p2, lo[2] + iz * cell, lo[2] + (iz + 1) * cell)
+                    if gx * gx + gy * gy + gz * gz > bound:
+                        continue
+                    c = (ix * ny + iy) * nz + iz
+                    for t in range(start[c], start[c + 1]):
+                        f = items[t]
+                        if seen[f] == q:
+                            continue
+                        seen[f] = q
+                        hx = _gap(p0, box[f, 0], box[f, 3])
+                        hy = _gap(p1, box[f, 1], box[f, 4])
+                        hz = _gap(p2, box[f, 2], box[f, 5])
+                        if hx * hx + hy * hy + hz * hz > bound:
+                            continue
+                        x0, x1, x2, d = closest_on_face(V, F[f, 0], F[f, 1], F[f, 2], p0, p1, p2)
+                        if d < best or (d == best and f < bf):
+                            best, bf, b0, b1, b2 = d, f, x0, x1, x2
+                            if best < enough:
+                                return best, bf, b0, b1, b2
+                            s = np.sqrt(best) + e
+                            bound = s * s
+        # every cell not yet visited is beyond one of the shell's sides that is not the grid's
+        lb = np.inf
+        if cx - r > 0:
+            lb = min(lb, p0 - (lo[0] + (cx - r) * cell))
+        if cx + r < nx - 1:
+            lb = min(lb, lo[0] + (cx + r + 1) * cell - p0)
+        if cy - r > 0:
+            lb = min(lb, p1 - (lo[1] + (cy - r) * cell))
+        if cy + r < ny - 1:
+            lb = min(lb, lo[1] + (cy + r + 1) * cell - p1)
+        if cz - r > 0:
+            lb = min(lb, p2 - (lo[2] + (cz - r) * cell))
+        if cz + r < nz - 1:
+            lb = min(lb, lo[2] + (cz + r + 1) * cell - p2)
+        if lb == np.inf or (lb > e and (lb - e) * (lb - e) > best):
+            return best, bf, b0, b1, b2
+        r += 1
+
+
+@njit(cache=True)
+def grid_slack(lo, cell, dims):
+    """The slack of :func:`grid_closest`'s comparisons: ``1e-12`` times the largest coordinate of the grid."""
+    scale = cell
+    for c in range(3):
+        scale = max(scale, max(abs(lo[c]), abs(lo[c] + dims[c] * cell)))
+    return 1e-12 * scale
+
+
+@njit(cache=True)
+def grid_closest(V, F, lo, cell, dims, start, items, box, P, enough):
+    """The closest point on the faces ``F`` of ``V`` to every row of ``P`` through their
+    :func:`face_grid` (given): ``(d2 (k,), face (k,), C (k, 3))``, squared distances, faces and points.
+
+    The same answer as measuring every face (:func:`closest_on_face`; the lowest face index among
+    equally close ones), which the grid only spares: from the cell of the point (the nearest cell
+    of the grid for a point outside it), shells of cells at growing distance; a cell or a face
+    whose box is farther than the best distance so far is skipped, and the search stops when
+    every cell outside the shells is farther than it. Distances are compared with a slack of
+    ``1e-12`` times the grid's scale, so that rounding cannot skip a face that would win.
+
+    A point stops at the first face closer than ``sqrt(enough)`` (0: none does): for a question
+    such as "is it within this distance", where which face answers does not matter. Each point first
+    measures the face of the point before it (consecutive points are often near each other).
+    """
+    k = len(P)
+    d2 = np.empty(k)
+    face = np.empty(k, np.int64)
+    C = np.empty((k, 3))
+    seen = np.full(len(F), -1, np.int64)
+    e = grid_slack(lo, cell, dims)
+    hint = np.int64(-1)  # typed: a literal would compile _grid_point once more
+    for q in range(k):
+        d2[q], face[q], C[q, 0], C[q, 1], C[q, 2] = _grid_point(
+            V, F, lo, cell, dims, start, items, box, seen, q, P[q, 0], P[q, 1], P[q, 2], e, enough, hint
+        )
+        hint = face[q]
+    return d2, face, C
+
+
+@njit(cache=True)
+def cover_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, Q, floor, V0, F0, lo, cell, dims, start, items, box):
+    """Move vertex ``cand[i]`` to the closest point on the input ``(V0, F0)`` of ``Q[i]`` (through the
+    input's :func:`face_grid`) when the smallest angle of the faces around it stays at least
+    ``floor`` (radians) and none turns over; the rows of a vertex in order of preference, the first
+    allowed one wins, each test on the positions so far. A point is projected only when it is
+    tried. Returns the number of moves (:func:`.stages._cover`)."""
     hes = np.empty(RING, np.int64)
     moved = np.zeros(len(V), np.bool_)
+    seen = np.full(len(F0), -1, np.int64)
+    e = grid_slack(lo, cell, dims)
+    hint = np.int64(-1)  # typed: a literal would compile _grid_point once more
     done = 0
     for i in range(len(cand)):
         v = cand[i]
         if VH[v] < 0 or cls[v] != 0 or moved[v]:
             continue
-        if _ring_min_angle(V, F, T, VH, v, P[i, 0], P[i, 1], P[i, 2], hes) >= floor:
-            V[v, 0], V[v, 1], V[v, 2] = P[i, 0], P[i, 1], P[i, 2]
+        _, hint, x, y, z = _grid_point(
+            V0, F0, lo, cell, dims, start, items, box, seen, i, Q[i, 0], Q[i, 1], Q[i, 2], e, 0.0, hint
+        )
+        if _ring_min_angle(V, F, T, VH, v, x, y, z, hes) >= floor:
+            V[v, 0], V[v, 1], V[v, 2] = x, y, z
             moved[v] = True
             done += 1
     return done
@@ -660,8 +851,8 @@ def faces_min_angle(V, F):
 
 
 # --------------------------------------------------------------------------------------------
-# the relocation step of the clean-up (given): one pass of :func:`..stages._relocate` in two
-# kernels around the projection (a libigl call). In NumPy a pass was about sixty calls, most of a
+# the relocation step of the clean-up (given): one pass of :func:`..stages._relocate`, its points,
+# their projection and the moves, in one kernel (:func:`relocate_round`). In NumPy a pass was about sixty calls, most of a
 # small mesh's remeshing time (spot's cage: 14 of 28 ms). The sums are those of the NumPy version,
 # in its order: ``np.bincount`` adds in index order, and ``np.einsum("ij,ij->i")`` over three
 # columns adds ``(x0 y0 + x2 y2) + x1 y1`` (:func:`dot3`).
@@ -852,6 +1043,50 @@ def relocate_moves(
         if moved[E[e, 0]]:
             fresh[E[e, 1]] = True
     return done
+
+
+@njit(cache=True)
+def relocate_round(
+    V,
+    F,
+    T,
+    VH,
+    val,
+    cls,
+    feat,
+    falive,
+    cnt,
+    Fl,
+    E,
+    deg,
+    fresh,
+    min_angle,
+    search_angle,
+    step,
+    directions,
+    P_at,
+    flat_at,
+    V0,
+    F0,
+    lo,
+    cell,
+    dims,
+    start,
+    items,
+    box,
+):
+    """One pass of :func:`..stages._relocate`: :func:`relocate_targets`, their closest points on the
+    input ``(V0, F0)`` (:func:`grid_closest` through its grid), :func:`relocate_moves`. Returns the
+    number of moves, or -1 when no candidate has a point to try."""
+    cand, worst, rows, kinds, Q, D = relocate_targets(
+        V, Fl, E, deg, cls, fresh, min_angle, search_angle, step, directions
+    )
+    if not len(rows):
+        return -1
+    P = grid_closest(V0, F0, lo, cell, dims, start, items, box, Q, 0.0)[2]
+    return relocate_moves(
+        V, F, T, VH, val, cls, feat, falive, cnt, E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh
+    )
 
 
 @njit(cache=True)

@@ -131,7 +131,7 @@ def isotropic_remesh(
         n = S.cnt[0]
         Fl = S.faces()
         cls = S.cls[:n]
-        Ef = S.feature_edges()
+        Ef = S.feature_edges() if len(E0) else E0  # no feature edge at the start: none later (splits only copy them)
         Vn = S.V[:n]
         for _ in range(steps):
             Vn = _relax(Vn, Fl, cls, Ef, lam)

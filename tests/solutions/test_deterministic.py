@@ -33,7 +33,7 @@ Why not one CPU target for every machine (numba's generic target everywhere, so 
 would load this process's kernels): measured on the kernels' benches (best of 3 CPU times per case,
 three alternating rounds of host-target and generic-target processes, znver3), the generic target is
 7% slower in geometric mean over 21 remeshing, simplification and sdf cases and 10-30% slower on
-several (remeshing the spot cage at 1.5x 9.9 -> 11.1 ms, a case already slower than gpytoolbox's).
+several (remeshing the spot cage at 1.5x: 9.9 -> 11.1 ms, measured before its projection was compiled).
 
 The environment variables are read when numba, numpy and OpenBLAS load, so every other setting
 runs in a fresh interpreter (``tests/solutions/kernel_digests.py``).

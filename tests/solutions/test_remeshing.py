@@ -245,18 +245,58 @@ def test_a_wrong_valence_count_is_named_when_the_mesh_is_returned():
         M.state_mesh(S)
 
 
-def test_near_faces_agrees_with_igl_distances():
-    """The clean-up's tips' pass skips libigl for the input vertices ``kernels.near_faces`` calls
-    covered: that must never claim a point nearer than libigl's distance, and must find every one
-    that libigl puts clearly within the bound (points on, near and off a mesh with sharp edges)."""
-    V, F = datasets.rock_on_plinth(16)
-    rng = np.random.default_rng(5)
+def _points_around(V, n, seed):
+    """Points on, near and far off the mesh (its vertices first)."""
+    rng = np.random.default_rng(seed)
     scale = np.ptp(V, axis=0).max()
-    X = np.r_[V, V[rng.integers(0, len(V), 400)] + rng.normal(0.0, 0.05 * scale, (400, 3))]
-    X = np.r_[X, rng.uniform(V.min(axis=0) - 0.1 * scale, V.max(axis=0) + 0.1 * scale, (400, 3))]
-    d2 = np.asarray(igl.point_mesh_squared_distance(X, V, F)[0]).ravel()
-    U = np.arange(len(X))
-    for t in np.quantile(np.sqrt(d2), [0.1, 0.3, 0.5, 0.7, 0.9]):
-        near = K.near_faces(X, U, V, F.astype(np.int64), t * t)
-        assert not (near & (d2 >= t * t * (1 + 1e-9))).any()
-        assert near[d2 < t * t * (1 - 1e-9)].all()
+    near = V[rng.integers(0, len(V), n)] + rng.normal(0.0, 0.05 * scale, (n, 3))
+    far = rng.uniform(V.min(axis=0) - 0.5 * scale, V.max(axis=0) + 0.5 * scale, (n, 3))
+    return np.r_[V, near, far], scale
+
+
+def test_grid_closest_agrees_with_igl_and_not_with_the_grid():
+    """The projector's compiled query (``kernels.grid_closest`` through ``kernels.face_grid``) gives
+    libigl's squared distances and closest points for points on, near and far off a mesh with sharp
+    edges, and a mesh with a degenerate face (its sides); and the same bytes for any cell size (one
+    cell, a fine grid, the default), the face of the lowest index among equally close ones, as
+    measuring every face would: a mesh vertex names the first face around it."""
+    cases = [datasets.rock_on_plinth(16)]
+    # a strip with a degenerate face (three corners on a line) beside a proper one
+    cases.append(
+        (
+            np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [1, 1, 0], [1, -1, 0.5]], float),
+            np.array([[0, 1, 2], [0, 3, 1], [1, 4, 2]]),
+        )
+    )
+    for V, F in cases:
+        F = F.astype(np.int64)
+        X, scale = _points_around(V, 300, 5)
+        d2, face, C = K.grid_closest(V, F, *K.face_grid(V, F, 0.0), X, 0.0)
+        e2, _, EC = igl.point_mesh_squared_distance(X, V, F)
+        np.testing.assert_allclose(d2, np.asarray(e2).ravel(), rtol=0, atol=1e-12 * scale**2)
+        np.testing.assert_allclose(C, EC, rtol=0, atol=1e-9 * scale)
+        assert ((face >= 0) & (face < len(F))).all()
+        for cell in (1e-3 * scale, 0.1 * scale, 10.0 * scale):
+            again = K.grid_closest(V, F, *K.face_grid(V, F, cell), X, 0.0)
+            for a, b in zip(again, (d2, face, C)):
+                assert a.tobytes() == b.tobytes(), f"cell {cell}: another answer"
+        first = np.full(len(V), len(F))
+        np.minimum.at(first, F.ravel(), np.repeat(np.arange(len(F)), 3))
+        assert (d2[: len(V)] == 0).all() and (face[: len(V)] == first).all()
+
+
+def test_grid_closest_stops_early_only_below_enough():
+    """With ``enough``, a point closer than ``sqrt(enough)`` may stop at any such face (the tips'
+    pass asks only whether an input vertex is covered); every other point gets the exact answer."""
+    V, F = datasets.rock_on_plinth(16)
+    F = F.astype(np.int64)
+    X, scale = _points_around(V, 300, 6)
+    grid = K.face_grid(V, F, 0.0)
+    exact = K.grid_closest(V, F, *grid, X, 0.0)
+    r2 = np.quantile(exact[0], 0.4)
+    d2, face, C = K.grid_closest(V, F, *grid, X, r2)
+    close = exact[0] < r2
+    assert (d2[close] < r2).all()
+    assert close.any() and (d2[close] != exact[0][close]).any(), "no point stopped early: the test shows nothing"
+    for a, b in zip((d2, face, C), exact):
+        assert a[~close].tobytes() == b[~close].tobytes()
