@@ -227,6 +227,9 @@ def _cover(S: RemeshState, project, passes: int) -> int:
     floor = K.faces_min_angle(S.V[:n], Fl).min()
     U = np.arange(len(X))
     steps = np.asarray(COVER_STEPS)
+    # an input vertex's projected points, kept while its candidate stays put (see kernels.cover_pass)
+    from_, at = np.full(len(X), -1, np.int64), np.zeros((len(X), 3), np.int64)
+    P_at, known = np.zeros((len(X), len(steps), 3)), np.zeros((len(X), len(steps)), bool)
     total = 0
     for _ in range(passes):
         V = S.V[:n]
@@ -235,7 +238,7 @@ def _cover(S: RemeshState, project, passes: int) -> int:
         U, d, cand, Q = K.cover_targets(V, X, U, d2, Fl[face], S.high, COVER_DISTANCE, steps)
         if not len(U):
             break
-        done = K.cover_pass(*S.args(), cand, Q, floor, project.V0, project.F0, *project.grid)
+        done = K.cover_pass(*S.args(), U, cand, Q, floor, project.V0, project.F0, *project.grid, from_, at, P_at, known)
         total += done
         if not done:
             break

@@ -1056,29 +1056,74 @@ def grid_closest(V, F, lo, cell, dims, start, items, box, P, enough):
 
 
 @njit(cache=True)
-def cover_pass(V, F, T, VH, val, cls, feat, falive, cnt, cand, Q, floor, V0, F0, lo, cell, dims, start, items, box):
+def cover_pass(
+    V,
+    F,
+    T,
+    VH,
+    val,
+    cls,
+    feat,
+    falive,
+    cnt,
+    U,
+    cand,
+    Q,
+    floor,
+    V0,
+    F0,
+    lo,
+    cell,
+    dims,
+    start,
+    items,
+    box,
+    from_,
+    at,
+    P_at,
+    known,
+):
     """Move vertex ``cand[i]`` to the closest point on the input ``(V0, F0)`` of ``Q[i]`` (through the
     input's :func:`face_grid`) when the smallest angle of the faces around it stays at least
-    ``floor`` (radians) and none turns over; the rows of a vertex in order of preference, the first
-    allowed one wins, each test on the positions so far. A point is projected only when it is
-    tried. Returns the number of moves (:func:`.stages._cover`)."""
+    ``floor`` (radians) and none turns over; the ``s = len(cand) // len(U)`` rows of input vertex
+    ``U[k]`` (from ``k * s``: one candidate vertex, its points in order of preference), the first
+    allowed one wins, each test on the positions so far. Returns the number of moves
+    (:func:`.stages._cover`).
+
+    A point is projected only when it is tried, and once: an input vertex's points depend only on
+    it and its candidate's position, so across the passes of one clean-up ``P_at[x, j]`` keeps the
+    projection of its point ``j`` (``known[x, j]``) while its candidate (``from_[x]``) stays at the
+    same bits (``at[x]``, int64).
+    """
     hes = np.empty(RING, np.int64)
     moved = np.zeros(len(V), np.bool_)
     seen = np.full(len(F0), -1, np.int64)
     e = grid_slack(lo, cell, dims)
-    hint = np.int64(-1)  # typed: a literal would compile _grid_point once more
-    done = 0
-    for i in range(len(cand)):
-        v = cand[i]
+    s = len(cand) // max(len(U), 1)
+    bits = V.view(np.int64)  # positions compared as bits: -0.0 is not 0.0 here
+    hint, q, done = np.int64(-1), np.int64(0), 0  # typed: a literal would compile _grid_point once more
+    for k in range(len(U)):
+        x, v = U[k], cand[k * s]
         if VH[v] < 0 or cls[v] != 0 or moved[v]:
             continue
-        _, hint, x, y, z = _grid_point(
-            V0, F0, lo, cell, dims, start, items, box, seen, i, Q[i, 0], Q[i, 1], Q[i, 2], e, 0.0, hint
-        )
-        if _ring_min_angle(V, F, T, VH, v, x, y, z, hes) >= floor:
-            V[v, 0], V[v, 1], V[v, 2] = x, y, z
-            moved[v] = True
-            done += 1
+        if from_[x] != v or at[x, 0] != bits[v, 0] or at[x, 1] != bits[v, 1] or at[x, 2] != bits[v, 2]:
+            from_[x] = v
+            at[x, 0], at[x, 1], at[x, 2] = bits[v, 0], bits[v, 1], bits[v, 2]
+            known[x, :] = False
+        for j in range(s):
+            i = k * s + j
+            if not known[x, j]:
+                _, hint, P_at[x, j, 0], P_at[x, j, 1], P_at[x, j, 2] = _grid_point(
+                    V0, F0, lo, cell, dims, start, items, box, seen, q, Q[i, 0], Q[i, 1], Q[i, 2], e, 0.0, hint
+                )
+                known[x, j] = True
+                q += 1
+            px, py, pz = P_at[x, j, 0], P_at[x, j, 1], P_at[x, j, 2]
+            if _ring_min_angle(V, F, T, VH, v, px, py, pz, hes) >= floor:
+                V[v, 0], V[v, 1], V[v, 2] = px, py, pz
+                moved[v] = True
+                done += 1
+                break
     return done
 
 
