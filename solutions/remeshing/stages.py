@@ -177,24 +177,15 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
     flat_at = np.zeros((n, 1 + len(SEARCH_DIRECTIONS)), bool)
     directions = np.array(SEARCH_DIRECTIONS)
     below, search_below = np.radians(min_angle), np.radians(SEARCH_ANGLE)
-    for _ in range(passes):  # a pass: its points, their projection, the moves (one kernel)
-        done = K.relocate_round(
-            *S.args(),
-            Fl,
-            E,
-            deg,
-            fresh,
-            below,
-            search_below,
-            SEARCH_STEP,
-            directions,
-            P_at,
-            flat_at,
-            project.V0,
-            project.F0,
-            *project.grid,
+    for _ in range(passes):  # a pass: its points (kernel), their projection (the grid), the moves (kernel)
+        cand, worst, rows, kinds, Q, D = K.relocate_targets(
+            S.V, Fl, E, deg, S.cls, fresh, below, search_below, SEARCH_STEP, directions
         )
-        if done <= 0:  # -1: nothing around the candidates moved, the last pass's answers stand; 0: no move
+        if not len(rows):
+            break
+        P = project(Q)
+        done = K.relocate_moves(*S.args(), E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh)
+        if not done:
             break
         total += done
     return total
