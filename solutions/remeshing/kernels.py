@@ -907,13 +907,16 @@ def face_grid(V, F, cell):
         return lo, cell, dims, np.zeros(2, np.int64), np.zeros(0, np.int64), box
     cap = GRID_CELLS_PER_FACE * m + 64
     while True:
-        total = 1
+        total = 1.0  # a float: a tiny cell in a large box would overflow an int64 product
         for c in range(3):
-            dims[c] = int((hi[c] - lo[c]) / cell) + 1
-            total *= dims[c]
+            total *= (hi[c] - lo[c]) / cell + 1.0
         if total <= cap:
             break
         cell *= 1.25
+    total = 1
+    for c in range(3):
+        dims[c] = int((hi[c] - lo[c]) / cell) + 1
+        total *= dims[c]
     count = np.zeros(total + 1, np.int64)
     rng = np.empty((m, 6), np.int64)
     for f in range(m):
