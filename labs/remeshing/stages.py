@@ -174,13 +174,13 @@ def _relocate(S: RemeshState, project, min_angle: float, passes: int) -> int:
         cand, worst, rows, kinds, Q, D = K.relocate_targets(
             S.V, Fl, E, deg, S.cls, fresh, below, search_below, SEARCH_STEP, directions
         )
-        if not len(rows):
+        if not len(rows):  # nothing around the candidates moved: the last pass's answers stand
             break
         P = project(Q)
         done = K.relocate_moves(*S.args(), E, cand, worst, rows, kinds, Q, D, P, P_at, flat_at, fresh)
+        total += done
         if not done:
             break
-        total += done
     return total
 
 
